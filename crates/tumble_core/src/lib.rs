@@ -1,0 +1,30 @@
+//! # tumble_core
+//!
+//! The ECS-free math of tumble: rigid-body state, mass properties, integrators, invariants and
+//! analytic reference solutions. Everything here is a plain function on plain data, so every
+//! integrator can be tested and benchmarked without an ECS, and the ECS layer (`tumble_ecs`) is a
+//! thin loop over queries that calls these functions.
+//!
+//! Conventions:
+//! - `BodyState::position` is the world position of the **centre of mass**.
+//! - Angular velocity `ω` is in **world** coordinates (`Ṙ = [ω]× R`).
+//! - Inertia is stored as principal moments `I_b` in a principal frame; the world inverse inertia
+//!   `R I_b⁻¹ Rᵀ` is applied by rotating into the principal frame, never inverted numerically.
+//! - A zero principal moment locks that axis (its inverse is 0), never NaN.
+
+#![forbid(unsafe_code)]
+#![warn(missing_docs)]
+
+pub mod error;
+pub mod integrate;
+pub mod invariants;
+pub mod mass;
+pub mod rotation;
+#[cfg(feature = "parry")]
+pub mod shapes;
+pub mod state;
+
+pub use error::{InvalidInput, UNIT_QUATERNION_TOLERANCE};
+pub use integrate::{Integrator, StepError};
+pub use mass::{Density, Mass, MassProperties};
+pub use state::{BodyState, Wrench};

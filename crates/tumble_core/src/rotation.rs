@@ -1,0 +1,44 @@
+//! Quaternion helpers: the exponential map and its linearization.
+
+use glam::{Quat, Vec3};
+
+/// The unit quaternion of a rotation by the vector `θ` (axis `θ/|θ|`, angle `|θ|`):
+/// `exp(½ θ) = (sin(|θ|/2) θ/|θ|, cos(|θ|/2))`, exact for every angle.
+///
+/// For `|θ|` below 1e-4 rad the Taylor form `(θ/2 (1 − |θ|²/24), 1 − |θ|²/8)` is used, which is
+/// exact in f32 there and avoids dividing by a tiny angle.
+#[inline]
+pub fn exp_rotation(theta: Vec3) -> Quat {
+    let angle2 = theta.length_squared();
+    if angle2 < 1e-8 {
+        let xyz = theta * (0.5 * (1.0 - angle2 / 24.0));
+        Quat::from_xyzw(xyz.x, xyz.y, xyz.z, 1.0 - angle2 / 8.0)
+    } else {
+        let angle = angle2.sqrt();
+        let (s, c) = (0.5 * angle).sin_cos();
+        let xyz = theta * (s / angle);
+        Quat::from_xyzw(xyz.x, xyz.y, xyz.z, c)
+    }
+}
+
+/// Rotates `q` by the world angular velocity `ω` over `dt` with the exact exponential map:
+/// `q ← exp(½ Δt ω) q`, then renormalizes to remove round-off.
+#[inline]
+pub fn rotate_exact(q: Quat, omega: Vec3, dt: f32) -> Quat {
+    (exp_rotation(omega * dt) * q).normalize()
+}
+
+/// The linearized update `q ← normalize(q + ½ Δt (ω, 0) q)`: first-order, its error grows with
+/// `|ω|Δt` (kept to show that error, see the `symplectic-euler-linear` integrator).
+#[inline]
+pub fn rotate_linearized(q: Quat, omega: Vec3, dt: f32) -> Quat {
+    let w = Quat::from_xyzw(omega.x, omega.y, omega.z, 0.0);
+    (q + (w * q) * (0.5 * dt)).normalize()
+}
+
+/// Rotation angle between two unit quaternions, `2 acos |⟨a, b⟩|`, in radians (0..π).
+#[inline]
+pub fn angle_between(a: Quat, b: Quat) -> f32 {
+    let d = a.dot(b).abs().min(1.0);
+    2.0 * d.acos()
+}

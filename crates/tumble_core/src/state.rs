@@ -1,0 +1,82 @@
+//! Rigid-body state and the external load applied over one step.
+
+use glam::{Quat, Vec3};
+
+use crate::error::{InvalidInput, check_finite_vec3, check_unit_quat};
+
+/// Kinematic state of one rigid body.
+///
+/// `position` is the world position of the centre of mass, `rotation` maps body coordinates to
+/// world coordinates, `angular_velocity` is in world coordinates.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BodyState {
+    /// World position of the centre of mass `x` (m).
+    pub position: Vec3,
+    /// Orientation `q`, body → world, unit quaternion.
+    pub rotation: Quat,
+    /// Linear velocity of the centre of mass `v` (m/s).
+    pub linear_velocity: Vec3,
+    /// Angular velocity `ω` in world coordinates (rad/s).
+    pub angular_velocity: Vec3,
+}
+
+impl Default for BodyState {
+    fn default() -> Self {
+        Self {
+            position: Vec3::ZERO,
+            rotation: Quat::IDENTITY,
+            linear_velocity: Vec3::ZERO,
+            angular_velocity: Vec3::ZERO,
+        }
+    }
+}
+
+impl BodyState {
+    /// True when every component is finite.
+    #[inline]
+    pub fn is_finite(&self) -> bool {
+        self.position.is_finite()
+            && self.rotation.is_finite()
+            && self.linear_velocity.is_finite()
+            && self.angular_velocity.is_finite()
+    }
+
+    /// Checks that every component is finite and the rotation is a unit quaternion.
+    pub fn validate(&self) -> Result<(), InvalidInput> {
+        check_finite_vec3("position", self.position)?;
+        check_unit_quat("rotation", self.rotation)?;
+        check_finite_vec3("linear velocity", self.linear_velocity)?;
+        check_finite_vec3("angular velocity", self.angular_velocity)
+    }
+}
+
+/// Net external load on a body, held constant over one step (zero-order hold).
+///
+/// `torque` is about the centre of mass, in world coordinates.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Wrench {
+    /// Net force `F` (N), world frame.
+    pub force: Vec3,
+    /// Net torque `τ` about the centre of mass (N·m), world frame.
+    pub torque: Vec3,
+}
+
+impl Wrench {
+    /// No force, no torque.
+    pub const ZERO: Self = Self {
+        force: Vec3::ZERO,
+        torque: Vec3::ZERO,
+    };
+
+    /// Checks that force and torque are finite.
+    pub fn validate(&self) -> Result<(), InvalidInput> {
+        check_finite_vec3("force", self.force)?;
+        check_finite_vec3("torque", self.torque)
+    }
+
+    /// True when both force and torque are finite.
+    #[inline]
+    pub fn is_finite(&self) -> bool {
+        self.force.is_finite() && self.torque.is_finite()
+    }
+}

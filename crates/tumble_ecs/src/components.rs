@@ -1,0 +1,287 @@
+//! Components and resources: the whole public data model of a tumble world.
+
+use bevy_ecs::prelude::*;
+use glam::{Quat, Vec3};
+use tumble_core::{BodyState, Integrator, InvalidInput, MassProperties};
+
+use crate::validate::revalidate_body_hook;
+
+/// Marks an entity as a rigid body. Only entities with this marker are touched by the physics
+/// systems, so resources and other entities never are.
+///
+/// Requires [`Transform`], [`Velocity`] and [`MassProps`] (inserted with their defaults when
+/// missing: identity pose, at rest, 1 kg with unit principal moments).
+#[derive(Component, Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[require(Transform, Velocity, MassProps)]
+pub struct RigidBody;
+
+/// Pose of the body origin in world coordinates.
+///
+/// The centre of mass sits at `translation + rotation * c`, with `c` the local centre of mass of
+/// the body's [`MassProps`].
+#[derive(Component, Debug, Clone, Copy, PartialEq)]
+#[component(on_insert = revalidate_body_hook)]
+pub struct Transform {
+    /// World position of the body origin (m).
+    pub translation: Vec3,
+    /// Orientation, body → world; must stay a unit quaternion.
+    pub rotation: Quat,
+}
+
+impl Default for Transform {
+    fn default() -> Self {
+        Self::IDENTITY
+    }
+}
+
+impl Transform {
+    /// At the origin, unrotated.
+    pub const IDENTITY: Self = Self {
+        translation: Vec3::ZERO,
+        rotation: Quat::IDENTITY,
+    };
+
+    /// A pose at `translation`, unrotated.
+    pub fn from_translation(translation: Vec3) -> Self {
+        Self {
+            translation,
+            ..Self::IDENTITY
+        }
+    }
+
+    /// A pose with `rotation` (unit quaternion), at the origin.
+    pub fn from_rotation(rotation: Quat) -> Self {
+        Self {
+            rotation,
+            ..Self::IDENTITY
+        }
+    }
+
+    /// Returns this pose with its translation replaced.
+    pub fn with_translation(self, translation: Vec3) -> Self {
+        Self {
+            translation,
+            ..self
+        }
+    }
+
+    /// World position of the centre of mass: `x = t + R c`.
+    #[inline]
+    pub fn center_of_mass(&self, mass: &MassProps) -> Vec3 {
+        self.translation + self.rotation * mass.local_center_of_mass()
+    }
+
+    /// Maps a body-local point to world coordinates: `t + R p`.
+    #[inline]
+    pub fn transform_point(&self, local: Vec3) -> Vec3 {
+        self.translation + self.rotation * local
+    }
+}
+
+/// Velocity of the centre of mass and angular velocity, both in world coordinates.
+#[derive(Component, Debug, Clone, Copy, PartialEq, Default)]
+#[component(on_insert = revalidate_body_hook)]
+pub struct Velocity {
+    /// Linear velocity of the centre of mass `v` (m/s).
+    pub linear: Vec3,
+    /// Angular velocity `ω`, world frame (rad/s).
+    pub angular: Vec3,
+}
+
+impl Velocity {
+    /// At rest.
+    pub const ZERO: Self = Self {
+        linear: Vec3::ZERO,
+        angular: Vec3::ZERO,
+    };
+
+    /// A linear velocity only.
+    pub fn linear(linear: Vec3) -> Self {
+        Self {
+            linear,
+            angular: Vec3::ZERO,
+        }
+    }
+
+    /// An angular velocity (world frame) only.
+    pub fn angular(angular: Vec3) -> Self {
+        Self {
+            linear: Vec3::ZERO,
+            angular,
+        }
+    }
+}
+
+/// Mass properties of a body. Valid by construction: a [`MassProperties`] can only be built
+/// through its checked constructors, so mass ≤ 0, NaN or negative inertia never reach the world.
+///
+/// Immutable: to change the mass, insert a new `MassProps`.
+#[derive(Component, Debug, Clone, Copy, PartialEq)]
+#[component(immutable)]
+pub struct MassProps(pub MassProperties);
+
+impl Default for MassProps {
+    /// 1 kg with unit principal moments (1 kg·m²) and the centre of mass at the origin.
+    fn default() -> Self {
+        let one = tumble_core::Mass::new(1.0).expect("1 kg is a valid mass");
+        Self(MassProperties::new(one, Vec3::ONE).expect("unit inertia is valid"))
+    }
+}
+
+impl std::ops::Deref for MassProps {
+    type Target = MassProperties;
+    fn deref(&self) -> &MassProperties {
+        &self.0
+    }
+}
+
+impl From<MassProperties> for MassProps {
+    fn from(value: MassProperties) -> Self {
+        Self(value)
+    }
+}
+
+/// Net force and torque (about the centre of mass, world frame) to apply in the next step.
+///
+/// **Clearing rule:** the integrator *consumes* the accumulator: it reads it and resets it to zero
+/// in the same pass. So a force that game code adds between two steps (or in
+/// [`PhysicsSet::Forces`](crate::schedule::PhysicsSet::Forces)) is applied in the next step
+/// exactly once, and nothing needs to clear it at the start of a step.
+#[derive(Component, Debug, Clone, Copy, PartialEq, Default)]
+#[component(on_insert = revalidate_body_hook)]
+pub struct ForceAccumulator {
+    /// Accumulated force `ΣF` (N), world frame.
+    pub force: Vec3,
+    /// Accumulated torque `Στ` about the centre of mass (N·m), world frame.
+    pub torque: Vec3,
+}
+
+impl ForceAccumulator {
+    /// Adds a force through the centre of mass (no torque).
+    #[inline]
+    pub fn add_force(&mut self, force: Vec3) {
+        self.force += force;
+    }
+
+    /// Adds a pure torque (world frame).
+    #[inline]
+    pub fn add_torque(&mut self, torque: Vec3) {
+        self.torque += torque;
+    }
+
+    /// Adds a force applied at a world point: the force, plus the torque `(p − x) × F` about the
+    /// centre of mass `x` (see [`Transform::center_of_mass`]).
+    ///
+    /// The lever arm is formed before the cross product, so a body far from the world origin
+    /// loses no precision to cancellation.
+    #[inline]
+    pub fn add_force_at_point(&mut self, force: Vec3, world_point: Vec3, center_of_mass: Vec3) {
+        self.force += force;
+        self.torque += (world_point - center_of_mass).cross(force);
+    }
+
+    /// Returns the accumulated load and resets the accumulator to zero.
+    #[inline]
+    pub fn take(&mut self) -> tumble_core::Wrench {
+        let wrench = tumble_core::Wrench {
+            force: self.force,
+            torque: self.torque,
+        };
+        *self = Self::default();
+        wrench
+    }
+}
+
+/// Multiplies the world [`Gravity`] for one body (1 = normal, 0 = none, −1 = reversed).
+#[derive(Component, Debug, Clone, Copy, PartialEq)]
+pub struct GravityScale(pub f32);
+
+impl Default for GravityScale {
+    fn default() -> Self {
+        Self(1.0)
+    }
+}
+
+/// Velocity damping, Padé form as rapier and avian use it: `v ← v / (1 + Δt c_lin)`,
+/// `ω ← ω / (1 + Δt c_ang)` after each step. Coefficients in 1/s, `>= 0`.
+#[derive(Component, Debug, Clone, Copy, PartialEq, Default)]
+pub struct Damping {
+    /// Linear coefficient `c_lin` (1/s).
+    pub linear: f32,
+    /// Angular coefficient `c_ang` (1/s).
+    pub angular: f32,
+}
+
+/// Uniform gravitational acceleration `g` (m/s²). Absent resource ⇒ no gravity system at all.
+#[derive(Resource, Debug, Clone, Copy, PartialEq)]
+pub struct Gravity(pub Vec3);
+
+impl Gravity {
+    /// Earth gravity along −y: `(0, −9.81, 0)`.
+    pub const EARTH_Y_DOWN: Self = Self(Vec3::new(0.0, -9.81, 0.0));
+}
+
+/// The step size and integrator of a world. The time step is validated on construction and the
+/// field is private, so a world never holds `Δt ≤ 0` or a non-finite `Δt`.
+#[derive(Resource, Debug, Clone, Copy, PartialEq)]
+pub struct PhysicsSettings {
+    dt: f32,
+    /// The integration method for every body of the world.
+    pub integrator: Integrator,
+}
+
+impl PhysicsSettings {
+    /// Settings with time step `dt` (s) and the given integrator; rejects `dt ≤ 0` and NaN/Inf.
+    pub fn new(dt: f32, integrator: Integrator) -> Result<Self, InvalidInput> {
+        tumble_core::error::check_time_step(dt)?;
+        Ok(Self { dt, integrator })
+    }
+
+    /// The fixed time step `Δt` (s).
+    #[inline]
+    pub fn dt(&self) -> f32 {
+        self.dt
+    }
+
+    /// Changes the time step; rejects `dt ≤ 0` and NaN/Inf and then leaves the settings unchanged.
+    pub fn set_dt(&mut self, dt: f32) -> Result<(), InvalidInput> {
+        tumble_core::error::check_time_step(dt)?;
+        self.dt = dt;
+        Ok(())
+    }
+}
+
+impl Default for PhysicsSettings {
+    /// 60 Hz with the default integrator.
+    fn default() -> Self {
+        Self {
+            dt: 1.0 / 60.0,
+            integrator: Integrator::default(),
+        }
+    }
+}
+
+/// Reads a body's core state (centre-of-mass position) from its components.
+#[inline]
+pub fn body_state(transform: &Transform, velocity: &Velocity, mass: &MassProps) -> BodyState {
+    BodyState {
+        position: transform.center_of_mass(mass),
+        rotation: transform.rotation,
+        linear_velocity: velocity.linear,
+        angular_velocity: velocity.angular,
+    }
+}
+
+/// Writes a core state back to a body's components (origin = `x − R c`).
+#[inline]
+pub fn write_body_state(
+    state: &BodyState,
+    mass: &MassProps,
+    transform: &mut Transform,
+    velocity: &mut Velocity,
+) {
+    transform.rotation = state.rotation;
+    transform.translation = state.position - state.rotation * mass.local_center_of_mass();
+    velocity.linear = state.linear_velocity;
+    velocity.angular = state.angular_velocity;
+}

@@ -1,0 +1,209 @@
+//! Force generators. Each generator is its own entity (a body may have any number of them) that
+//! names its body; its system runs in [`PhysicsSet::Forces`](crate::schedule::PhysicsSet::Forces)
+//! and adds to the body's [`ForceAccumulator`] (inserted automatically when a generator is
+//! spawned). A generator whose body is missing or rejected does nothing.
+
+use bevy_ecs::lifecycle::HookContext;
+use bevy_ecs::prelude::*;
+use bevy_ecs::world::DeferredWorld;
+use glam::Vec3;
+
+use crate::components::{
+    ForceAccumulator, Gravity, GravityScale, MassProps, RigidBody, Transform, Velocity,
+};
+use crate::validate::Rejected;
+
+/// A constant world-frame force on `body`, through a body-local point (or the centre of mass).
+#[derive(Component, Debug, Clone, Copy, PartialEq)]
+#[component(on_insert = ensure_accumulators)]
+pub struct ConstantForce {
+    /// The body that receives the force.
+    pub body: Entity,
+    /// Force `F` (N), world frame.
+    pub force: Vec3,
+    /// Point of application in body coordinates; `None` = the centre of mass (no torque).
+    /// Otherwise the torque `(p − x) × F` is added, with `p` the point in world coordinates.
+    pub local_point: Option<Vec3>,
+}
+
+/// A constant world-frame torque on `body`.
+#[derive(Component, Debug, Clone, Copy, PartialEq)]
+#[component(on_insert = ensure_accumulators)]
+pub struct ConstantTorque {
+    /// The body that receives the torque.
+    pub body: Entity,
+    /// Torque `τ` (N·m), world frame.
+    pub torque: Vec3,
+}
+
+/// The second end of a [`Spring`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum SpringEnd {
+    /// A point fixed in the world (m).
+    World(Vec3),
+    /// A body-local point of another body.
+    Body {
+        /// The other body.
+        body: Entity,
+        /// Anchor in that body's coordinates.
+        anchor: Vec3,
+    },
+}
+
+/// A damped linear spring between a point of body `a` and a second end.
+///
+/// With anchors `p_a`, `p_b` in world coordinates, `d = p_a − p_b`, `n = d/|d|` and the relative
+/// anchor velocity `u = ṗ_a − ṗ_b`, the force on `a` is
+/// `F_a = −(k (|d| − L₀) + c (u·n)) n` and `b` receives `−F_a`, each at its anchor (so with the
+/// matching torques). At `|d| = 0` the direction is undefined and no force is applied.
+#[derive(Component, Debug, Clone, Copy, PartialEq)]
+#[component(on_insert = ensure_accumulators)]
+pub struct Spring {
+    /// First body.
+    pub a: Entity,
+    /// Anchor on `a`, body coordinates.
+    pub anchor_a: Vec3,
+    /// The other end.
+    pub b: SpringEnd,
+    /// Stiffness `k` (N/m), `>= 0`.
+    pub stiffness: f32,
+    /// Damping `c` (N·s/m), `>= 0`.
+    pub damping: f32,
+    /// Rest length `L₀` (m), `>= 0`.
+    pub rest_length: f32,
+}
+
+/// Inserts a zero [`ForceAccumulator`] on every body a generator names, where missing.
+fn ensure_accumulators(mut world: DeferredWorld, ctx: HookContext) {
+    let entity = ctx.entity;
+    let mut targets = Vec::with_capacity(2);
+    if let Some(f) = world.get::<ConstantForce>(entity) {
+        targets.push(f.body);
+    }
+    if let Some(t) = world.get::<ConstantTorque>(entity) {
+        targets.push(t.body);
+    }
+    if let Some(s) = world.get::<Spring>(entity) {
+        targets.push(s.a);
+        if let SpringEnd::Body { body, .. } = s.b {
+            targets.push(body);
+        }
+    }
+    for body in targets {
+        if world.get::<ForceAccumulator>(body).is_none()
+            && let Ok(mut e) = world.commands().get_entity(body)
+        {
+            e.insert_if_new(ForceAccumulator::default());
+        }
+    }
+}
+
+/// The bodies force generators write to: valid rigid bodies with an accumulator.
+pub type ForceTargets<'w, 's> = Query<
+    'w,
+    's,
+    (
+        &'static Transform,
+        &'static Velocity,
+        &'static MassProps,
+        &'static mut ForceAccumulator,
+    ),
+    (With<RigidBody>, Without<Rejected>),
+>;
+
+/// Adds `m g s` to every body with an accumulator (`s` = [`GravityScale`], default 1).
+/// Only in the schedule when a [`Gravity`] resource exists.
+pub fn apply_gravity(
+    gravity: Res<Gravity>,
+    mut bodies: Query<
+        (&MassProps, Option<&GravityScale>, &mut ForceAccumulator),
+        (With<RigidBody>, Without<Rejected>),
+    >,
+) {
+    let g = gravity.0;
+    for (mass, scale, mut acc) in &mut bodies {
+        let s = scale.map_or(1.0, |s| s.0);
+        acc.force += (mass.mass() * s) * g;
+    }
+}
+
+/// Applies every [`ConstantForce`].
+pub fn apply_constant_forces(generators: Query<&ConstantForce>, mut bodies: ForceTargets) {
+    for gen_force in &generators {
+        let Ok((transform, _, mass, mut acc)) = bodies.get_mut(gen_force.body) else {
+            continue;
+        };
+        match gen_force.local_point {
+            None => acc.add_force(gen_force.force),
+            Some(local) => acc.add_force_at_point(
+                gen_force.force,
+                transform.transform_point(local),
+                transform.center_of_mass(mass),
+            ),
+        }
+    }
+}
+
+/// Applies every [`ConstantTorque`].
+pub fn apply_constant_torques(generators: Query<&ConstantTorque>, mut bodies: ForceTargets) {
+    for gen_torque in &generators {
+        if let Ok((_, _, _, mut acc)) = bodies.get_mut(gen_torque.body) {
+            acc.add_torque(gen_torque.torque);
+        }
+    }
+}
+
+/// World anchor point and its velocity `ṗ = v + ω × (p − x)` for a body-local anchor.
+#[inline]
+fn anchor_kinematics(
+    transform: &Transform,
+    velocity: &Velocity,
+    mass: &MassProps,
+    local: Vec3,
+) -> (Vec3, Vec3, Vec3) {
+    let com = transform.center_of_mass(mass);
+    let point = transform.transform_point(local);
+    let point_velocity = velocity.linear + velocity.angular.cross(point - com);
+    (point, point_velocity, com)
+}
+
+/// Spring force on end `a`: `−(k (|d| − L₀) + c (u·n)) n`, zero when `|d| = 0`.
+#[inline]
+pub fn spring_force(spring: &Spring, d: Vec3, relative_velocity: Vec3) -> Vec3 {
+    let length = d.length();
+    if length <= 0.0 {
+        return Vec3::ZERO;
+    }
+    let n = d / length;
+    let magnitude = spring.stiffness * (length - spring.rest_length)
+        + spring.damping * relative_velocity.dot(n);
+    -magnitude * n
+}
+
+/// Applies every [`Spring`].
+pub fn apply_springs(springs: Query<&Spring>, mut bodies: ForceTargets) {
+    for spring in &springs {
+        match spring.b {
+            SpringEnd::World(anchor_b) => {
+                let Ok((t, v, m, mut acc)) = bodies.get_mut(spring.a) else {
+                    continue;
+                };
+                let (pa, ua, com) = anchor_kinematics(t, v, m, spring.anchor_a);
+                let f = spring_force(spring, pa - anchor_b, ua);
+                acc.add_force_at_point(f, pa, com);
+            }
+            SpringEnd::Body { body, anchor } => {
+                let Ok([(ta, va, ma, mut acc_a), (tb, vb, mb, mut acc_b)]) =
+                    bodies.get_many_mut([spring.a, body])
+                else {
+                    continue;
+                };
+                let (pa, ua, com_a) = anchor_kinematics(ta, va, ma, spring.anchor_a);
+                let (pb, ub, com_b) = anchor_kinematics(tb, vb, mb, anchor);
+                let f = spring_force(spring, pa - pb, ua - ub);
+                acc_a.add_force_at_point(f, pa, com_a);
+                acc_b.add_force_at_point(-f, pb, com_b);
+            }
+        }
+    }
+}

@@ -1,0 +1,33 @@
+//! # tumble_ecs
+//!
+//! The `bevy_ecs` layer of tumble: components ([`Transform`](components::Transform),
+//! [`Velocity`](components::Velocity), [`MassProps`](components::MassProps),
+//! [`ForceAccumulator`](components::ForceAccumulator), …), force generators, the integrate
+//! systems, a [`PhysicsPlan`](schedule::PhysicsPlan) that builds a schedule holding only what a
+//! world needs, a fixed-step [`FixedStepper`](stepper::FixedStepper) and validation that keeps bad
+//! data out.
+
+#![forbid(unsafe_code)]
+#![warn(missing_docs)]
+// ECS queries name their filters inline, as bevy itself does.
+#![allow(clippy::type_complexity)]
+
+pub mod components;
+pub mod forces;
+pub mod schedule;
+pub mod stepper;
+pub mod systems;
+pub mod validate;
+
+/// Everything a game loop needs, in one import.
+pub mod prelude {
+    pub use crate::components::{
+        Damping, ForceAccumulator, Gravity, GravityScale, MassProps, PhysicsSettings, RigidBody,
+        Transform, Velocity,
+    };
+    pub use crate::forces::{ConstantForce, ConstantTorque, Spring, SpringEnd};
+    pub use crate::schedule::{PhysicsPlan, PhysicsSchedule, PhysicsSet, Stage};
+    pub use crate::stepper::{FixedStepper, FrameSteps, interpolate};
+    pub use crate::validate::{BodyError, BodyErrorKind, PhysicsErrors, Rejected};
+    pub use tumble_core::{Density, Integrator, Mass, MassProperties};
+}

@@ -1,0 +1,110 @@
+//! Rejection of bad component data: typed errors that name the entity, and a quarantine marker
+//! so that one bad body never harms another.
+//!
+//! Bad data is caught in two places:
+//! - **on insert**: a component hook on [`Transform`], [`Velocity`] and [`ForceAccumulator`]
+//!   re-checks the whole body; [`MassProps`](crate::components::MassProps) and
+//!   [`PhysicsSettings`](crate::components::PhysicsSettings) cannot hold bad values at all;
+//! - **on change**: the integrate systems check each body's input before stepping it (game code
+//!   may have written NaN into a `&mut Transform`) and its output after (a method outside its
+//!   stable region).
+//!
+//! A rejected body gets the [`Rejected`] marker, keeps its last valid data untouched and is skipped
+//! by every physics system; the error is logged with `tracing` and appended to [`PhysicsErrors`].
+//! Inserting valid data again lifts the quarantine.
+
+use bevy_ecs::lifecycle::HookContext;
+use bevy_ecs::prelude::*;
+use bevy_ecs::world::DeferredWorld;
+use thiserror::Error;
+use tumble_core::{InvalidInput, StepError};
+
+use crate::components::{ForceAccumulator, RigidBody, Transform, Velocity};
+
+/// Why a body was rejected.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum BodyErrorKind {
+    /// A component holds invalid data.
+    #[error("invalid {component}: {source}")]
+    Invalid {
+        /// The component type, e.g. `"Transform"`.
+        component: &'static str,
+        /// What is wrong with it.
+        source: InvalidInput,
+    },
+    /// The integrator produced a non-finite state; the body keeps its last finite state.
+    #[error(transparent)]
+    Diverged(#[from] StepError),
+}
+
+/// A body-level error, naming the entity.
+#[derive(Debug, Clone, PartialEq, Error)]
+#[error("rigid body {entity}: {kind}")]
+pub struct BodyError {
+    /// The rejected entity.
+    pub entity: Entity,
+    /// What went wrong.
+    pub kind: BodyErrorKind,
+}
+
+/// Quarantine marker: the body is skipped by every physics system until valid data is inserted.
+#[derive(Component, Debug, Clone, PartialEq)]
+pub struct Rejected(pub BodyError);
+
+/// Every body error raised so far, oldest first. Game code may drain it.
+#[derive(Resource, Debug, Clone, Default, PartialEq)]
+pub struct PhysicsErrors(pub Vec<BodyError>);
+
+/// Checks the body data of a [`Transform`], [`Velocity`] and optional [`ForceAccumulator`].
+pub fn check_body(
+    transform: &Transform,
+    velocity: &Velocity,
+    forces: Option<&ForceAccumulator>,
+) -> Result<(), BodyErrorKind> {
+    use tumble_core::error::{check_finite_vec3, check_unit_quat};
+    let invalid = |component| move |source| BodyErrorKind::Invalid { component, source };
+    check_finite_vec3("translation", transform.translation).map_err(invalid("Transform"))?;
+    check_unit_quat("rotation", transform.rotation).map_err(invalid("Transform"))?;
+    check_finite_vec3("linear velocity", velocity.linear).map_err(invalid("Velocity"))?;
+    check_finite_vec3("angular velocity", velocity.angular).map_err(invalid("Velocity"))?;
+    if let Some(acc) = forces {
+        check_finite_vec3("force", acc.force).map_err(invalid("ForceAccumulator"))?;
+        check_finite_vec3("torque", acc.torque).map_err(invalid("ForceAccumulator"))?;
+    }
+    Ok(())
+}
+
+/// Quarantines `entity`: logs the error, records it in [`PhysicsErrors`] and inserts
+/// [`Rejected`]. Used by the hooks and the integrate systems.
+pub fn reject(commands: &mut Commands, error: BodyError) {
+    tracing::warn!(entity = %error.entity, "{error}");
+    let entity = error.entity;
+    commands.entity(entity).insert(Rejected(error.clone()));
+    commands.queue(move |world: &mut World| {
+        world.get_resource_or_init::<PhysicsErrors>().0.push(error);
+    });
+}
+
+/// Component hook: re-checks the whole body whenever one of its state components is inserted.
+pub fn revalidate_body_hook(mut world: DeferredWorld, ctx: HookContext) {
+    let entity = ctx.entity;
+    if world.get::<RigidBody>(entity).is_none() {
+        return;
+    }
+    let (Some(transform), Some(velocity)) = (
+        world.get::<Transform>(entity),
+        world.get::<Velocity>(entity),
+    ) else {
+        return; // the rest of the bundle is still being inserted; its own hook will check.
+    };
+    let result = check_body(transform, velocity, world.get::<ForceAccumulator>(entity));
+    let was_rejected = world.get::<Rejected>(entity).is_some();
+    let mut commands = world.commands();
+    match result {
+        Err(kind) => reject(&mut commands, BodyError { entity, kind }),
+        Ok(()) if was_rejected => {
+            commands.entity(entity).remove::<Rejected>();
+        }
+        Ok(()) => {}
+    }
+}

@@ -1,0 +1,53 @@
+//! # tumble
+//!
+//! Rigid-body dynamics for headless game loops, on `bevy_ecs`, `glam` and `parry3d`.
+//!
+//! Spawn bodies with components, build a [`PhysicsPlan`](prelude::PhysicsPlan) schedule, run it
+//! once per fixed step, read the poses back:
+//!
+//! ```
+//! use tumble::prelude::*;
+//! use tumble::{bevy_ecs::prelude::World, glam::Vec3};
+//!
+//! let mut world = World::new();
+//! world.insert_resource(PhysicsSettings::new(1.0 / 60.0, Integrator::SymplecticEuler).unwrap());
+//! world.insert_resource(Gravity(Vec3::new(0.0, -9.81, 0.0)));
+//! let mass = MassProperties::solid_sphere(Mass::new(1.0).unwrap(), 0.5).unwrap();
+//! let ball = world
+//!     .spawn((RigidBody, MassProps(mass), ForceAccumulator::default()))
+//!     .id();
+//! let mut schedule = PhysicsPlan::for_world(&mut world).build_schedule();
+//! for _ in 0..60 {
+//!     schedule.run(&mut world);
+//!     world.clear_trackers();
+//! }
+//! let y = world.get::<Transform>(ball).unwrap().translation.y;
+//! assert!((y - (-9.81 * 61.0 / 120.0)).abs() < 1e-3); // x_n = g Δt² n(n+1)/2
+//! ```
+//!
+//! The crates: [`core`] (ECS-free math: state, mass properties, integrators, invariants) and
+//! [`ecs`] (components, systems, schedule). `glam`, `bevy_ecs` (and `parry3d` with the `parry`
+//! feature) are re-exported so versions always match.
+
+#![forbid(unsafe_code)]
+#![warn(missing_docs)]
+
+pub use bevy_ecs;
+pub use glam;
+#[cfg(feature = "parry")]
+pub use parry3d;
+pub use tumble_core as core;
+pub use tumble_ecs as ecs;
+
+/// Everything a game loop needs, in one import.
+pub mod prelude {
+    #[cfg(feature = "parry")]
+    pub use tumble_core::shapes::mass_properties_of;
+    pub use tumble_core::{BodyState, Integrator, Wrench};
+    pub use tumble_ecs::prelude::*;
+}
+
+/// The README's code blocks, compiled and run as doc tests so the front door never rots.
+#[doc = include_str!("../README.md")]
+#[cfg(doctest)]
+pub struct ReadmeDoctests;

@@ -1,0 +1,74 @@
+//! The same inputs give bit-identical results, run after run.
+
+use tumble::glam::{Quat, Vec3};
+use tumble::prelude::*;
+
+use super::util::{mass_props, run, world_with};
+
+fn scene_bits() -> Vec<u32> {
+    let mut world = world_with(1.0 / 90.0, Integrator::SymplecticEuler);
+    world.insert_resource(Gravity(Vec3::new(0.0, -9.81, 0.0)));
+    let mut bodies = Vec::new();
+    for i in 0..64u32 {
+        let f = i as f32;
+        let e = world
+            .spawn((
+                RigidBody,
+                mass_props(1.0 + f * 0.1, [1.0, 1.0 + f * 0.01, 2.0 + f * 0.02]),
+                Transform {
+                    translation: Vec3::new(f, (f * 0.7).sin(), 0.0),
+                    rotation: Quat::from_rotation_y(f * 0.1),
+                },
+                Velocity {
+                    linear: Vec3::new(0.0, 1.0, f * 0.01),
+                    angular: Vec3::new(0.5, 2.0, f * 0.03),
+                },
+                ForceAccumulator::default(),
+            ))
+            .id();
+        bodies.push(e);
+    }
+    for pair in bodies.windows(2) {
+        world.spawn(Spring {
+            a: pair[0],
+            anchor_a: Vec3::new(0.1, 0.0, 0.0),
+            b: SpringEnd::Body {
+                body: pair[1],
+                anchor: Vec3::new(-0.1, 0.0, 0.0),
+            },
+            stiffness: 30.0,
+            damping: 0.2,
+            rest_length: 1.0,
+        });
+        world.spawn(ConstantForce {
+            body: pair[0],
+            force: Vec3::Z,
+            local_point: Some(Vec3::Y),
+        });
+    }
+    run(&mut world, 500);
+    let mut bits = Vec::new();
+    for e in bodies {
+        let t = world.get::<Transform>(e).unwrap();
+        let v = world.get::<Velocity>(e).unwrap();
+        for x in t
+            .translation
+            .to_array()
+            .into_iter()
+            .chain(t.rotation.to_array())
+            .chain(v.linear.to_array())
+            .chain(v.angular.to_array())
+        {
+            bits.push(x.to_bits());
+        }
+    }
+    bits
+}
+
+#[test]
+fn two_runs_are_bit_identical() {
+    let a = scene_bits();
+    let b = scene_bits();
+    assert_eq!(a, b);
+    assert!(a.iter().all(|&x| f32::from_bits(x).is_finite()));
+}

@@ -1,0 +1,220 @@
+//! Mass properties from parry3d shapes against closed forms, and the Mass/Density split.
+
+use tumble::glam::{Quat, Vec3};
+use tumble::parry3d::math::Pose;
+use tumble::parry3d::shape::{
+    Ball, Capsule, Compound, Cone, ConvexPolyhedron, Cuboid, Cylinder, SharedShape,
+};
+use tumble::prelude::*;
+
+const PI: f64 = std::f64::consts::PI;
+/// parry integrates in f32: a few ulps of relative error on closed-form shapes.
+const TOL: f64 = 1e-5;
+
+fn rho() -> Density {
+    Density::new(750.0).unwrap()
+}
+
+fn close(a: f32, b: f64, tol: f64, what: &str) {
+    let r = (f64::from(a) - b).abs() / b.abs();
+    assert!(r < tol, "{what}: {a} vs {b} (rel {r:e})");
+}
+
+/// Sorted principal moments (parry may order axes its own way for hulls and compounds).
+fn sorted(v: Vec3) -> [f32; 3] {
+    let mut a = v.to_array();
+    a.sort_by(f32::total_cmp);
+    a
+}
+
+#[test]
+fn ball_is_two_fifths_m_r_squared() {
+    let r = 0.3_f64;
+    let props = mass_properties_of(&Ball::new(r as f32), rho()).unwrap();
+    let m = 750.0 * 4.0 / 3.0 * PI * r.powi(3);
+    close(props.mass(), m, TOL, "ball mass");
+    for i in props.principal_inertia().to_array() {
+        close(i, 0.4 * m * r * r, TOL, "ball inertia");
+    }
+    assert!(props.is_spherical());
+}
+
+#[test]
+fn cuboid_is_m_b2_c2_over_12() {
+    let (a, b, c) = (0.8_f64, 0.3, 0.1); // full edges
+    let shape = Cuboid::new(Vec3::new(a as f32, b as f32, c as f32) * 0.5);
+    let props = mass_properties_of(&shape, rho()).unwrap();
+    let m = 750.0 * a * b * c;
+    close(props.mass(), m, TOL, "box mass");
+    let i = props.principal_inertia();
+    close(i.x, m * (b * b + c * c) / 12.0, TOL, "box Ixx");
+    close(i.y, m * (a * a + c * c) / 12.0, TOL, "box Iyy");
+    close(i.z, m * (a * a + b * b) / 12.0, TOL, "box Izz");
+    // The closed-form constructor agrees.
+    let direct =
+        MassProperties::solid_cuboid(Mass::new(m as f32).unwrap(), shape.half_extents).unwrap();
+    close(
+        direct.principal_inertia().y,
+        m * (a * a + c * c) / 12.0,
+        TOL,
+        "solid_cuboid",
+    );
+}
+
+#[test]
+fn cylinder_axial_half_m_r2_transverse_m_3r2_h2_over_12() {
+    let (hh, r) = (0.4_f64, 0.15);
+    let h = 2.0 * hh;
+    let props = mass_properties_of(&Cylinder::new(hh as f32, r as f32), rho()).unwrap();
+    let m = 750.0 * PI * r * r * h;
+    close(props.mass(), m, TOL, "cylinder mass");
+    let i = props.principal_inertia();
+    close(i.y, 0.5 * m * r * r, TOL, "cylinder axial (y)");
+    close(
+        i.x,
+        m * (3.0 * r * r + h * h) / 12.0,
+        TOL,
+        "cylinder transverse",
+    );
+    close(
+        i.z,
+        m * (3.0 * r * r + h * h) / 12.0,
+        TOL,
+        "cylinder transverse",
+    );
+}
+
+#[test]
+fn cone_moments_and_centre_of_mass() {
+    let (hh, r) = (0.5_f64, 0.2);
+    let h = 2.0 * hh;
+    let props = mass_properties_of(&Cone::new(hh as f32, r as f32), rho()).unwrap();
+    let m = 750.0 * PI * r * r * h / 3.0;
+    close(props.mass(), m, TOL, "cone mass");
+    let i = props.principal_inertia();
+    close(i.y, 0.3 * m * r * r, TOL, "cone axial");
+    // About the centre of mass: 3/20 m r² + 3/80 m h².
+    close(
+        i.x,
+        0.15 * m * r * r + 3.0 / 80.0 * m * h * h,
+        TOL,
+        "cone transverse",
+    );
+    // Centre of mass a quarter of the height above the base (base at y = −h/2).
+    close(
+        props.local_center_of_mass().y,
+        -hh + h / 4.0,
+        TOL,
+        "cone com",
+    );
+}
+
+#[test]
+fn capsule_is_cylinder_plus_two_hemispheres() {
+    let (hh, r) = (0.3_f64, 0.1);
+    let h = 2.0 * hh;
+    let props = mass_properties_of(&Capsule::new_y(hh as f32, r as f32), rho()).unwrap();
+    let m_cyl = 750.0 * PI * r * r * h;
+    let m_sph = 750.0 * 4.0 / 3.0 * PI * r.powi(3);
+    close(props.mass(), m_cyl + m_sph, TOL, "capsule mass");
+    let axial = m_cyl * r * r / 2.0 + m_sph * 0.4 * r * r;
+    // Hemisphere about its own centre of mass (3r/8 from the flat face), then shifted.
+    let transverse = m_cyl * (h * h / 12.0 + r * r / 4.0)
+        + m_sph * (0.4 * r * r + h * h / 4.0 + 3.0 * h * r / 8.0);
+    let i = props.principal_inertia();
+    close(i.y, axial, TOL, "capsule axial");
+    close(i.x, transverse, TOL, "capsule transverse");
+}
+
+#[test]
+fn convex_hull_of_box_corners_is_the_box() {
+    let half = Vec3::new(0.5, 0.2, 0.1);
+    let corners: Vec<Vec3> = (0..8)
+        .map(|k| {
+            let s = |bit: i32| if k & bit != 0 { 1.0 } else { -1.0 };
+            Vec3::new(s(1) * half.x, s(2) * half.y, s(4) * half.z)
+        })
+        .collect();
+    let hull = ConvexPolyhedron::from_convex_hull(&corners).unwrap();
+    let props = mass_properties_of(&hull, rho()).unwrap();
+    let (a, b, c) = (1.0_f64, 0.4, 0.2);
+    let m = 750.0 * a * b * c;
+    close(props.mass(), m, 1e-4, "hull mass");
+    let expected = [
+        m * (a * a + b * b),
+        m * (a * a + c * c),
+        m * (b * b + c * c),
+    ]
+    .map(|x| x / 12.0);
+    let got = sorted(props.principal_inertia());
+    let mut want = expected;
+    want.sort_by(f64::total_cmp);
+    for (g, w) in got.iter().zip(want) {
+        close(*g, w, 1e-4, "hull inertia");
+    }
+    assert!(props.local_center_of_mass().length() < 1e-5);
+}
+
+#[test]
+fn compound_of_two_balls_obeys_parallel_axes() {
+    let r = 0.1_f64;
+    let d = 0.5_f64; // each ball at ±d on x
+    let ball = SharedShape::ball(r as f32);
+    let compound = Compound::new(vec![
+        (
+            Pose::from_translation(Vec3::new(d as f32, 0.0, 0.0)),
+            ball.clone(),
+        ),
+        (Pose::from_translation(Vec3::new(-d as f32, 0.0, 0.0)), ball),
+    ]);
+    let props = mass_properties_of(&compound, rho()).unwrap();
+    let m1 = 750.0 * 4.0 / 3.0 * PI * r.powi(3);
+    close(props.mass(), 2.0 * m1, TOL, "compound mass");
+    let own = 0.4 * m1 * r * r;
+    let got = sorted(props.principal_inertia());
+    close(got[0], 2.0 * own, 1e-4, "compound axial");
+    close(
+        got[1],
+        2.0 * (own + m1 * d * d),
+        1e-4,
+        "compound transverse",
+    );
+    close(
+        got[2],
+        2.0 * (own + m1 * d * d),
+        1e-4,
+        "compound transverse",
+    );
+    // The principal frame maps the smallest moment's axis onto world x.
+    let frame: Quat = props.principal_frame();
+    let inertia = props.principal_inertia().to_array();
+    let smallest = (0..3)
+        .min_by(|&i, &j| inertia[i].total_cmp(&inertia[j]))
+        .unwrap();
+    let axis = frame * Vec3::AXES[smallest];
+    assert!(
+        axis.x.abs() > 0.999,
+        "smallest-moment axis {axis} should be ±x"
+    );
+}
+
+#[test]
+fn mass_and_density_reject_bad_values() {
+    for bad in [0.0, -1.0, f32::NAN, f32::INFINITY] {
+        assert!(Mass::new(bad).is_err(), "mass {bad}");
+        assert!(Density::new(bad).is_err(), "density {bad}");
+    }
+    let one = Mass::new(1.0).unwrap();
+    assert!(MassProperties::new(one, Vec3::new(1.0, -1.0, 1.0)).is_err());
+    assert!(MassProperties::new(one, Vec3::ZERO).is_err());
+    assert!(MassProperties::new(one, Vec3::new(1.0, f32::NAN, 1.0)).is_err());
+    assert!(
+        MassProperties::new(one, Vec3::ONE)
+            .unwrap()
+            .with_principal_frame(Quat::from_xyzw(0.0, 0.0, 0.0, 2.0))
+            .is_err()
+    );
+    // A flat shape has no volume, hence no mass.
+    let flat = Cuboid::new(Vec3::new(1.0, 0.0, 1.0));
+    assert!(mass_properties_of(&flat, rho()).is_err());
+}

@@ -1,0 +1,80 @@
+//! Symplectic Euler under constant gravity follows the discrete formula
+//! `x_n = x₀ + v₀ nΔt + g Δt² n(n+1)/2` (kick before drift), to f32 round-off.
+
+use tumble::bevy_ecs::prelude::*;
+use tumble::glam::{DVec3, Vec3};
+use tumble::prelude::*;
+
+use super::util::{mass_props, rel, run, world_with};
+
+fn discrete_position(x0: DVec3, v0: DVec3, g: DVec3, dt: f64, n: f64) -> DVec3 {
+    x0 + v0 * (n * dt) + g * (dt * dt * n * (n + 1.0) / 2.0)
+}
+
+fn check_projectile(with_accumulator: bool) {
+    let dt = 1.0 / 60.0_f32;
+    let g = Vec3::new(0.3, -9.81, 0.1);
+    let x0 = Vec3::new(1.0, 100.0, -2.0);
+    let v0 = Vec3::new(3.0, 20.0, -1.5);
+    let mut world = world_with(dt, Integrator::SymplecticEuler);
+    world.insert_resource(Gravity(g));
+    let mut body = world.spawn((
+        RigidBody,
+        mass_props(2.5, [1.0, 2.0, 3.0]),
+        Transform::from_translation(x0),
+        Velocity::linear(v0),
+    ));
+    if with_accumulator {
+        body.insert(ForceAccumulator::default());
+    }
+    let id = body.id();
+    let mut schedule = PhysicsPlan::for_world(&mut world).build_schedule();
+    for n in 1..=600u32 {
+        schedule.run(&mut world);
+        world.clear_trackers();
+        if n % 50 == 0 {
+            let x = world.get::<Transform>(id).unwrap().translation.as_dvec3();
+            let exact = discrete_position(
+                x0.as_dvec3(),
+                v0.as_dvec3(),
+                g.as_dvec3(),
+                f64::from(dt),
+                f64::from(n),
+            );
+            // f32 round-off: ~n ε per coordinate in the worst case, far below 1e-5.
+            let err = (x - exact).length() / exact.length();
+            assert!(err < 1e-5, "step {n}: |x − x_exact|/|x_exact| = {err:e}");
+            let v = world.get::<Velocity>(id).unwrap().linear.as_dvec3();
+            let v_exact = v0.as_dvec3() + g.as_dvec3() * (f64::from(dt) * f64::from(n));
+            assert!(rel(v.y, v_exact.y) < 1e-5, "vy {} vs {}", v.y, v_exact.y);
+        }
+    }
+}
+
+#[test]
+fn projectile_matches_discrete_formula_with_accumulator() {
+    check_projectile(true);
+}
+
+#[test]
+fn projectile_matches_discrete_formula_without_accumulator() {
+    check_projectile(false);
+}
+
+#[test]
+fn gravity_scale_scales_the_fall() {
+    let dt = 0.01;
+    let mut world = world_with(dt, Integrator::SymplecticEuler);
+    world.insert_resource(Gravity(Vec3::new(0.0, -10.0, 0.0)));
+    let half = world
+        .spawn((RigidBody, GravityScale(0.5), ForceAccumulator::default()))
+        .id();
+    let none = world.spawn((RigidBody, GravityScale(0.0))).id();
+    let full = world.spawn(RigidBody).id();
+    run(&mut world, 100);
+    let y = |e: Entity| f64::from(world.get::<Transform>(e).unwrap().translation.y);
+    let full_y = -10.0 * 0.01 * 0.01 * 100.0 * 101.0 / 2.0;
+    assert!(rel(y(full), full_y) < 1e-5);
+    assert!(rel(y(half), 0.5 * full_y) < 1e-5);
+    assert_eq!(y(none), 0.0);
+}

@@ -1,0 +1,96 @@
+//! A body on a spring follows the discrete map of symplectic Euler exactly:
+//! `v' = v + Δt (−k x − c v)/m`, `x' = x + Δt v'` — iterated here in f64.
+//! Two bodies on one spring exchange equal and opposite forces.
+
+use tumble::glam::Vec3;
+use tumble::prelude::*;
+
+use super::util::{mass_props, run, world_with};
+
+#[test]
+fn anchored_spring_follows_the_discrete_map() {
+    for (k, c) in [(40.0_f32, 0.0_f32), (40.0, 0.8)] {
+        let (m, dt, x0) = (2.0_f32, 1.0 / 60.0_f32, 0.7_f32);
+        let mut world = world_with(dt, Integrator::SymplecticEuler);
+        let body = world
+            .spawn((
+                RigidBody,
+                mass_props(m, [1.0, 1.0, 1.0]),
+                Transform::from_translation(Vec3::new(x0, 0.0, 0.0)),
+            ))
+            .id();
+        world.spawn(Spring {
+            a: body,
+            anchor_a: Vec3::ZERO,
+            b: SpringEnd::World(Vec3::ZERO),
+            stiffness: k,
+            damping: c,
+            rest_length: 0.0,
+        });
+        let steps = 300;
+        run(&mut world, steps);
+        let (mut x, mut v) = (f64::from(x0), 0.0_f64);
+        let (k, c, m, h) = (f64::from(k), f64::from(c), f64::from(m), f64::from(dt));
+        let mut amplitude = x.abs();
+        for _ in 0..steps {
+            v += h * (-k * x - c * v) / m;
+            x += h * v;
+            amplitude = amplitude.max(x.abs());
+        }
+        let got = world.get::<Transform>(body).unwrap().translation;
+        // f32 round-off accumulates about n ε of the amplitude.
+        let tol = 300.0 * 4.0 * f64::from(f32::EPSILON) * amplitude;
+        assert!(
+            (f64::from(got.x) - x).abs() < tol,
+            "k={k} c={c}: x {} vs {x}",
+            got.x
+        );
+        assert!(got.y.abs() < 1e-6 && got.z.abs() < 1e-6);
+    }
+}
+
+#[test]
+fn two_body_spring_conserves_linear_momentum() {
+    let dt = 1.0 / 120.0;
+    let mut world = world_with(dt, Integrator::SymplecticEuler);
+    let (ma, mb) = (1.0_f32, 3.0_f32);
+    let a = world
+        .spawn((
+            RigidBody,
+            mass_props(ma, [0.1, 0.2, 0.3]),
+            Transform::from_translation(Vec3::new(-1.0, 0.0, 0.0)),
+            Velocity {
+                linear: Vec3::new(0.0, 1.0, 0.0),
+                angular: Vec3::new(0.0, 0.0, 2.0),
+            },
+        ))
+        .id();
+    let b = world
+        .spawn((
+            RigidBody,
+            mass_props(mb, [0.3, 0.2, 0.1]),
+            Transform::from_translation(Vec3::new(1.0, 0.0, 0.0)),
+        ))
+        .id();
+    world.spawn(Spring {
+        a,
+        anchor_a: Vec3::new(0.2, 0.1, 0.0),
+        b: SpringEnd::Body {
+            body: b,
+            anchor: Vec3::new(-0.1, 0.0, 0.3),
+        },
+        stiffness: 50.0,
+        damping: 0.5,
+        rest_length: 1.0,
+    });
+    let p0 = Vec3::new(0.0, 1.0, 0.0) * ma;
+    run(&mut world, 240);
+    let va = world.get::<Velocity>(a).unwrap().linear;
+    let vb = world.get::<Velocity>(b).unwrap().linear;
+    let p = va * ma + vb * mb;
+    assert!(
+        (p - p0).length() < 1e-4 * (va.length() * ma + vb.length() * mb),
+        "p {p} vs {p0}"
+    );
+    assert!(vb.length() > 0.1, "the spring must have moved b");
+}

@@ -1,0 +1,37 @@
+//! Helpers shared by the core-layer tests.
+
+use tumble::bevy_ecs::prelude::*;
+use tumble::bevy_ecs::schedule::Schedule;
+use tumble::prelude::*;
+
+/// A world with the given step and integrator.
+pub fn world_with(dt: f32, integrator: Integrator) -> World {
+    let mut world = World::new();
+    world.insert_resource(PhysicsSettings::new(dt, integrator).expect("valid dt"));
+    world
+}
+
+/// Plans the schedule of `world` and runs it `steps` times.
+pub fn run(world: &mut World, steps: usize) -> Schedule {
+    let mut schedule = PhysicsPlan::for_world(world).build_schedule();
+    run_schedule(world, &mut schedule, steps);
+    schedule
+}
+
+/// Runs an already built schedule `steps` times.
+pub fn run_schedule(world: &mut World, schedule: &mut Schedule, steps: usize) {
+    for _ in 0..steps {
+        schedule.run(world);
+        world.clear_trackers();
+    }
+}
+
+/// Mass properties from a mass and principal moments.
+pub fn mass_props(m: f32, inertia: [f32; 3]) -> MassProps {
+    MassProps(MassProperties::new(Mass::new(m).unwrap(), inertia.into()).unwrap())
+}
+
+/// Relative difference `|a − b| / |b|` in f64.
+pub fn rel(a: f64, b: f64) -> f64 {
+    (a - b).abs() / b.abs()
+}
