@@ -1,0 +1,2 @@
+//! The `tumble` command line. Work in progress.
+fn main() {}

@@ -1,0 +1,1 @@
+//! Scene files (TOML) for tumble. Work in progress.
