@@ -62,7 +62,8 @@ impl Density {
 /// The inertia tensor about the centre of mass, in body coordinates, is
 /// `I = P diag(I_b) Pᵀ` with `P` = [`principal_frame`](Self::principal_frame) (principal → body).
 /// In world coordinates it is `(R P) diag(I_b) (R P)ᵀ`; its inverse uses the stored reciprocal
-/// moments, where a zero moment locks that axis (`1/0` is stored as `0`).
+/// moments, where a zero moment locks that axis (`1/0` is stored as `0`): no torque can spin the
+/// body about it and every integrator holds the angular velocity about it at zero.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MassProperties {
     inv_mass: f32,
@@ -178,6 +179,13 @@ impl MassProperties {
     pub fn is_spherical(&self) -> bool {
         let i = self.principal_inertia;
         i.x > 0.0 && i.x == i.y && i.y == i.z
+    }
+
+    /// True when some principal moment is zero: rotation about that axis is locked (its angular
+    /// velocity is held at zero by every integrator).
+    #[inline]
+    pub fn has_locked_axis(&self) -> bool {
+        self.principal_inertia.cmpeq(Vec3::ZERO).any()
     }
 
     /// Applies the world inverse inertia `(R P) I_b⁻¹ (R P)ᵀ` to a world vector, where

@@ -2,6 +2,8 @@
 //!
 //! One step runs these sets in order:
 //!
+//! 0. [`PhysicsSet::Prepare`] — only for drift–kick–drift integrators (`splitting`, `yoshida4`,
+//!    `rk4`): half a drift, so forces are sampled at the midpoint of the step.
 //! 1. [`PhysicsSet::Gravity`] — `m g s` into each accumulator; only if a [`Gravity`] resource
 //!    exists.
 //! 2. [`PhysicsSet::Forces`] — force generators that exist in the world (constant forces,
@@ -16,12 +18,12 @@ use std::fmt;
 use bevy_ecs::prelude::*;
 use bevy_ecs::schedule::{ScheduleBuildSettings, ScheduleLabel};
 
-use crate::components::{Gravity, PhysicsSettings};
+use crate::components::{ForceAccumulator, Gravity, PhysicsSettings};
 use crate::forces::{
     ConstantForce, ConstantTorque, Spring, apply_constant_forces, apply_constant_torques,
     apply_gravity, apply_springs,
 };
-use crate::systems::{integrate_with_forces, integrate_without_forces};
+use crate::systems::{HalfDrifted, begin_step, integrate_with_forces, integrate_without_forces};
 
 /// Label of the schedule that advances physics by one fixed step.
 #[derive(ScheduleLabel, Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
@@ -30,6 +32,8 @@ pub struct PhysicsSchedule;
 /// The ordered stages of one physics step.
 #[derive(SystemSet, Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum PhysicsSet {
+    /// First half-drift of drift–kick–drift integrators.
+    Prepare,
     /// Gravity into the accumulators.
     Gravity,
     /// Force generators and user force systems.
@@ -41,6 +45,8 @@ pub enum PhysicsSet {
 /// One system of the physics step.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Stage {
+    /// [`begin_step`].
+    BeginStep,
     /// [`apply_gravity`].
     Gravity,
     /// [`apply_constant_forces`].
@@ -59,6 +65,7 @@ impl Stage {
     /// The system's name.
     pub fn name(self) -> &'static str {
         match self {
+            Stage::BeginStep => "begin_step",
             Stage::Gravity => "apply_gravity",
             Stage::ConstantForces => "apply_constant_forces",
             Stage::ConstantTorques => "apply_constant_torques",
@@ -81,10 +88,12 @@ pub struct PhysicsPlan {
 impl PhysicsPlan {
     /// Plans the step for `world`. Inserts default [`PhysicsSettings`] if the world has none.
     pub fn for_world(world: &mut World) -> Self {
-        if !world.contains_resource::<PhysicsSettings>() {
-            world.insert_resource(PhysicsSettings::default());
+        let settings = *world.get_resource_or_init::<PhysicsSettings>();
+        world.init_resource::<HalfDrifted>();
+        let mut stages = Vec::with_capacity(7);
+        if settings.integrator.samples_forces_at_midpoint() && has_any::<ForceAccumulator>(world) {
+            stages.push(Stage::BeginStep);
         }
-        let mut stages = Vec::with_capacity(6);
         if world.contains_resource::<Gravity>() {
             stages.push(Stage::Gravity);
         }
@@ -133,6 +142,7 @@ impl PhysicsPlan {
         let mut previous: Option<Stage> = None;
         for &stage in &self.stages {
             let set = match stage {
+                Stage::BeginStep => PhysicsSet::Prepare,
                 Stage::Gravity => PhysicsSet::Gravity,
                 Stage::IntegrateWithForces | Stage::IntegrateWithoutForces => PhysicsSet::Integrate,
                 _ => PhysicsSet::Forces,
@@ -150,6 +160,7 @@ struct StageSet(Stage);
 
 fn add_stage(schedule: &mut Schedule, stage: Stage, set: PhysicsSet, after: Option<Stage>) {
     let config = match stage {
+        Stage::BeginStep => begin_step.into_configs(),
         Stage::Gravity => apply_gravity.into_configs(),
         Stage::ConstantForces => apply_constant_forces.into_configs(),
         Stage::ConstantTorques => apply_constant_torques.into_configs(),

@@ -13,10 +13,20 @@ use crate::components::{
 };
 use crate::validate::{BodyError, BodyErrorKind, Rejected, check_body, reject};
 
+/// Which part of a step the integrate system performs for a body.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Phase {
+    /// The whole step (forces sampled at the start, or constant).
+    Whole,
+    /// The rest of a step whose first half-drift already ran in [`begin_step`].
+    Finish,
+}
+
 /// Steps one body under `wrench`; on failure leaves it untouched and returns the error.
 #[inline]
 fn step_body(
     settings: &PhysicsSettings,
+    phase: Phase,
     transform: &mut Transform,
     velocity: &mut Velocity,
     mass: &MassProps,
@@ -25,7 +35,12 @@ fn step_body(
 ) -> Result<(), BodyErrorKind> {
     let dt = settings.dt();
     let mut state = body_state(transform, velocity, mass);
-    settings.integrator.try_step(&mut state, mass, wrench, dt)?;
+    match phase {
+        Phase::Whole => settings.integrator.try_step(&mut state, mass, wrench, dt)?,
+        Phase::Finish => settings
+            .integrator
+            .try_finish_step(&mut state, mass, wrench, dt)?,
+    }
     if let Some(d) = damping {
         // Padé damping v ← v / (1 + Δt c): unconditionally stable, as in rapier and avian.
         state.linear_velocity /= 1.0 + dt * d.linear;
@@ -35,9 +50,57 @@ fn step_body(
     Ok(())
 }
 
+/// Set by [`begin_step`] when it has drifted the bodies with accumulators half a step, so that
+/// [`integrate_with_forces`] finishes the step instead of taking a whole one. Reset every step.
+#[derive(Resource, Debug, Default, Clone, Copy, PartialEq, Eq)]
+pub struct HalfDrifted(pub bool);
+
+/// First phase of a drift–kick–drift step for bodies with a [`ForceAccumulator`]: half a drift
+/// before the force systems run, so forces are sampled at the midpoint. Does nothing for methods
+/// that sample forces at the start of the step. Bodies without an accumulator feel no
+/// state-dependent force and take their whole step in [`integrate_without_forces`].
+pub fn begin_step(
+    settings: Res<PhysicsSettings>,
+    mut drifted: ResMut<HalfDrifted>,
+    mut commands: Commands,
+    mut bodies: Query<
+        (
+            Entity,
+            &mut Transform,
+            &mut Velocity,
+            &MassProps,
+            &ForceAccumulator,
+        ),
+        (With<RigidBody>, Without<Rejected>),
+    >,
+) {
+    if !settings.integrator.samples_forces_at_midpoint() {
+        return;
+    }
+    drifted.0 = true;
+    let dt = settings.dt();
+    for (entity, mut transform, mut velocity, mass, acc) in &mut bodies {
+        let result = check_body(&transform, &velocity, Some(acc)).and_then(|()| {
+            let mut state = body_state(&transform, &velocity, mass);
+            settings.integrator.try_begin_step(&mut state, mass, dt)?;
+            write_body_state(&state, mass, &mut transform, &mut velocity);
+            Ok(())
+        });
+        if let Err(kind) = result {
+            reject(&mut commands, BodyError { entity, kind });
+        }
+    }
+}
+
 /// Integrates bodies that have a [`ForceAccumulator`], consuming (reading and zeroing) it.
+///
+/// For a drift–kick–drift method this finishes the step that [`begin_step`] began; if the
+/// schedule was planned without `begin_step` (the integrator was changed afterwards) it takes the
+/// whole step with the forces sampled at the start, and warns once.
 pub fn integrate_with_forces(
     settings: Res<PhysicsSettings>,
+    mut drifted: ResMut<HalfDrifted>,
+    mut warned: Local<bool>,
     mut commands: Commands,
     mut bodies: Query<
         (
@@ -51,11 +114,26 @@ pub fn integrate_with_forces(
         (With<RigidBody>, Without<Rejected>),
     >,
 ) {
+    let phase = if drifted.0 {
+        Phase::Finish
+    } else {
+        Phase::Whole
+    };
+    if settings.integrator.samples_forces_at_midpoint() && phase == Phase::Whole && !*warned {
+        *warned = true;
+        tracing::warn!(
+            integrator = %settings.integrator,
+            "schedule planned without begin_step: forces are sampled at the start of the step; \
+             plan again after changing the integrator"
+        );
+    }
+    drifted.0 = false;
     for (entity, mut transform, mut velocity, mass, mut acc, damping) in &mut bodies {
         let result = check_body(&transform, &velocity, Some(&acc)).and_then(|()| {
             let wrench = acc.take();
             step_body(
                 &settings,
+                phase,
                 &mut transform,
                 &mut velocity,
                 mass,
@@ -103,6 +181,7 @@ pub fn integrate_without_forces(
         let result = check_body(&transform, &velocity, None).and_then(|()| {
             step_body(
                 &settings,
+                Phase::Whole,
                 &mut transform,
                 &mut velocity,
                 mass,

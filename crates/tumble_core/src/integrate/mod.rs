@@ -1,9 +1,36 @@
 //! Time integrators: one file per method, one [`Integrator`] enum, one entry point per step.
 //!
 //! Every method advances a [`BodyState`] by `Δt` under a [`Wrench`] held constant over the step
-//! (zero-order hold: forces are sampled once per step, as a game loop does).
+//! (zero-order hold: forces are sampled once per step, as a game loop does). A step has two
+//! phases so that the ECS can sample forces where each method wants them:
+//!
+//! - [`Integrator::begin_step`] — before the forces are computed. The drift–kick–drift methods
+//!   (`splitting`, `yoshida4`, `rk4`) drift half a step here, so forces are sampled at the
+//!   midpoint (exact for constant forces, symplectic second order for springs). The kick–drift
+//!   methods (`symplectic-euler*`, `lclamp`, `implicit-gyroscopic`) sample at the start and do
+//!   nothing here.
+//! - [`Integrator::finish_step`] — after the forces: kick, then the rest of the drift.
+//!
+//! [`Integrator::step`] runs both with a given constant wrench; [`Integrator::step_with`] samples
+//! a state-dependent load between them.
+//!
+//! | method | rotation | order (torque-free) | `\|L\|` | energy |
+//! |---|---|---|---|---|
+//! | `symplectic-euler` | explicit `ω × Iω`, exact `exp` | 1 | grows | grows, diverges for fast spins |
+//! | `symplectic-euler-linear` | as above, `q += ½Δt ω q` | 1 | grows | grows |
+//! | `lclamp` | explicit, `\|L\|` rescaled | 1 | kept | drifts (stable spins tumble) |
+//! | `implicit-gyroscopic` | one Newton step, backward Euler | 1 | decays | decays |
+//! | `splitting` | Lie–Poisson Strang 1-2-3-2-1 | 2 | round-off | bounded |
+//! | `yoshida4` | Yoshida composition of `splitting` | 4 | round-off | bounded |
+//! | `rk4` | RK4 on `Q̇ = ½ ω(Q) Q` at constant `L` | 4 | exact | slow drift |
 
+mod frame;
+mod implicit_gyroscopic;
+mod lclamp;
+mod rk4;
+mod splitting;
 mod symplectic_euler;
+mod yoshida;
 
 use std::fmt;
 use std::str::FromStr;
@@ -13,7 +40,13 @@ use thiserror::Error;
 use crate::mass::MassProperties;
 use crate::state::{BodyState, Wrench};
 
+pub use frame::{rotate, rotate_inv, world_momentum, world_omega};
+pub use implicit_gyroscopic::{implicit_gyroscopic, implicit_gyroscopic_rate};
+pub use lclamp::lclamp;
+pub use rk4::rk4_free_flow;
+pub use splitting::{FreeFlow, begin_dkd, drift, finish_dkd, kick, strang_free_flow};
 pub use symplectic_euler::{explicit_gyroscopic_kick, symplectic_euler, symplectic_euler_linear};
+pub use yoshida::yoshida_free_flow;
 
 /// A time-integration method, selectable per world.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
@@ -21,11 +54,24 @@ pub enum Integrator {
     /// The textbook semi-implicit (symplectic) Euler step:
     /// `v += Δt F/m; x += Δt v; ω += Δt I⁻¹(τ − ω × Iω); q ← exp(½Δt ω) q`.
     /// First order; the explicit gyroscopic term diverges for fast asymmetric spins.
-    #[default]
     SymplecticEuler,
     /// As [`SymplecticEuler`](Self::SymplecticEuler) but with the linearized rotation update
     /// `q ← normalize(q + ½Δt (ω,0) q)`, the common shortcut, kept to show its error.
     SymplecticEulerLinear,
+    /// The explicit step with `|L|` rescaled to its expected length, as rapier (default), avian
+    /// and Jolt do. First order; kept as the reference point.
+    Lclamp,
+    /// Catto's implicit gyroscopic step: one Newton iteration of backward Euler on
+    /// `I(ω' − ω) + Δt ω' × Iω' = 0`. First order, dissipative.
+    ImplicitGyroscopic,
+    /// Lie–Poisson splitting (Strang 1-2-3-2-1, exact axis rotations) in a drift–kick–drift
+    /// step. Second order, symplectic, time-reversible, `|L|` kept to round-off.
+    #[default]
+    Splitting,
+    /// Yoshida's fourth-order composition of [`Splitting`](Self::Splitting)'s free flow.
+    Yoshida4,
+    /// Classic RK4 on the free rotation at constant `L`, in a drift–kick–drift step.
+    Rk4,
 }
 
 impl Integrator {
@@ -33,6 +79,11 @@ impl Integrator {
     pub const ALL: &'static [Integrator] = &[
         Integrator::SymplecticEuler,
         Integrator::SymplecticEulerLinear,
+        Integrator::Lclamp,
+        Integrator::ImplicitGyroscopic,
+        Integrator::Splitting,
+        Integrator::Yoshida4,
+        Integrator::Rk4,
     ];
 
     /// The kebab-case name used in scene files and on the command line.
@@ -40,24 +91,93 @@ impl Integrator {
         match self {
             Integrator::SymplecticEuler => "symplectic-euler",
             Integrator::SymplecticEulerLinear => "symplectic-euler-linear",
+            Integrator::Lclamp => "lclamp",
+            Integrator::ImplicitGyroscopic => "implicit-gyroscopic",
+            Integrator::Splitting => "splitting",
+            Integrator::Yoshida4 => "yoshida4",
+            Integrator::Rk4 => "rk4",
         }
     }
 
-    /// Nominal order of accuracy of the rotational update.
+    /// Nominal order of accuracy of the torque-free rotational motion.
     pub fn order(self) -> u32 {
         match self {
-            Integrator::SymplecticEuler | Integrator::SymplecticEulerLinear => 1,
+            Integrator::SymplecticEuler
+            | Integrator::SymplecticEulerLinear
+            | Integrator::Lclamp
+            | Integrator::ImplicitGyroscopic => 1,
+            Integrator::Splitting => 2,
+            Integrator::Yoshida4 | Integrator::Rk4 => 4,
         }
     }
 
-    /// Advances `state` by `dt` under `wrench`. The caller checks finiteness (see
-    /// [`try_step`](Self::try_step)).
+    /// True when the method drifts half a step before forces are sampled (see
+    /// [`begin_step`](Self::begin_step)); false when it samples forces at the start of the step.
+    pub fn samples_forces_at_midpoint(self) -> bool {
+        matches!(
+            self,
+            Integrator::Splitting | Integrator::Yoshida4 | Integrator::Rk4
+        )
+    }
+
+    fn free_flow(self) -> FreeFlow {
+        match self {
+            Integrator::Yoshida4 => yoshida_free_flow,
+            Integrator::Rk4 => rk4_free_flow,
+            _ => strang_free_flow,
+        }
+    }
+
+    /// First phase of a step, before forces are sampled: half a drift for the drift–kick–drift
+    /// methods, nothing for the others.
     #[inline]
-    pub fn step(self, state: &mut BodyState, mass: &MassProperties, wrench: &Wrench, dt: f32) {
+    pub fn begin_step(self, state: &mut BodyState, mass: &MassProperties, dt: f32) {
+        if self.samples_forces_at_midpoint() {
+            begin_dkd(state, mass, dt, self.free_flow());
+        }
+    }
+
+    /// Second phase of a step, with the load sampled after [`begin_step`](Self::begin_step).
+    #[inline]
+    pub fn finish_step(
+        self,
+        state: &mut BodyState,
+        mass: &MassProperties,
+        wrench: &Wrench,
+        dt: f32,
+    ) {
         match self {
             Integrator::SymplecticEuler => symplectic_euler(state, mass, wrench, dt),
             Integrator::SymplecticEulerLinear => symplectic_euler_linear(state, mass, wrench, dt),
+            Integrator::Lclamp => lclamp(state, mass, wrench, dt),
+            Integrator::ImplicitGyroscopic => implicit_gyroscopic(state, mass, wrench, dt),
+            Integrator::Splitting | Integrator::Yoshida4 | Integrator::Rk4 => {
+                finish_dkd(state, mass, wrench, dt, self.free_flow())
+            }
         }
+    }
+
+    /// A whole step under a constant `wrench`. The caller checks finiteness (see
+    /// [`try_step`](Self::try_step)).
+    #[inline]
+    pub fn step(self, state: &mut BodyState, mass: &MassProperties, wrench: &Wrench, dt: f32) {
+        self.begin_step(state, mass, dt);
+        self.finish_step(state, mass, wrench, dt);
+    }
+
+    /// A whole step with a state-dependent load, sampled where the method wants it (after
+    /// [`begin_step`](Self::begin_step)).
+    #[inline]
+    pub fn step_with(
+        self,
+        state: &mut BodyState,
+        mass: &MassProperties,
+        dt: f32,
+        load: impl FnOnce(&BodyState) -> Wrench,
+    ) {
+        self.begin_step(state, mass, dt);
+        let wrench = load(state);
+        self.finish_step(state, mass, &wrench, dt);
     }
 
     /// Advances `state` by `dt` and commits the result only if it is finite; otherwise `state`
@@ -72,12 +192,48 @@ impl Integrator {
     ) -> Result<(), StepError> {
         let mut next = *state;
         self.step(&mut next, mass, wrench, dt);
-        if next.is_finite() {
-            *state = next;
-            Ok(())
-        } else {
-            Err(StepError::Diverged { integrator: self })
-        }
+        commit_if_finite(self, state, next)
+    }
+
+    /// [`finish_step`](Self::finish_step) that commits only a finite result.
+    #[inline]
+    pub fn try_finish_step(
+        self,
+        state: &mut BodyState,
+        mass: &MassProperties,
+        wrench: &Wrench,
+        dt: f32,
+    ) -> Result<(), StepError> {
+        let mut next = *state;
+        self.finish_step(&mut next, mass, wrench, dt);
+        commit_if_finite(self, state, next)
+    }
+
+    /// [`begin_step`](Self::begin_step) that commits only a finite result.
+    #[inline]
+    pub fn try_begin_step(
+        self,
+        state: &mut BodyState,
+        mass: &MassProperties,
+        dt: f32,
+    ) -> Result<(), StepError> {
+        let mut next = *state;
+        self.begin_step(&mut next, mass, dt);
+        commit_if_finite(self, state, next)
+    }
+}
+
+#[inline]
+fn commit_if_finite(
+    integrator: Integrator,
+    state: &mut BodyState,
+    next: BodyState,
+) -> Result<(), StepError> {
+    if next.is_finite() {
+        *state = next;
+        Ok(())
+    } else {
+        Err(StepError::Diverged { integrator })
     }
 }
 

@@ -15,6 +15,7 @@
 
 use glam::Vec3;
 
+use super::frame::clear_locked_axes;
 use crate::mass::MassProperties;
 use crate::rotation::{rotate_exact, rotate_linearized};
 use crate::state::{BodyState, Wrench};
@@ -54,6 +55,7 @@ fn linear_kick_drift(state: &mut BodyState, mass: &MassProperties, force: Vec3, 
 pub fn symplectic_euler(state: &mut BodyState, mass: &MassProperties, wrench: &Wrench, dt: f32) {
     linear_kick_drift(state, mass, wrench.force, dt);
     explicit_gyroscopic_kick(state, mass, wrench.torque, dt);
+    clear_locked_axes(state, mass);
     state.rotation = rotate_exact(state.rotation, state.angular_velocity, dt);
 }
 
@@ -67,5 +69,6 @@ pub fn symplectic_euler_linear(
 ) {
     linear_kick_drift(state, mass, wrench.force, dt);
     explicit_gyroscopic_kick(state, mass, wrench.torque, dt);
+    clear_locked_axes(state, mass);
     state.rotation = rotate_linearized(state.rotation, state.angular_velocity, dt);
 }
