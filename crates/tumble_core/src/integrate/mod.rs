@@ -20,7 +20,8 @@
 //! | `symplectic-euler-linear` | as above, `q += ½Δt ω q` | 1 | grows | grows |
 //! | `lclamp` | explicit, `\|L\|` rescaled | 1 | kept | drifts (stable spins tumble) |
 //! | `implicit-gyroscopic` | one Newton step, backward Euler | 1 | decays | decays |
-//! | `splitting` | Lie–Poisson Strang 1-2-3-2-1 | 2 | round-off | bounded |
+//! | `splitting` | Lie–Poisson, exact symmetric top + residual | 2 | round-off | bounded |
+//! | `splitting-xyz` | Lie–Poisson Strang 1-2-3-2-1 | 2 | round-off | bounded (poorly for rods) |
 //! | `yoshida4` | Yoshida composition of `splitting` | 4 | round-off | bounded |
 //! | `rk4` | RK4 on `Q̇ = ½ ω(Q) Q` at constant `L` | 4 | exact | slow drift |
 
@@ -44,7 +45,9 @@ pub use frame::{rotate, rotate_inv, world_momentum, world_omega};
 pub use implicit_gyroscopic::{implicit_gyroscopic, implicit_gyroscopic_rate};
 pub use lclamp::lclamp;
 pub use rk4::rk4_free_flow;
-pub use splitting::{FreeFlow, begin_dkd, drift, finish_dkd, kick, strang_free_flow};
+pub use splitting::{
+    FreeFlow, begin_dkd, drift, finish_dkd, kick, strang_free_flow, symmetric_free_flow,
+};
 pub use symplectic_euler::{explicit_gyroscopic_kick, symplectic_euler, symplectic_euler_linear};
 pub use yoshida::yoshida_free_flow;
 
@@ -64,10 +67,14 @@ pub enum Integrator {
     /// Catto's implicit gyroscopic step: one Newton iteration of backward Euler on
     /// `I(ω' − ω) + Δt ω' × Iω' = 0`. First order, dissipative.
     ImplicitGyroscopic,
-    /// Lie–Poisson splitting (Strang 1-2-3-2-1, exact axis rotations) in a drift–kick–drift
-    /// step. Second order, symplectic, time-reversible, `|L|` kept to round-off.
+    /// Lie–Poisson splitting into an exact symmetric top plus a residual axis rotation (Strang
+    /// `R(h/2) S(h) R(h/2)`), in a drift–kick–drift step. Second order, symplectic,
+    /// time-reversible, `|L|` kept to round-off, exact for symmetric bodies.
     #[default]
     Splitting,
+    /// Lie–Poisson splitting one principal axis at a time (Strang 1-2-3-2-1), in a
+    /// drift–kick–drift step. Second order, symplectic; unstable in energy for fast thin rods.
+    SplittingXyz,
     /// Yoshida's fourth-order composition of [`Splitting`](Self::Splitting)'s free flow.
     Yoshida4,
     /// Classic RK4 on the free rotation at constant `L`, in a drift–kick–drift step.
@@ -82,6 +89,7 @@ impl Integrator {
         Integrator::Lclamp,
         Integrator::ImplicitGyroscopic,
         Integrator::Splitting,
+        Integrator::SplittingXyz,
         Integrator::Yoshida4,
         Integrator::Rk4,
     ];
@@ -94,6 +102,7 @@ impl Integrator {
             Integrator::Lclamp => "lclamp",
             Integrator::ImplicitGyroscopic => "implicit-gyroscopic",
             Integrator::Splitting => "splitting",
+            Integrator::SplittingXyz => "splitting-xyz",
             Integrator::Yoshida4 => "yoshida4",
             Integrator::Rk4 => "rk4",
         }
@@ -106,7 +115,7 @@ impl Integrator {
             | Integrator::SymplecticEulerLinear
             | Integrator::Lclamp
             | Integrator::ImplicitGyroscopic => 1,
-            Integrator::Splitting => 2,
+            Integrator::Splitting | Integrator::SplittingXyz => 2,
             Integrator::Yoshida4 | Integrator::Rk4 => 4,
         }
     }
@@ -114,9 +123,12 @@ impl Integrator {
     /// True when the method drifts half a step before forces are sampled (see
     /// [`begin_step`](Self::begin_step)); false when it samples forces at the start of the step.
     pub fn samples_forces_at_midpoint(self) -> bool {
-        matches!(
+        !matches!(
             self,
-            Integrator::Splitting | Integrator::Yoshida4 | Integrator::Rk4
+            Integrator::SymplecticEuler
+                | Integrator::SymplecticEulerLinear
+                | Integrator::Lclamp
+                | Integrator::ImplicitGyroscopic
         )
     }
 
@@ -124,7 +136,8 @@ impl Integrator {
         match self {
             Integrator::Yoshida4 => yoshida_free_flow,
             Integrator::Rk4 => rk4_free_flow,
-            _ => strang_free_flow,
+            Integrator::SplittingXyz => strang_free_flow,
+            _ => symmetric_free_flow,
         }
     }
 
@@ -151,9 +164,10 @@ impl Integrator {
             Integrator::SymplecticEulerLinear => symplectic_euler_linear(state, mass, wrench, dt),
             Integrator::Lclamp => lclamp(state, mass, wrench, dt),
             Integrator::ImplicitGyroscopic => implicit_gyroscopic(state, mass, wrench, dt),
-            Integrator::Splitting | Integrator::Yoshida4 | Integrator::Rk4 => {
-                finish_dkd(state, mass, wrench, dt, self.free_flow())
-            }
+            Integrator::Splitting
+            | Integrator::SplittingXyz
+            | Integrator::Yoshida4
+            | Integrator::Rk4 => finish_dkd(state, mass, wrench, dt, self.free_flow()),
         }
     }
 

@@ -1,4 +1,4 @@
-//! Fourth-order composition of the Strang free flow (Yoshida 1990; Suzuki 1990):
+//! Fourth-order composition of the symmetric + residual Strang free flow (Yoshida 1990; Suzuki 1990):
 //!
 //! ```text
 //! Ψ_h = Φ_{c₁h} ∘ Φ_{c₀h} ∘ Φ_{c₁h},   c₁ = 1/(2 − 2^{1/3}),   c₀ = 1 − 2c₁ = −2^{1/3} c₁
@@ -12,7 +12,7 @@
 
 use glam::{Quat, Vec3};
 
-use super::splitting::strang_free_flow;
+use super::splitting::symmetric_free_flow;
 
 /// `c₁ = 1/(2 − 2^{1/3})`.
 pub const C1: f64 = 1.351_207_191_959_657_8;
@@ -23,7 +23,7 @@ pub const C0: f64 = 1.0 - 2.0 * C1;
 #[inline]
 pub fn yoshida_free_flow(q: Quat, momentum: Vec3, inertia: Vec3, h: f32) -> Quat {
     let (c1, c0) = (C1 as f32, C0 as f32);
-    let q = strang_free_flow(q, momentum, inertia, c1 * h);
-    let q = strang_free_flow(q, momentum, inertia, c0 * h);
-    strang_free_flow(q, momentum, inertia, c1 * h)
+    let q = symmetric_free_flow(q, momentum, inertia, c1 * h);
+    let q = symmetric_free_flow(q, momentum, inertia, c0 * h);
+    symmetric_free_flow(q, momentum, inertia, c1 * h)
 }

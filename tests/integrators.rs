@@ -1,0 +1,8 @@
+//! Integrator tests: conservation, Dzhanibekov flips, stability at the extremes, divergence
+//! detection, and observed order of convergence against the exact torque-free top.
+
+mod integrators {
+    pub mod extremes;
+    pub mod gyroscopic;
+    pub mod harness;
+}
