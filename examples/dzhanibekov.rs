@@ -46,18 +46,43 @@ fn run(integrator: Integrator, omega0: Vec3, dt: f32, seconds: f32) -> (u32, f32
 }
 
 fn main() {
+    // (name, ω₀ in the principal frame, exact flip count or None for a stable spin)
     let cases = [
-        ("middle (1,5,1)", Vec3::new(1.0, 5.0, 1.0)),
-        ("middle (0.01,10,0.01)", Vec3::new(0.01, 10.0, 0.01)),
-        ("largest z 10", Vec3::new(0.01, 0.01, 10.0)),
-        ("smallest x 10", Vec3::new(10.0, 0.01, 0.01)),
+        (
+            "middle axis, ω₀ = (1, 5, 1)",
+            Vec3::new(1.0, 5.0, 1.0),
+            Some(67),
+        ),
+        (
+            "near separatrix, ω₀ = (0.01, 10, 0.01)",
+            Vec3::new(0.01, 10.0, 0.01),
+            Some(44),
+        ),
+        (
+            "largest axis, ω₀ = (0.01, 0.01, 10)",
+            Vec3::new(0.01, 0.01, 10.0),
+            None,
+        ),
+        (
+            "smallest axis, ω₀ = (10, 0.01, 0.01)",
+            Vec3::new(10.0, 0.01, 0.01),
+            None,
+        ),
     ];
-    for (name, omega0) in cases {
-        println!("{name}");
+    for (name, omega0, exact_flips) in cases {
+        match exact_flips {
+            Some(n) => println!("{name}: exact solution flips {n} times"),
+            None => println!("{name}: stable, ω stays near {omega0}"),
+        }
         for &integrator in Integrator::ALL {
             let (flips, de, dl, w) = run(integrator, omega0, 1.0 / 60.0, 120.0);
+            let flips = if exact_flips.is_some() {
+                format!("flips {flips:>3}")
+            } else {
+                String::new()
+            };
             println!(
-                "  {:<24} flips {flips:>3}  ΔE/E {de:>10.3e}  Δ|L|/|L| {dl:>10.3e}  ω_body {w:.3}",
+                "  {:<24} {flips:<9}  ΔE/E {de:>10.3e}  Δ|L|/|L| {dl:>10.3e}  final ω_body {w:.3}",
                 integrator.name()
             );
         }

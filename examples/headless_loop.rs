@@ -5,10 +5,7 @@ use tumble::prelude::*;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut world = World::new();
-    world.insert_resource(PhysicsSettings::new(
-        1.0 / 60.0,
-        Integrator::SymplecticEuler,
-    )?);
+    world.insert_resource(PhysicsSettings::new(1.0 / 60.0, Integrator::default())?);
     world.insert_resource(Gravity(Vec3::new(0.0, -9.81, 0.0)));
     let mass = MassProperties::solid_cuboid(Mass::new(2.0)?, Vec3::new(0.5, 0.1, 0.02))?;
     let body = world
