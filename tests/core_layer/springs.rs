@@ -94,3 +94,42 @@ fn two_body_spring_conserves_linear_momentum() {
     );
     assert!(vb.length() > 0.1, "the spring must have moved b");
 }
+
+#[test]
+fn default_integrator_spring_is_position_verlet() {
+    // Forces sampled at the midpoint: x_{½} = x + ½h v; v' = v + h a(x_{½}); x' = x_{½} + ½h v'.
+    // Symplectic and second order: stable for ω h < 2, here ω h = 1.5.
+    let (m, k, dt) = (0.5_f32, 4050.0_f32, 1.0 / 60.0_f32);
+    let mut world = world_with(dt, Integrator::Splitting);
+    let body = world
+        .spawn((
+            RigidBody,
+            mass_props(m, [1.0, 1.0, 1.0]),
+            Transform::from_translation(Vec3::new(0.3, 0.0, 0.0)),
+            Velocity::linear(Vec3::new(-1.0, 0.0, 0.0)),
+        ))
+        .id();
+    world.spawn(Spring {
+        a: body,
+        anchor_a: Vec3::ZERO,
+        b: SpringEnd::World(Vec3::ZERO),
+        stiffness: k,
+        damping: 0.0,
+        rest_length: 0.0,
+    });
+    let steps = 2000;
+    run(&mut world, steps);
+    let (w2, h) = (f64::from(k / m), f64::from(dt));
+    let (mut x, mut v) = (0.3_f64, -1.0_f64);
+    for _ in 0..steps {
+        let half = x + 0.5 * h * v;
+        v -= h * w2 * half;
+        x = half + 0.5 * h * v;
+    }
+    let got = world.get::<Transform>(body).unwrap().translation.x;
+    // Bounded orbit of amplitude ≤ 0.4 m; f32 round-off grows like n ε relative at worst.
+    assert!(
+        (f64::from(got) - x).abs() < 2000.0 * 4.0 * f64::from(f32::EPSILON),
+        "{got} vs {x}"
+    );
+}
