@@ -14,7 +14,8 @@ fn rotate64(q: Quat, v: DVec3) -> DVec3 {
     let b = DVec3::new(f64::from(q.x), f64::from(q.y), f64::from(q.z));
     let w = f64::from(q.w);
     let b2 = b.dot(b);
-    ((w * w - b2) * v + (2.0 * b.dot(v)) * b + (2.0 * w) * b.cross(v)) / (w * w + b2)
+    let inv_norm2 = 1.0 / (w * w + b2);
+    ((w * w - b2) * v + (2.0 * b.dot(v)) * b + (2.0 * w) * b.cross(v)) * inv_norm2
 }
 
 /// Rotation by `q`, exact in norm for a nearly unit `q`: the sandwich `q v q* / |q|²` evaluated
@@ -62,16 +63,13 @@ pub fn world_momentum(q_principal: Quat, inertia: Vec3, omega: Vec3) -> Vec3 {
 }
 
 /// World angular velocity `ω = Q I_b⁻¹ Qᵀ L` (zero about locked axes), in f64 with a single
-/// rounding; divides by `I_b` rather than multiplying by a rounded reciprocal.
+/// rounding (the reciprocal of `I_b` is taken in f64, not the biased f32 `fl(1/I)`).
 #[inline]
 pub fn world_omega(q_principal: Quat, inertia: Vec3, momentum: Vec3) -> Vec3 {
     let body = rotate64(q_principal.conjugate(), momentum.as_dvec3());
     let i = inertia.as_dvec3();
-    let rate = DVec3::new(
-        if i.x > 0.0 { body.x / i.x } else { 0.0 },
-        if i.y > 0.0 { body.y / i.y } else { 0.0 },
-        if i.z > 0.0 { body.z / i.z } else { 0.0 },
-    );
+    let inv = |moment: f64| if moment > 0.0 { 1.0 / moment } else { 0.0 };
+    let rate = body * DVec3::new(inv(i.x), inv(i.y), inv(i.z));
     rotate64(q_principal, rate).as_vec3()
 }
 

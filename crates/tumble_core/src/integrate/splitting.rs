@@ -87,6 +87,14 @@ fn body_axis_flow(q: Quat, momentum: Vec3, axis: usize, coefficient: f32, h: f32
     q * axis_rotation(axis, h * coefficient * m_axis)
 }
 
+/// Unit quaternion of a rotation by `angle` about the unit vector `axis`.
+#[inline]
+fn axis_angle(axis: Vec3, angle: f32) -> Quat {
+    let (s, c) = (0.5 * angle).sin_cos();
+    let v = axis * s;
+    Quat::from_xyzw(v.x, v.y, v.z, c)
+}
+
 /// Reciprocal moment, `0` for a locked axis.
 #[inline]
 fn reciprocal(moment: f32) -> f32 {
@@ -118,7 +126,7 @@ pub fn symmetric_free_flow(q: Quat, momentum: Vec3, inertia: Vec3, h: f32) -> Qu
     // S(h): Casimir rotation about L, then the commuting rotation about axis a.
     let l = momentum.length();
     let q = if l > 0.0 {
-        Quat::from_axis_angle(momentum / l, h * r[b] * l) * q
+        axis_angle(momentum / l, h * r[b] * l) * q
     } else {
         q
     };

@@ -1,0 +1,52 @@
+//! Cost of one body-step of each integrator over an array of bodies (plain data, no ECS):
+//! torque-free asymmetric bodies with varied rates, as in a scene of many tumbling objects.
+
+use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
+use tumble::glam::{Quat, Vec3};
+use tumble::prelude::*;
+
+fn bodies(n: usize) -> (Vec<BodyState>, Vec<MassProperties>) {
+    let mut states = Vec::with_capacity(n);
+    let mut masses = Vec::with_capacity(n);
+    for i in 0..n {
+        let f = i as f32 / n as f32;
+        states.push(BodyState {
+            position: Vec3::new(f, 2.0 * f, 0.0),
+            rotation: Quat::from_rotation_y(f * 3.0),
+            linear_velocity: Vec3::new(1.0, 0.0, f),
+            angular_velocity: Vec3::new(1.0 + f, 5.0 - f, 1.0),
+        });
+        let inertia = Vec3::new(1.0, 2.0 + f, 3.0 + f);
+        masses.push(MassProperties::new(Mass::new(1.0 + f).unwrap(), inertia).unwrap());
+    }
+    (states, masses)
+}
+
+fn step_all(c: &mut Criterion) {
+    let n = 10_000;
+    let mut group = c.benchmark_group("body_step");
+    group.throughput(Throughput::Elements(n as u64));
+    let (states0, masses) = bodies(n);
+    for &integrator in Integrator::ALL {
+        group.bench_with_input(
+            BenchmarkId::from_parameter(integrator),
+            &integrator,
+            |b, &it| {
+                let mut states = states0.clone();
+                b.iter(|| {
+                    for (state, mass) in states.iter_mut().zip(&masses) {
+                        it.step(state, mass, &Wrench::ZERO, 1.0 / 60.0);
+                    }
+                });
+            },
+        );
+    }
+    group.finish();
+}
+
+criterion_group! {
+    name = benches;
+    config = Criterion::default().sample_size(20).measurement_time(std::time::Duration::from_secs(2));
+    targets = step_all
+}
+criterion_main!(benches);
