@@ -204,9 +204,7 @@ impl Integrator {
         wrench: &Wrench,
         dt: f32,
     ) -> Result<(), StepError> {
-        let mut next = *state;
-        self.step(&mut next, mass, wrench, dt);
-        commit_if_finite(self, state, next)
+        self.commit_if_finite(state, |next| self.step(next, mass, wrench, dt))
     }
 
     /// [`finish_step`](Self::finish_step) that commits only a finite result.
@@ -218,9 +216,24 @@ impl Integrator {
         wrench: &Wrench,
         dt: f32,
     ) -> Result<(), StepError> {
+        self.commit_if_finite(state, |next| self.finish_step(next, mass, wrench, dt))
+    }
+
+    /// Runs `advance` on a copy of `state` and commits the copy only if it is finite.
+    #[inline]
+    fn commit_if_finite(
+        self,
+        state: &mut BodyState,
+        advance: impl FnOnce(&mut BodyState),
+    ) -> Result<(), StepError> {
         let mut next = *state;
-        self.finish_step(&mut next, mass, wrench, dt);
-        commit_if_finite(self, state, next)
+        advance(&mut next);
+        if next.is_finite() {
+            *state = next;
+            Ok(())
+        } else {
+            Err(StepError::Diverged { integrator: self })
+        }
     }
 
     /// [`begin_step`](Self::begin_step) that commits only a finite result.
@@ -231,23 +244,7 @@ impl Integrator {
         mass: &MassProperties,
         dt: f32,
     ) -> Result<(), StepError> {
-        let mut next = *state;
-        self.begin_step(&mut next, mass, dt);
-        commit_if_finite(self, state, next)
-    }
-}
-
-#[inline]
-fn commit_if_finite(
-    integrator: Integrator,
-    state: &mut BodyState,
-    next: BodyState,
-) -> Result<(), StepError> {
-    if next.is_finite() {
-        *state = next;
-        Ok(())
-    } else {
-        Err(StepError::Diverged { integrator })
+        self.commit_if_finite(state, |next| self.begin_step(next, mass, dt))
     }
 }
 
