@@ -36,9 +36,11 @@ pub fn rotate_linearized(q: Quat, omega: Vec3, dt: f32) -> Quat {
     (q + (w * q) * (0.5 * dt)).normalize()
 }
 
-/// Rotation angle between two unit quaternions, `2 acos |⟨a, b⟩|`, in radians (0..π).
+/// Rotation angle between two orientations, in radians (0..π): the angle of `a* b`, computed as
+/// `2 atan2(|v|, |w|)` in f64, which stays accurate for tiny angles where `2 acos |⟨a, b⟩|` loses
+/// every digit (and returns 0 once round-off pushes the dot product past 1).
 #[inline]
-pub fn angle_between(a: Quat, b: Quat) -> f32 {
-    let d = a.dot(b).abs().min(1.0);
-    2.0 * d.acos()
+pub fn angle_between(a: Quat, b: Quat) -> f64 {
+    let r = a.as_dquat().normalize().conjugate() * b.as_dquat().normalize();
+    2.0 * glam::DVec3::new(r.x, r.y, r.z).length().atan2(r.w.abs())
 }
