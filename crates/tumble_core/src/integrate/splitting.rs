@@ -25,7 +25,9 @@
 //! pumps energy up a thousandfold (bounded only by `|L|²/(2 I_min)`).
 //!
 //! In every sub-flow the world momentum `L` is fixed, so `|L|` of a torque-free body is kept to
-//! round-off.
+//! round-off. The flows run in f64 on the body momentum `m` and the principal orientation `Q`,
+//! each sub-flow a body-frame rotation `Q ← Q exp(θ e)` with `m ← exp(−θ e) m`; only the final
+//! `ω` and `q` are rounded to f32.
 //!
 //! **Known limit.** A thin body that is *not* symmetric (e.g. I = (1e-4, 1, 1.02)) spinning fast
 //! about a tilted axis: the residual rotation mixes the large transverse momentum into the tiny
@@ -41,75 +43,88 @@
 //! first drift before the force systems), so constant forces are integrated exactly and springs
 //! get the second-order, symplectic position-Verlet scheme.
 
-use glam::{Quat, Vec3};
+use glam::{DQuat, DVec3};
 
-use super::frame::{
-    axis_rotation, principal_axis, principal_orientation, set_principal_orientation,
-    world_momentum, world_omega,
-};
+use super::frame::{recip, rotate64};
 use crate::mass::MassProperties;
+use crate::rotation::rotate_exact;
 use crate::state::{BodyState, Wrench};
 
-/// Exact flow of `mᵢ²/(2Iᵢ)` for time `h`: rotates `Q` about its principal axis `i` by
-/// `θ = h (aᵢ·L)/Iᵢ`, with `aᵢ = Q eᵢ` the axis in the world. `L` is unchanged. `inertia` holds
-/// the principal moments `I_b`.
-#[inline]
-fn axis_flow(q: Quat, momentum: Vec3, inertia: Vec3, axis: usize, h: f32) -> Quat {
-    let moment = inertia[axis];
-    if moment <= 0.0 {
-        return q; // locked axis: no rotation about it
-    }
-    let a = principal_axis(q, axis) / q.length_squared();
-    let theta = h * a.dot(momentum) / moment;
-    q * axis_rotation(axis, theta)
+/// The state a free flow advances: principal orientation `Q` (principal → world) and body
+/// momentum `m = Qᵀ L`, both f64.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FreeBody {
+    /// Principal orientation `Q`.
+    pub q: DQuat,
+    /// Body momentum `m` in the principal frame.
+    pub m: DVec3,
 }
 
-/// Strang splitting 1-2-3-2-1 of the free flow over `h`, on the principal orientation `Q`
-/// (`splitting-xyz`).
+impl FreeBody {
+    /// Rotates the body by `angle` about its principal axis `axis` (0, 1, 2): `Q ← Q exp(θ eₐ)`,
+    /// and the body momentum the opposite way, `m ← exp(−θ eₐ) m`, so `L = Q m` is unchanged.
+    #[inline]
+    pub fn rotate_about_axis(&mut self, axis: usize, angle: f64) {
+        let (s, c) = (0.5 * angle).sin_cos();
+        // cos θ and sin θ from the half angle: one sin_cos per rotation.
+        let (cos, sin) = (c * c - s * s, 2.0 * s * c);
+        let m = self.m;
+        match axis {
+            0 => {
+                self.q *= DQuat::from_xyzw(s, 0.0, 0.0, c);
+                self.m = DVec3::new(m.x, cos * m.y + sin * m.z, cos * m.z - sin * m.y);
+            }
+            1 => {
+                self.q *= DQuat::from_xyzw(0.0, s, 0.0, c);
+                self.m = DVec3::new(cos * m.x - sin * m.z, m.y, cos * m.z + sin * m.x);
+            }
+            _ => {
+                self.q *= DQuat::from_xyzw(0.0, 0.0, s, c);
+                self.m = DVec3::new(cos * m.x + sin * m.y, cos * m.y - sin * m.x, m.z);
+            }
+        }
+    }
+
+    /// Exact flow of `½ k mₐ²` for time `h`: rotation about axis `a` by `h k mₐ`.
+    #[inline]
+    pub fn axis_flow(&mut self, axis: usize, k: f64, h: f64) {
+        if k != 0.0 {
+            self.rotate_about_axis(axis, h * k * self.m[axis]);
+        }
+    }
+
+    /// Exact flow of the Casimir `½ k |m|²` for time `h`: rotation about `m` itself by
+    /// `h k |m|` (so `m` is unchanged).
+    #[inline]
+    pub fn casimir_flow(&mut self, k: f64, h: f64) {
+        let length = self.m.length();
+        if length > 0.0 && k != 0.0 {
+            let (s, c) = (0.5 * h * k * length).sin_cos();
+            let v = self.m * (s / length);
+            self.q *= DQuat::from_xyzw(v.x, v.y, v.z, c);
+        }
+    }
+}
+
+/// A free-flow approximation over `h`, given the reciprocal principal moments `r = 1/I_b`
+/// (0 on locked axes).
+pub type FreeFlow = fn(&mut FreeBody, DVec3, f64);
+
+/// Strang splitting 1-2-3-2-1 of the free flow over `h` (`splitting-xyz`).
 #[inline]
-pub fn strang_free_flow(q: Quat, momentum: Vec3, inertia: Vec3, h: f32) -> Quat {
+pub fn strang_free_flow(body: &mut FreeBody, r: DVec3, h: f64) {
     let half = 0.5 * h;
-    let q = axis_flow(q, momentum, inertia, 0, half);
-    let q = axis_flow(q, momentum, inertia, 1, half);
-    let q = axis_flow(q, momentum, inertia, 2, h);
-    let q = axis_flow(q, momentum, inertia, 1, half);
-    axis_flow(q, momentum, inertia, 0, half)
-}
-
-/// Rotation of `Q` about its principal axis `axis` by `h · coefficient · mₐ`, with
-/// `mₐ = (Q eₐ)·L` the body momentum about that axis.
-#[inline]
-fn body_axis_flow(q: Quat, momentum: Vec3, axis: usize, coefficient: f32, h: f32) -> Quat {
-    if coefficient == 0.0 {
-        return q;
-    }
-    let m_axis = principal_axis(q, axis).dot(momentum) / q.length_squared();
-    q * axis_rotation(axis, h * coefficient * m_axis)
-}
-
-/// Unit quaternion of a rotation by `angle` about the unit vector `axis`.
-#[inline]
-fn axis_angle(axis: Vec3, angle: f32) -> Quat {
-    let (s, c) = (0.5 * angle).sin_cos();
-    let v = axis * s;
-    Quat::from_xyzw(v.x, v.y, v.z, c)
-}
-
-/// Reciprocal moment, `0` for a locked axis.
-#[inline]
-fn reciprocal(moment: f32) -> f32 {
-    if moment > 0.0 { 1.0 / moment } else { 0.0 }
+    body.axis_flow(0, r.x, half);
+    body.axis_flow(1, r.y, half);
+    body.axis_flow(2, r.z, h);
+    body.axis_flow(1, r.y, half);
+    body.axis_flow(0, r.x, half);
 }
 
 /// Symmetric + residual splitting `R(h/2) ∘ S(h) ∘ R(h/2)` of the free flow over `h`
 /// (`splitting`); see the module documentation.
 #[inline]
-pub fn symmetric_free_flow(q: Quat, momentum: Vec3, inertia: Vec3, h: f32) -> Quat {
-    let r = Vec3::new(
-        reciprocal(inertia.x),
-        reciprocal(inertia.y),
-        reciprocal(inertia.z),
-    );
+pub fn symmetric_free_flow(body: &mut FreeBody, r: DVec3, h: f64) {
     // The pair (b, c) with the closest reciprocals; a is the remaining axis.
     let gaps = [(r.y - r.z).abs(), (r.x - r.z).abs(), (r.x - r.y).abs()];
     let a = if gaps[0] <= gaps[1] && gaps[0] <= gaps[2] {
@@ -121,44 +136,48 @@ pub fn symmetric_free_flow(q: Quat, momentum: Vec3, inertia: Vec3, h: f32) -> Qu
     };
     let (b, c) = ((a + 1) % 3, (a + 2) % 3);
     let residual = r[c] - r[b];
-    let half = 0.5 * h;
-    let q = body_axis_flow(q, momentum, c, residual, half);
-    // S(h): Casimir rotation about L, then the commuting rotation about axis a.
-    let l = momentum.length();
-    let q = if l > 0.0 {
-        axis_angle(momentum / l, h * r[b] * l) * q
-    } else {
-        q
-    };
-    let q = body_axis_flow(q, momentum, a, r[a] - r[b], h);
-    body_axis_flow(q, momentum, c, residual, half)
+    body.axis_flow(c, residual, 0.5 * h);
+    // S(h): the Casimir rotation about m and the commuting rotation about axis a.
+    body.casimir_flow(r[b], h);
+    body.axis_flow(a, r[a] - r[b], h);
+    body.axis_flow(c, residual, 0.5 * h);
 }
 
-/// A free-flow approximation `Q ← Φ(Q, L, h)` at constant world momentum `L`.
-pub type FreeFlow = fn(Quat, Vec3, Vec3, f32) -> Quat;
-
-/// Drift for `h`: `x += h v` and the free rotation `Φ_h` at constant `L` (spherical bodies
+/// Drift for `h`: `x += h v` and the free rotation over `h` at constant `L` (spherical bodies
 /// rotate exactly about `ω`, since `ω ∥ L` for them).
 #[inline]
 pub fn drift(state: &mut BodyState, mass: &MassProperties, h: f32, flow: FreeFlow) {
     state.position += h * state.linear_velocity;
+    rotate_freely(state, mass, h, flow);
+}
+
+/// The rotational part of a drift: the free flow over `h` at constant world `L`.
+#[inline]
+pub fn rotate_freely(state: &mut BodyState, mass: &MassProperties, h: f32, flow: FreeFlow) {
     if mass.is_spherical() {
-        state.rotation = crate::rotation::rotate_exact(state.rotation, state.angular_velocity, h);
+        state.rotation = rotate_exact(state.rotation, state.angular_velocity, h);
         return;
     }
-    let q = principal_orientation(state, mass);
-    let momentum = world_momentum(q, mass.principal_inertia(), state.angular_velocity);
-    let q = flow(q, momentum, mass.principal_inertia(), h).normalize();
-    state.angular_velocity = world_omega(q, mass.principal_inertia(), momentum);
-    set_principal_orientation(state, mass, q);
+    let frame = mass.principal_frame().as_dquat();
+    let q = state.rotation.as_dquat() * frame;
+    let inertia = mass.principal_inertia().as_dvec3();
+    let r = DVec3::new(recip(inertia.x), recip(inertia.y), recip(inertia.z));
+    let mut body = FreeBody {
+        q,
+        m: inertia * rotate64(q.conjugate(), state.angular_velocity.as_dvec3()),
+    };
+    flow(&mut body, r, f64::from(h));
+    let q = body.q.normalize();
+    state.angular_velocity = rotate64(q, r * body.m).as_vec3();
+    state.rotation = (q * frame.conjugate()).as_quat().normalize();
 }
 
 /// Kick for `h`: `v += h F/m`, `L += h τ` (so `ω += h I⁻¹ τ` at the current pose).
 #[inline]
 pub fn kick(state: &mut BodyState, mass: &MassProperties, wrench: &Wrench, h: f32) {
     state.linear_velocity += (h * mass.inv_mass()) * wrench.force;
-    if wrench.torque != Vec3::ZERO {
-        state.angular_velocity += mass.world_inertia_mul(state.rotation, h * wrench.torque);
+    if wrench.torque != glam::Vec3::ZERO {
+        state.angular_velocity += mass.world_inv_inertia_mul(state.rotation, h * wrench.torque);
     }
 }
 
@@ -179,4 +198,21 @@ pub fn finish_dkd(
 ) {
     kick(state, mass, wrench, h);
     drift(state, mass, 0.5 * h, flow);
+}
+
+/// A whole drift–kick–drift step under a torque-free `wrench`: the translation is
+/// `x += ½h v; v += h F/m; x += ½h v` (exact for constant `F`) and, with no torque to kick
+/// between them, the two rotational half drifts are taken as one free flow over `h`.
+#[inline]
+pub fn torque_free_dkd(
+    state: &mut BodyState,
+    mass: &MassProperties,
+    wrench: &Wrench,
+    h: f32,
+    flow: FreeFlow,
+) {
+    state.position += (0.5 * h) * state.linear_velocity;
+    state.linear_velocity += (h * mass.inv_mass()) * wrench.force;
+    state.position += (0.5 * h) * state.linear_velocity;
+    rotate_freely(state, mass, h, flow);
 }

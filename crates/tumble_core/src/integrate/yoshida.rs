@@ -10,9 +10,9 @@
 //! fourth order for torque-free rotation and exact for constant forces; a torque sampled once per
 //! step makes the coupled motion second order. Cost: three Strang flows per drift.
 
-use glam::{Quat, Vec3};
+use glam::DVec3;
 
-use super::splitting::symmetric_free_flow;
+use super::splitting::{FreeBody, symmetric_free_flow};
 
 /// `c₁ = 1/(2 − 2^{1/3})`.
 pub const C1: f64 = 1.351_207_191_959_657_8;
@@ -21,9 +21,8 @@ pub const C0: f64 = 1.0 - 2.0 * C1;
 
 /// The fourth-order free flow `Ψ_h = Φ_{c₁h} ∘ Φ_{c₀h} ∘ Φ_{c₁h}`.
 #[inline]
-pub fn yoshida_free_flow(q: Quat, momentum: Vec3, inertia: Vec3, h: f32) -> Quat {
-    let (c1, c0) = (C1 as f32, C0 as f32);
-    let q = symmetric_free_flow(q, momentum, inertia, c1 * h);
-    let q = symmetric_free_flow(q, momentum, inertia, c0 * h);
-    symmetric_free_flow(q, momentum, inertia, c1 * h)
+pub fn yoshida_free_flow(body: &mut FreeBody, r: DVec3, h: f64) {
+    symmetric_free_flow(body, r, C1 * h);
+    symmetric_free_flow(body, r, C0 * h);
+    symmetric_free_flow(body, r, C1 * h);
 }
