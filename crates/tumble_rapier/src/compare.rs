@@ -1,0 +1,130 @@
+//! Stepping both engines side by side and measuring their differences.
+
+use std::time::Instant;
+
+use tumble_core::rotation::angle_between;
+use tumble_core::{BodyState, Integrator};
+
+use crate::rapier_side::RapierScene;
+use crate::scene::ComparisonScene;
+use crate::tumble_side::TumbleScene;
+
+/// How to run a comparison.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ComparisonOptions {
+    /// tumble's integrator.
+    pub integrator: Integrator,
+    /// rapier's gyroscopic term (its default is on).
+    pub gyroscopic: bool,
+    /// rapier's solver iterations, which are substeps for free bodies (its default is 4).
+    pub rapier_solver_iterations: usize,
+    /// Number of steps.
+    pub steps: usize,
+}
+
+impl Default for ComparisonOptions {
+    fn default() -> Self {
+        Self {
+            integrator: Integrator::default(),
+            gyroscopic: true,
+            rapier_solver_iterations: 4,
+            steps: 600,
+        }
+    }
+}
+
+/// Largest differences seen for one body over the run.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct BodyDifference {
+    /// Body name.
+    pub name: String,
+    /// max |x_tumble − x_rapier| (m), centre of mass.
+    pub position: f32,
+    /// max orientation angle between the engines (rad).
+    pub angle: f64,
+    /// max |v_tumble − v_rapier| (m/s).
+    pub linear_velocity: f32,
+    /// max |ω_tumble − ω_rapier| (rad/s).
+    pub angular_velocity: f32,
+    /// Against the exact solution, when one was given: (tumble, rapier) max position error (m).
+    pub exact_position: Option<(f64, f64)>,
+    /// Against the exact solution: (tumble, rapier) max orientation error (rad).
+    pub exact_angle: Option<(f64, f64)>,
+}
+
+/// The result of [`compare`].
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Comparison {
+    /// One entry per body, in scene order.
+    pub bodies: Vec<BodyDifference>,
+    /// Mean wall time per step of tumble's schedule (ns).
+    pub tumble_ns_per_step: f64,
+    /// Mean wall time per step of rapier's pipeline (ns).
+    pub rapier_ns_per_step: f64,
+}
+
+impl Comparison {
+    /// How many times slower rapier's step is than tumble's.
+    pub fn speed_ratio(&self) -> f64 {
+        self.rapier_ns_per_step / self.tumble_ns_per_step
+    }
+}
+
+/// An exact solution: the state of body `i` at time `t`, when the scene has one.
+pub type ExactSolution<'a> = &'a dyn Fn(usize, f64) -> Option<BodyState>;
+
+/// Runs `scene` in both engines for `options.steps` steps, recording after every step the
+/// largest per-body differences (and errors against `exact`, where it knows the body).
+pub fn compare(
+    scene: &ComparisonScene,
+    options: &ComparisonOptions,
+    exact: Option<ExactSolution<'_>>,
+) -> Comparison {
+    let mut tumble = TumbleScene::new(scene, options.integrator);
+    let mut rapier = RapierScene::new(scene, options.gyroscopic, options.rapier_solver_iterations);
+    let mut bodies: Vec<BodyDifference> = scene
+        .bodies
+        .iter()
+        .map(|b| BodyDifference {
+            name: b.name.clone(),
+            ..Default::default()
+        })
+        .collect();
+    let (mut tumble_ns, mut rapier_ns) = (0u128, 0u128);
+    for step in 1..=options.steps {
+        let start = Instant::now();
+        tumble.step();
+        tumble_ns += start.elapsed().as_nanos();
+        let start = Instant::now();
+        rapier.step();
+        rapier_ns += start.elapsed().as_nanos();
+        let t = f64::from(scene.dt) * step as f64;
+        for (i, diff) in bodies.iter_mut().enumerate() {
+            let (a, b) = (tumble.state(i), rapier.state(i));
+            diff.position = diff.position.max((a.position - b.position).length());
+            diff.angle = diff.angle.max(angle_between(a.rotation, b.rotation));
+            diff.linear_velocity = diff
+                .linear_velocity
+                .max((a.linear_velocity - b.linear_velocity).length());
+            diff.angular_velocity = diff
+                .angular_velocity
+                .max((a.angular_velocity - b.angular_velocity).length());
+            if let Some(reference) = exact.and_then(|f| f(i, t)) {
+                let pos = |s: &BodyState| f64::from((s.position - reference.position).length());
+                let (pt, pr) = diff.exact_position.unwrap_or((0.0, 0.0));
+                diff.exact_position = Some((pt.max(pos(&a)), pr.max(pos(&b))));
+                let (at, ar) = diff.exact_angle.unwrap_or((0.0, 0.0));
+                diff.exact_angle = Some((
+                    at.max(angle_between(a.rotation, reference.rotation)),
+                    ar.max(angle_between(b.rotation, reference.rotation)),
+                ));
+            }
+        }
+    }
+    let steps = options.steps.max(1) as f64;
+    Comparison {
+        bodies,
+        tumble_ns_per_step: tumble_ns as f64 / steps,
+        rapier_ns_per_step: rapier_ns as f64 / steps,
+    }
+}

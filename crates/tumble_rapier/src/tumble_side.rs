@@ -1,0 +1,98 @@
+//! The same scene in tumble, through the ECS schedule a game would run.
+
+use bevy_ecs::prelude::*;
+use bevy_ecs::schedule::Schedule;
+use tumble_core::{BodyState, Integrator};
+use tumble_ecs::components::{body_state, write_body_state};
+use tumble_ecs::prelude::*;
+
+use crate::scene::{ComparisonScene, Load};
+
+/// A tumble world holding the bodies of a [`ComparisonScene`] and its planned schedule.
+pub struct TumbleScene {
+    world: World,
+    schedule: Schedule,
+    entities: Vec<Entity>,
+}
+
+impl TumbleScene {
+    /// Builds the scene with the given integrator.
+    ///
+    /// # Panics
+    /// If `scene.dt` is not a valid time step (a `ComparisonScene` is built by code, not read
+    /// from a user file; the scene loader validates user input).
+    pub fn new(scene: &ComparisonScene, integrator: Integrator) -> Self {
+        let mut world = World::new();
+        world.insert_resource(
+            PhysicsSettings::new(scene.dt, integrator).expect("comparison scenes have a valid dt"),
+        );
+        if let Some(g) = scene.gravity {
+            world.insert_resource(Gravity(g));
+        }
+        let mut entities = Vec::with_capacity(scene.bodies.len());
+        for body in &scene.bodies {
+            let mass = MassProps(body.mass);
+            let (mut transform, mut velocity) = (Transform::IDENTITY, Velocity::ZERO);
+            write_body_state(&body.state, &mass, &mut transform, &mut velocity);
+            let mut e = world.spawn((RigidBody, mass, transform, velocity));
+            if body.gravity_scale != 1.0 {
+                e.insert(GravityScale(body.gravity_scale));
+            }
+            if body.linear_damping != 0.0 || body.angular_damping != 0.0 {
+                e.insert(Damping {
+                    linear: body.linear_damping,
+                    angular: body.angular_damping,
+                });
+            }
+            let id = e.id();
+            for load in &body.loads {
+                match *load {
+                    Load::Force { force, local_point } => {
+                        world.spawn(ConstantForce {
+                            body: id,
+                            force,
+                            local_point,
+                        });
+                    }
+                    Load::Torque(torque) => {
+                        world.spawn(ConstantTorque { body: id, torque });
+                    }
+                }
+            }
+            entities.push(id);
+        }
+        let schedule = PhysicsPlan::for_world(&mut world).build_schedule();
+        Self {
+            world,
+            schedule,
+            entities,
+        }
+    }
+
+    /// Advances tumble by one step.
+    pub fn step(&mut self) {
+        self.schedule.run(&mut self.world);
+        self.world.clear_trackers();
+    }
+
+    /// The state of body `i` (position = centre of mass).
+    pub fn state(&self, i: usize) -> BodyState {
+        let e = self.entities[i];
+        let (Some(t), Some(v), Some(m)) = (
+            self.world.get::<Transform>(e),
+            self.world.get::<Velocity>(e),
+            self.world.get::<MassProps>(e),
+        ) else {
+            return BodyState {
+                position: glam::Vec3::NAN,
+                ..BodyState::default()
+            };
+        };
+        body_state(t, v, m)
+    }
+
+    /// True when body `i` was quarantined (bad data or divergence).
+    pub fn is_rejected(&self, i: usize) -> bool {
+        self.world.get::<Rejected>(self.entities[i]).is_some()
+    }
+}
