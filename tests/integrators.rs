@@ -6,4 +6,5 @@ mod integrators {
     pub mod extremes;
     pub mod gyroscopic;
     pub mod harness;
+    pub mod stability;
 }

@@ -15,6 +15,7 @@
 pub mod components;
 pub mod forces;
 pub mod schedule;
+pub mod stability;
 pub mod stepper;
 pub mod systems;
 pub mod validate;
@@ -27,6 +28,7 @@ pub mod prelude {
     };
     pub use crate::forces::{ConstantForce, ConstantTorque, Spring, SpringEnd};
     pub use crate::schedule::{PhysicsPlan, PhysicsSchedule, PhysicsSet, Stage};
+    pub use crate::stability::{StabilityWarning, check_stability};
     pub use crate::stepper::{FixedStepper, FrameSteps, interpolate};
     pub use crate::validate::{BodyError, BodyErrorKind, PhysicsErrors, Rejected};
     pub use tumble_core::{Density, Integrator, Mass, MassProperties};

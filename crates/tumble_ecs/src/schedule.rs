@@ -87,8 +87,13 @@ pub struct PhysicsPlan {
 
 impl PhysicsPlan {
     /// Plans the step for `world`. Inserts default [`PhysicsSettings`] if the world has none.
+    /// Settings outside the integrator's stable region are reported through `tracing` (see
+    /// [`check_stability`](crate::stability::check_stability)).
     pub fn for_world(world: &mut World) -> Self {
         let settings = *world.get_resource_or_init::<PhysicsSettings>();
+        for warning in crate::stability::check_stability(world) {
+            tracing::warn!("{warning}");
+        }
         world.init_resource::<HalfDrifted>();
         let mut stages = Vec::with_capacity(7);
         if settings.integrator.samples_forces_at_midpoint() && has_any::<ForceAccumulator>(world) {

@@ -1,0 +1,141 @@
+//! Predicting, when a schedule is planned, the settings that leave the selected integrator's
+//! stable region, so a game hears about it before the body blows up (the integrate systems still
+//! catch an actual divergence and quarantine the body).
+//!
+//! Two mechanisms matter for free bodies and springs:
+//!
+//! - **Springs.** Every method here advances positions with a symplectic kick–drift or
+//!   drift–kick–drift update, whose harmonic oscillator is stable iff `ω Δt < 2`, `ω = √(k/μ)`
+//!   with `μ` the reduced mass of the two ends (the body's mass for a world anchor). Damping is
+//!   ignored (it only helps).
+//! - **Explicit gyroscopic term** (`symplectic-euler`, `symplectic-euler-linear`). About a
+//!   principal axis `i` the torque-free motion nutates at `Ω² = ω² (I_j − I_i)(I_k − I_i)/(I_j I_k)`;
+//!   forward Euler multiplies each such oscillation by `√(1 + Ω²Δt²)` per step, a growth rate of
+//!   `Ω²Δt/2` per second. Round-off (1e-7) reaches order one after `t* = 2 ln(10⁷)/(Ω²Δt)`
+//!   (≈ 32/(Ω²Δt)): I = (1, 2, 3) at 20 rad/s and 60 Hz gives 4.8 s (measured: 3.5 s). A warning
+//!   is raised when `t*` is shorter than [`EXPLICIT_GYROSCOPIC_HORIZON`].
+
+use bevy_ecs::prelude::*;
+use tumble_core::Integrator;
+
+use crate::components::{MassProps, PhysicsSettings, RigidBody, Velocity};
+use crate::forces::{Spring, SpringEnd};
+
+/// `ω Δt` above which the symplectic position update of a spring diverges.
+pub const SPRING_LIMIT: f32 = 2.0;
+
+/// Bodies whose explicit gyroscopic step would amplify round-off to order one within this many
+/// seconds are reported (s).
+pub const EXPLICIT_GYROSCOPIC_HORIZON: f32 = 600.0;
+
+/// A setting outside the selected integrator's stable region.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum StabilityWarning {
+    /// A spring too stiff for the time step.
+    StiffSpring {
+        /// The spring entity.
+        spring: Entity,
+        /// `√(k/μ) Δt` (stable below [`SPRING_LIMIT`]).
+        omega_dt: f32,
+    },
+    /// A spin the explicit gyroscopic step will blow up.
+    ExplicitGyroscopic {
+        /// The body.
+        body: Entity,
+        /// The integrator.
+        integrator: Integrator,
+        /// Predicted time for round-off to grow to order one (s).
+        seconds: f32,
+    },
+}
+
+impl std::fmt::Display for StabilityWarning {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match *self {
+            StabilityWarning::StiffSpring { spring, omega_dt } => write!(
+                f,
+                "spring {spring}: √(k/μ)Δt = {omega_dt:.3} ≥ {SPRING_LIMIT}, outside the stable \
+                 region of every integrator here; lower the stiffness or the time step"
+            ),
+            StabilityWarning::ExplicitGyroscopic {
+                body,
+                integrator,
+                seconds,
+            } => write!(
+                f,
+                "rigid body {body}: integrator `{integrator}` amplifies its spin's round-off to \
+                 order one in about {seconds:.1} s (explicit gyroscopic term); use `splitting`"
+            ),
+        }
+    }
+}
+
+/// Squared nutation frequency per unit `|ω|²`, largest over the principal axes:
+/// `max_i |(I_j − I_i)(I_k − I_i)| / (I_j I_k)`.
+fn nutation_factor(inertia: glam::Vec3) -> f32 {
+    let i = inertia.to_array();
+    (0..3)
+        .map(|a| {
+            let (b, c) = ((a + 1) % 3, (a + 2) % 3);
+            if i[b] > 0.0 && i[c] > 0.0 {
+                ((i[b] - i[a]) * (i[c] - i[a])).abs() / (i[b] * i[c])
+            } else {
+                0.0
+            }
+        })
+        .fold(0.0, f32::max)
+}
+
+/// Checks the world's springs and spins against the selected integrator's stable region.
+pub fn check_stability(world: &mut World) -> Vec<StabilityWarning> {
+    let Some(settings) = world.get_resource::<PhysicsSettings>().copied() else {
+        return Vec::new();
+    };
+    let dt = settings.dt();
+    let mut warnings = Vec::new();
+    let springs: Vec<(Entity, Spring)> = world
+        .query::<(Entity, &Spring)>()
+        .iter(world)
+        .map(|(e, s)| (e, *s))
+        .collect();
+    let mut bodies = world.query_filtered::<&MassProps, With<RigidBody>>();
+    for (entity, spring) in springs {
+        let mut mass_of = |e: Entity| bodies.get(world, e).ok().map(|m| m.mass());
+        let reduced = match (mass_of(spring.a), spring.b) {
+            (Some(ma), SpringEnd::World(_)) => ma,
+            (Some(ma), SpringEnd::Body { body, .. }) => match mass_of(body) {
+                Some(mb) => ma * mb / (ma + mb),
+                None => continue,
+            },
+            (None, _) => continue,
+        };
+        let omega_dt = (spring.stiffness / reduced).sqrt() * dt;
+        if omega_dt >= SPRING_LIMIT {
+            warnings.push(StabilityWarning::StiffSpring {
+                spring: entity,
+                omega_dt,
+            });
+        }
+    }
+    if matches!(
+        settings.integrator,
+        Integrator::SymplecticEuler | Integrator::SymplecticEulerLinear
+    ) {
+        let mut spins = world.query_filtered::<(Entity, &MassProps, &Velocity), With<RigidBody>>();
+        for (body, mass, velocity) in spins.iter(world) {
+            let omega2 =
+                velocity.angular.length_squared() * nutation_factor(mass.principal_inertia());
+            if omega2 > 0.0 {
+                let seconds = 2.0 * 1e7_f32.ln() / (omega2 * dt);
+                if seconds < EXPLICIT_GYROSCOPIC_HORIZON {
+                    warnings.push(StabilityWarning::ExplicitGyroscopic {
+                        body,
+                        integrator: settings.integrator,
+                        seconds,
+                    });
+                }
+            }
+        }
+    }
+    warnings
+}
