@@ -1,0 +1,19 @@
+//! # tumble_report
+//!
+//! The numbers users read to choose an integrator and a time step:
+//!
+//! - **work–precision** ([`workprec`]): for each reference scene with an exact solution, each
+//!   integrator (and rapier as a row) and Δt from 1/15 to 1/1920 s, the error at a fixed horizon
+//!   (orientation angle, position, relative energy and `|L|` drift) and the run time per
+//!   body-step, measured in the same process;
+//! - **stability matrix** ([`stability`]): extreme scenes × integrator × setting: finite?
+//!   `max ||q| − 1|`? final/initial energy? and whether tumble's stability prediction warned;
+//! - **outputs** ([`output`]): `report.md`, `results.json` and SVG plots.
+
+#![forbid(unsafe_code)]
+#![warn(missing_docs)]
+
+pub mod output;
+pub mod reference;
+pub mod stability;
+pub mod workprec;

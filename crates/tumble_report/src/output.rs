@@ -1,0 +1,304 @@
+//! `report.md`, `results.json` and SVG plots.
+
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::path::Path;
+
+use plotters::prelude::*;
+use serde::Serialize;
+
+use crate::stability::Cell;
+use crate::workprec::Point;
+
+/// Where and on what the report was measured.
+#[derive(Debug, Clone, Serialize)]
+pub struct Machine {
+    /// CPU model from /proc/cpuinfo, when readable.
+    pub cpu: String,
+    /// Logical cores.
+    pub cores: usize,
+    /// Operating system.
+    pub os: String,
+    /// tumble version.
+    pub tumble_version: String,
+    /// Quick mode (fewer, shorter runs).
+    pub quick: bool,
+}
+
+impl Machine {
+    /// Reads the machine description.
+    pub fn detect(quick: bool) -> Self {
+        let cpu = std::fs::read_to_string("/proc/cpuinfo")
+            .ok()
+            .and_then(|s| {
+                s.lines()
+                    .find(|l| l.starts_with("model name"))
+                    .and_then(|l| l.split(':').nth(1))
+                    .map(|m| m.trim().to_owned())
+            })
+            .unwrap_or_else(|| "unknown".to_owned());
+        Self {
+            cpu,
+            cores: std::thread::available_parallelism().map_or(1, |n| n.get()),
+            os: std::env::consts::OS.to_owned(),
+            tumble_version: env!("CARGO_PKG_VERSION").to_owned(),
+            quick,
+        }
+    }
+}
+
+/// Everything the report measured, as written to `results.json`.
+#[derive(Debug, Clone, Serialize)]
+pub struct Results {
+    /// Schema version of this file.
+    pub schema: u32,
+    /// Units of every field.
+    pub units: BTreeMap<&'static str, &'static str>,
+    /// The machine.
+    pub machine: Machine,
+    /// Work–precision points.
+    pub work_precision: Vec<Point>,
+    /// Stability matrix.
+    pub stability: Vec<Cell>,
+}
+
+impl Results {
+    /// Bundles the measurements with their units.
+    pub fn new(machine: Machine, work_precision: Vec<Point>, stability: Vec<Cell>) -> Self {
+        let units = BTreeMap::from([
+            ("dt_s", "s"),
+            ("orientation_error_rad", "rad"),
+            ("position_error_m", "m"),
+            ("energy_drift", "1 (relative)"),
+            ("momentum_drift", "1 (relative)"),
+            ("ns_per_body_step", "ns"),
+            ("max_quaternion_error", "1"),
+            ("energy_ratio", "1"),
+        ]);
+        Self {
+            schema: 1,
+            units,
+            machine,
+            work_precision,
+            stability,
+        }
+    }
+}
+
+/// The error that matters for a scene: orientation for rotating scenes, position otherwise.
+pub fn headline_error(p: &Point) -> f64 {
+    if p.scene.starts_with("top") || p.scene == "dzhanibekov" {
+        p.orientation_error_rad
+    } else {
+        p.position_error_m.max(p.orientation_error_rad)
+    }
+}
+
+fn sci(x: f64) -> String {
+    if x.is_finite() {
+        format!("{x:.1e}")
+    } else {
+        "∞".to_owned()
+    }
+}
+
+/// The headline table: error at Δt = 1/60 s and ns per body-step, per scene and method.
+pub fn headline_table(points: &[Point]) -> String {
+    let mut scenes: Vec<&str> = Vec::new();
+    let mut methods: Vec<&str> = Vec::new();
+    for p in points {
+        if !scenes.contains(&p.scene.as_str()) {
+            scenes.push(&p.scene);
+        }
+        if !methods.contains(&p.method.as_str()) {
+            methods.push(&p.method);
+        }
+    }
+    let mut out = String::from("| method |");
+    for s in &scenes {
+        let _ = write!(out, " {s} |");
+    }
+    out.push_str(" ns/body-step |\n|---|");
+    for _ in &scenes {
+        out.push_str("---|");
+    }
+    out.push_str("---|\n");
+    for m in &methods {
+        let _ = write!(out, "| `{m}` |");
+        let mut ns = Vec::new();
+        for s in &scenes {
+            match points
+                .iter()
+                .find(|p| p.method == *m && p.scene == *s && (p.dt_s - 1.0 / 60.0).abs() < 1e-6)
+            {
+                Some(p) if p.finite => {
+                    let _ = write!(out, " {} |", sci(headline_error(p)));
+                    ns.push(p.ns_per_body_step);
+                }
+                Some(_) => out.push_str(" diverged |"),
+                None => out.push_str(" — |"),
+            }
+        }
+        ns.sort_by(f64::total_cmp);
+        let median = ns.get(ns.len() / 2).copied().unwrap_or(f64::NAN);
+        let _ = writeln!(out, " {median:.0} |");
+    }
+    out
+}
+
+/// The full markdown report.
+pub fn markdown(results: &Results, plots: &[String]) -> String {
+    let mut out = String::new();
+    let m = &results.machine;
+    let _ = writeln!(out, "# tumble accuracy report\n");
+    let _ = writeln!(
+        out,
+        "Machine: {} ({} cores, {}), tumble {}{}.\n",
+        m.cpu,
+        m.cores,
+        m.os,
+        m.tumble_version,
+        if m.quick { ", quick mode" } else { "" }
+    );
+    let _ = writeln!(
+        out,
+        "## Headline: error at Δt = 1/60 s\n\nOrientation error (rad) for the tops, position \
+         error (m, or orientation where larger) for the others, at each scene's horizon; \
+         ns/body-step is the median over scenes.\n"
+    );
+    out.push_str(&headline_table(&results.work_precision));
+    let _ = writeln!(out, "\n## Work–precision\n");
+    for plot in plots {
+        let _ = writeln!(out, "![{plot}]({plot})\n");
+    }
+    let mut scenes: Vec<&str> = results
+        .work_precision
+        .iter()
+        .map(|p| p.scene.as_str())
+        .collect();
+    scenes.dedup();
+    for scene in scenes {
+        let _ = writeln!(out, "### {scene}\n");
+        out.push_str("| method | Δt (s) | orientation (rad) | position (m) | energy drift | |L| drift | ns/body-step |\n|---|---|---|---|---|---|---|\n");
+        for p in results.work_precision.iter().filter(|p| p.scene == scene) {
+            let _ = writeln!(
+                out,
+                "| `{}` | 1/{:.0} | {} | {} | {} | {} | {:.0} |",
+                p.method,
+                1.0 / p.dt_s,
+                sci(p.orientation_error_rad),
+                sci(p.position_error_m),
+                sci(p.energy_drift),
+                p.momentum_drift.map_or("—".to_owned(), sci),
+                p.ns_per_body_step
+            );
+        }
+        out.push('\n');
+    }
+    let _ = writeln!(
+        out,
+        "## Stability matrix\n\nStable = finite, `||q| − 1| < 1e-5`, energy ratio in [0.01, 100]. \
+         **Bold** cells are unstable. \"warned\" = tumble's planning-time prediction.\n"
+    );
+    out.push_str("| scene | setting | integrator | finite | max \\|\\|q\\|−1\\| | E/E₀ | warned |\n|---|---|---|---|---|---|---|\n");
+    for c in &results.stability {
+        let mark = |s: String| if c.stable() { s } else { format!("**{s}**") };
+        let _ = writeln!(
+            out,
+            "| {} | {} | `{}` | {} | {} | {} | {} |",
+            c.scene,
+            c.setting,
+            c.integrator,
+            mark(c.finite.to_string()),
+            sci(c.max_quaternion_error),
+            mark(if c.energy_ratio.is_finite() {
+                format!("{:.4}", c.energy_ratio)
+            } else {
+                "—".into()
+            }),
+            c.warned
+        );
+    }
+    out
+}
+
+/// Draws error against time per body-step (log–log) for one scene; returns the file name.
+pub fn plot_scene(
+    dir: &Path,
+    scene: &str,
+    points: &[Point],
+) -> Result<String, Box<dyn std::error::Error>> {
+    let file = format!("workprec-{scene}.svg");
+    let path = dir.join(&file);
+    let pts: Vec<&Point> = points
+        .iter()
+        .filter(|p| p.scene == scene && p.finite && headline_error(p) > 0.0)
+        .collect();
+    if pts.is_empty() {
+        return Ok(file);
+    }
+    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+    for p in &pts {
+        x0 = x0.min(p.ns_per_body_step);
+        x1 = x1.max(p.ns_per_body_step);
+        y0 = y0.min(headline_error(p));
+        y1 = y1.max(headline_error(p));
+    }
+    let root = SVGBackend::new(&path, (800, 560)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(
+            format!("{scene}: error at the horizon vs time per body-step"),
+            ("sans-serif", 18),
+        )
+        .margin(12)
+        .x_label_area_size(40)
+        .y_label_area_size(70)
+        .build_cartesian_2d(
+            (x0 * 0.8..x1 * 1.25).log_scale(),
+            (y0 * 0.5..y1 * 2.0).log_scale(),
+        )?;
+    chart
+        .configure_mesh()
+        .x_desc("ns per body-step")
+        .y_desc("error (rad or m)")
+        .draw()?;
+    let mut methods: Vec<&str> = pts.iter().map(|p| p.method.as_str()).collect();
+    methods.sort_unstable();
+    methods.dedup();
+    for (k, method) in methods.iter().enumerate() {
+        let color = Palette99::pick(k).to_rgba();
+        let series: Vec<(f64, f64)> = pts
+            .iter()
+            .filter(|p| p.method == *method)
+            .map(|p| (p.ns_per_body_step, headline_error(p)))
+            .collect();
+        chart
+            .draw_series(LineSeries::new(series.clone(), color.stroke_width(2)))?
+            .label(*method)
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 16, y)], color.stroke_width(2))
+            });
+        chart.draw_series(
+            series
+                .into_iter()
+                .map(|(x, y)| Circle::new((x, y), 3, color.filled())),
+        )?;
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()?;
+    root.present()?;
+    Ok(file)
+}
+
+/// Replaces the text between `<!-- report:begin -->` and `<!-- report:end -->` with `table`.
+pub fn replace_between_markers(text: &str, table: &str) -> Option<String> {
+    const BEGIN: &str = "<!-- report:begin -->";
+    const END: &str = "<!-- report:end -->";
+    let start = text.find(BEGIN)? + BEGIN.len();
+    let end = start + text[start..].find(END)?;
+    Some(format!("{}\n{}{}", &text[..start], table, &text[end..]))
+}

@@ -1,0 +1,231 @@
+//! Reference scenes with exact solutions (f64).
+
+use glam::{DQuat, DVec3, Quat, Vec3};
+use tumble_core::{BodyState, Mass, MassProperties, Wrench};
+
+/// The load of a reference scene, evaluated at the state where the integrator samples it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Load {
+    /// Torque-free, force-free.
+    Free,
+    /// Uniform gravity `g` (m/s²).
+    Gravity(Vec3),
+    /// A spring of stiffness `k` from the centre of mass to the world origin, rest length 0.
+    Spring(f32),
+    /// A constant world force through a body-local point.
+    ForceAtPoint {
+        /// Force (N), world frame.
+        force: Vec3,
+        /// Point, body frame.
+        point: Vec3,
+    },
+}
+
+impl Load {
+    /// The load on a body in `state`.
+    pub fn wrench(&self, state: &BodyState, mass: &MassProperties) -> Wrench {
+        match *self {
+            Load::Free => Wrench::ZERO,
+            Load::Gravity(g) => Wrench {
+                force: mass.mass() * g,
+                torque: Vec3::ZERO,
+            },
+            Load::Spring(k) => Wrench {
+                force: -k * state.position,
+                torque: Vec3::ZERO,
+            },
+            Load::ForceAtPoint { force, point } => Wrench {
+                force,
+                torque: (state.rotation * point).cross(force),
+            },
+        }
+    }
+
+    /// Potential energy (J), so that kinetic + potential is conserved.
+    pub fn potential(&self, state: &BodyState, mass: &MassProperties) -> f64 {
+        let x = state.position.as_dvec3();
+        match *self {
+            Load::Free => 0.0,
+            Load::Gravity(g) => -f64::from(mass.mass()) * g.as_dvec3().dot(x),
+            Load::Spring(k) => 0.5 * f64::from(k) * x.length_squared(),
+            Load::ForceAtPoint { force, point } => -force
+                .as_dvec3()
+                .dot(x + (state.rotation * point).as_dvec3()),
+        }
+    }
+}
+
+/// Exact (or reference) state at time `t`: position of the centre of mass and orientation.
+pub type Exact = Box<dyn Fn(f64) -> (DVec3, DQuat) + Send + Sync>;
+
+/// One reference scene.
+pub struct Case {
+    /// Short name.
+    pub name: &'static str,
+    /// What it shows.
+    pub description: &'static str,
+    /// Mass properties.
+    pub mass: MassProperties,
+    /// Initial state.
+    pub initial: BodyState,
+    /// The load.
+    pub load: Load,
+    /// Horizon (s).
+    pub horizon: f64,
+    /// Exact solution.
+    pub exact: Exact,
+    /// True when rapier can run the scene (no springs).
+    pub rapier: bool,
+}
+
+/// Orientation and body rates of a torque-free body from a tiny-step f64 RK4 (h = 1e-4) on
+/// `q̇ = ½ q ⊗ (0, ω_b)`, `ṁ = m × ω_b`: error ≈ h⁴|ω|⁵T, below 1e-12 for these scenes.
+fn free_top(inertia: DVec3, omega0: DVec3, t: f64) -> DQuat {
+    let h = 1e-4;
+    let f = |q: DQuat, m: DVec3| {
+        let w = m / inertia;
+        (q * DQuat::from_xyzw(w.x, w.y, w.z, 0.0) * 0.5, m.cross(w))
+    };
+    let (mut q, mut m) = (DQuat::IDENTITY, inertia * omega0);
+    let steps = (t / h).round() as usize;
+    let h = t / steps as f64;
+    for _ in 0..steps {
+        let (a1, b1) = f(q, m);
+        let (a2, b2) = f(q + a1 * (h / 2.0), m + b1 * (h / 2.0));
+        let (a3, b3) = f(q + a2 * (h / 2.0), m + b2 * (h / 2.0));
+        let (a4, b4) = f(q + a3 * h, m + b3 * h);
+        q = (q + (a1 + a2 * 2.0 + a3 * 2.0 + a4) * (h / 6.0)).normalize();
+        m += (b1 + b2 * 2.0 + b3 * 2.0 + b4) * (h / 6.0);
+    }
+    q
+}
+
+/// Orientation of a spherical body (moment `inertia`) driven by the torque `(R p) × F` of a
+/// constant world force at body point `p`, from rest: f64 RK4 with h = 1e-4 on `(q, L)`.
+fn pendulum(point: DVec3, force: DVec3, inertia: f64, t: f64) -> DQuat {
+    let f = |q: DQuat, l: DVec3| {
+        let w = l / inertia;
+        (
+            DQuat::from_xyzw(w.x, w.y, w.z, 0.0) * q * 0.5,
+            (q * point).cross(force),
+        )
+    };
+    let steps = (t / 1e-4).round().max(1.0) as usize;
+    let h = t / steps as f64;
+    let (mut q, mut l) = (DQuat::IDENTITY, DVec3::ZERO);
+    for _ in 0..steps {
+        let (a1, b1) = f(q, l);
+        let (a2, b2) = f(q + a1 * (h / 2.0), l + b1 * (h / 2.0));
+        let (a3, b3) = f(q + a2 * (h / 2.0), l + b2 * (h / 2.0));
+        let (a4, b4) = f(q + a3 * h, l + b3 * h);
+        q = (q + (a1 + a2 * 2.0 + a3 * 2.0 + a4) * (h / 6.0)).normalize();
+        l += (b1 + b2 * 2.0 + b3 * 2.0 + b4) * (h / 6.0);
+    }
+    q
+}
+
+fn top(name: &'static str, description: &'static str, omega0: Vec3) -> Case {
+    let inertia = Vec3::new(1.0, 2.0, 3.0);
+    Case {
+        name,
+        description,
+        mass: MassProperties::new(Mass::new(1.0).expect("valid"), inertia).expect("valid"),
+        initial: BodyState {
+            angular_velocity: omega0,
+            ..Default::default()
+        },
+        load: Load::Free,
+        horizon: 10.0,
+        exact: Box::new(move |t| {
+            (
+                DVec3::ZERO,
+                free_top(inertia.as_dvec3(), omega0.as_dvec3(), t),
+            )
+        }),
+        rapier: true,
+    }
+}
+
+/// The reference scenes of the work–precision study.
+pub fn cases() -> Vec<Case> {
+    let sphere = MassProperties::solid_sphere(Mass::new(2.0).expect("valid"), 0.5).expect("valid");
+    let (x0, v0, g) = (
+        Vec3::new(0.0, 10.0, 0.0),
+        Vec3::new(3.0, 12.0, -1.0),
+        Vec3::new(0.0, -9.81, 0.0),
+    );
+    let (k, m) = (100.0_f32, 1.0_f32);
+    let spring_x0 = Vec3::new(0.5, 0.0, 0.0);
+    let force = Vec3::new(0.0, 0.0, 1.0);
+    let point = Vec3::new(0.5, 0.0, 0.0);
+    vec![
+        top(
+            "top-largest",
+            "torque-free top, I = (1, 2, 3), ω₀ = (0.1, 0.1, 3): stable spin near the largest axis",
+            Vec3::new(0.1, 0.1, 3.0),
+        ),
+        top(
+            "top-smallest",
+            "torque-free top, ω₀ = (3, 0.1, 0.1): stable spin near the smallest axis",
+            Vec3::new(3.0, 0.1, 0.1),
+        ),
+        top(
+            "dzhanibekov",
+            "torque-free top, ω₀ = (1, 5, 1): flips about the middle axis every 1.79 s",
+            Vec3::new(1.0, 5.0, 1.0),
+        ),
+        Case {
+            name: "projectile",
+            description: "uniform gravity: x = x₀ + v₀t + ½gt²",
+            mass: sphere,
+            initial: BodyState {
+                position: x0,
+                linear_velocity: v0,
+                ..Default::default()
+            },
+            load: Load::Gravity(g),
+            horizon: 5.0,
+            exact: Box::new(move |t| {
+                let x = x0.as_dvec3() + v0.as_dvec3() * t + 0.5 * g.as_dvec3() * t * t;
+                (x, DQuat::IDENTITY)
+            }),
+            rapier: true,
+        },
+        Case {
+            name: "spring",
+            description: "undamped spring, √(k/m) = 10 rad/s: x = x₀ cos(√(k/m) t)",
+            mass: MassProperties::solid_sphere(Mass::new(m).expect("valid"), 0.1).expect("valid"),
+            initial: BodyState {
+                position: spring_x0,
+                ..Default::default()
+            },
+            load: Load::Spring(k),
+            horizon: 10.0,
+            exact: Box::new(move |t| {
+                let w = f64::from(k / m).sqrt();
+                (spring_x0.as_dvec3() * (w * t).cos(), DQuat::IDENTITY)
+            }),
+            rapier: false,
+        },
+        Case {
+            name: "force-at-point",
+            description: "sphere pushed by a constant world force at a rim point (no gravity): \
+                          x = ½(F/m)t², rotation swings like a pendulum (f64 RK4 reference)",
+            mass: sphere,
+            initial: BodyState::default(),
+            load: Load::ForceAtPoint { force, point },
+            horizon: 3.0,
+            exact: Box::new(move |t| {
+                let x = 0.5 * (force.as_dvec3() / f64::from(sphere.mass())) * t * t;
+                let inertia = f64::from(sphere.principal_inertia().x);
+                (x, pendulum(point.as_dvec3(), force.as_dvec3(), inertia, t))
+            }),
+            rapier: true,
+        },
+    ]
+}
+
+/// f64 → f32 quaternion.
+pub fn to_quat(q: DQuat) -> Quat {
+    Quat::from_xyzw(q.x as f32, q.y as f32, q.z as f32, q.w as f32)
+}

@@ -1,0 +1,261 @@
+//! The stability matrix: extreme scenes × integrator × setting, run through the ECS schedule a
+//! game would run, with tumble's stability prediction checked against what happened.
+
+use bevy_ecs::prelude::*;
+use glam::{Quat, Vec3};
+use serde::Serialize;
+use tumble_core::invariants::kinetic_energy;
+use tumble_core::{Integrator, Mass, MassProperties};
+use tumble_ecs::components::body_state;
+use tumble_ecs::prelude::*;
+
+/// One cell of the matrix.
+#[derive(Debug, Clone, Serialize)]
+pub struct Cell {
+    /// Scene name.
+    pub scene: String,
+    /// Integrator name.
+    pub integrator: String,
+    /// The swept setting, e.g. `"|ω|Δt = 5"`.
+    pub setting: String,
+    /// Every body stayed finite and was never quarantined.
+    pub finite: bool,
+    /// Largest `||q| − 1|` over the run.
+    pub max_quaternion_error: f64,
+    /// Final / initial total energy, kinetic plus spring potential (NaN when not finite).
+    pub energy_ratio: f64,
+    /// tumble's planning-time stability prediction warned.
+    pub warned: bool,
+}
+
+impl Cell {
+    /// Stable: finite, unit quaternions, energy bounded within a factor of 100 either way.
+    ///
+    /// A symplectic method's energy oscillates rather than drifts, with an amplitude that grows
+    /// near the edge of its stable region (for a spring at `ωΔt = h`, up to
+    /// `(1 + h/2)/(1 − h/2)`: 79 at `h = 1.95`), so a tight band would call stable runs unstable;
+    /// an unstable run leaves any fixed band exponentially (or, exactly at the edge, as `n²`).
+    pub fn stable(&self) -> bool {
+        self.finite && self.max_quaternion_error < 1e-5 && (1e-2..1e2).contains(&self.energy_ratio)
+    }
+}
+
+fn sphere(m: f32) -> MassProps {
+    MassProps(MassProperties::solid_sphere(Mass::new(m).expect("valid"), 0.1).expect("valid"))
+}
+
+fn run(
+    world: &mut World,
+    steps: usize,
+    name: &str,
+    integrator: Integrator,
+    setting: String,
+) -> Cell {
+    let warned = !check_stability(world).is_empty();
+    let e0 = total_energy(world);
+    let mut schedule = PhysicsPlan::for_world(world).build_schedule();
+    let mut max_q = 0.0_f64;
+    let mut finite = true;
+    for _ in 0..steps {
+        schedule.run(world);
+        world.clear_trackers();
+        let mut q = world.query::<(&Transform, Option<&Rejected>)>();
+        for (t, rejected) in q.iter(world) {
+            max_q = max_q.max(f64::from((t.rotation.length() - 1.0).abs()));
+            finite &= rejected.is_none() && t.translation.is_finite();
+        }
+        if !finite {
+            break;
+        }
+    }
+    let e1 = total_energy(world);
+    Cell {
+        scene: name.to_owned(),
+        integrator: integrator.name().to_owned(),
+        setting,
+        finite,
+        max_quaternion_error: max_q,
+        energy_ratio: if finite { e1 / e0 } else { f64::NAN },
+        warned,
+    }
+}
+
+/// Kinetic energy of every body plus the potential `½ k (|d| − L₀)²` of every spring (J).
+fn total_energy(world: &mut World) -> f64 {
+    let mut q = world.query_filtered::<(&Transform, &Velocity, &MassProps), With<RigidBody>>();
+    let kinetic: f64 = q
+        .iter(world)
+        .map(|(t, v, m)| f64::from(kinetic_energy(&body_state(t, v, m), m)))
+        .sum();
+    let springs: Vec<Spring> = world.query::<&Spring>().iter(world).copied().collect();
+    let mut poses = world.query::<&Transform>();
+    let point = |poses: &mut QueryState<&Transform>, world: &World, e: Entity, p: Vec3| {
+        poses
+            .get(world, e)
+            .map(|t| t.transform_point(p))
+            .unwrap_or(Vec3::NAN)
+    };
+    let potential: f64 = springs
+        .iter()
+        .map(|s| {
+            let a = point(&mut poses, world, s.a, s.anchor_a);
+            let b = match s.b {
+                SpringEnd::World(p) => p,
+                SpringEnd::Body { body, anchor } => point(&mut poses, world, body, anchor),
+            };
+            let stretch = f64::from((a - b).length() - s.rest_length);
+            0.5 * f64::from(s.stiffness) * stretch * stretch
+        })
+        .sum();
+    kinetic + potential
+}
+
+fn world(dt: f32, integrator: Integrator) -> World {
+    let mut w = World::new();
+    w.insert_resource(PhysicsSettings::new(dt, integrator).expect("valid dt"));
+    w
+}
+
+/// Thin rod (I = (1e-4, 1, 1)) spinning at `|ω|Δt` about a tilted axis.
+fn thin_rod(integrator: Integrator, omega_dt: f32, steps: usize) -> Cell {
+    let dt = 1.0 / 60.0;
+    let mut w = world(dt, integrator);
+    let mass = MassProperties::new(Mass::new(1.0).expect("valid"), Vec3::new(1e-4, 1.0, 1.0))
+        .expect("valid");
+    let axis = Vec3::new(0.3, 1.0, 0.2).normalize();
+    w.spawn((
+        RigidBody,
+        MassProps(mass),
+        Velocity::angular(axis * omega_dt / dt),
+    ));
+    run(
+        &mut w,
+        steps,
+        "thin-rod",
+        integrator,
+        format!("|ω|Δt = {omega_dt}"),
+    )
+}
+
+/// A mass on a stiff spring to a world anchor, √(k/m)Δt = `omega_dt`.
+fn stiff_spring(integrator: Integrator, omega_dt: f32, steps: usize) -> Cell {
+    let (dt, m) = (1.0 / 60.0_f32, 1.0_f32);
+    let mut w = world(dt, integrator);
+    let body = w
+        .spawn((RigidBody, sphere(m), Transform::from_translation(Vec3::X)))
+        .id();
+    w.spawn(Spring {
+        a: body,
+        anchor_a: Vec3::ZERO,
+        b: SpringEnd::World(Vec3::ZERO),
+        stiffness: m * (omega_dt / dt).powi(2),
+        damping: 0.0,
+        rest_length: 0.0,
+    });
+    run(
+        &mut w,
+        steps,
+        "stiff-spring",
+        integrator,
+        format!("√(k/m)Δt = {omega_dt}"),
+    )
+}
+
+/// 1e9 kg and 1 kg on a spring with √(k/m_light)Δt = 1.
+fn mass_ratio(integrator: Integrator, dt: f32, steps: usize) -> Cell {
+    let mut w = world(dt, integrator);
+    let heavy = w.spawn((RigidBody, sphere(1e9))).id();
+    let light = w
+        .spawn((
+            RigidBody,
+            sphere(1.0),
+            Transform::from_translation(Vec3::new(2.0, 0.0, 0.0)),
+        ))
+        .id();
+    w.spawn(Spring {
+        a: light,
+        anchor_a: Vec3::ZERO,
+        b: SpringEnd::Body {
+            body: heavy,
+            anchor: Vec3::ZERO,
+        },
+        stiffness: (1.0 / dt).powi(2),
+        damping: 0.0,
+        rest_length: 1.0,
+    });
+    run(
+        &mut w,
+        steps,
+        "mass-ratio-1e9",
+        integrator,
+        format!("Δt = 1/{:.0}", 1.0 / dt),
+    )
+}
+
+/// A tumbling asymmetric body 1e5 m from the origin.
+fn far_away(integrator: Integrator, dt: f32, steps: usize) -> Cell {
+    let mut w = world(dt, integrator);
+    let mass = MassProperties::new(Mass::new(1.0).expect("valid"), Vec3::new(1.0, 2.0, 3.0))
+        .expect("valid");
+    w.spawn((
+        RigidBody,
+        MassProps(mass),
+        Transform {
+            translation: Vec3::splat(1e5),
+            rotation: Quat::from_rotation_x(0.4),
+        },
+        Velocity {
+            linear: Vec3::new(0.5, 0.0, 0.0),
+            angular: Vec3::new(0.2, 2.0, 0.2),
+        },
+    ));
+    run(
+        &mut w,
+        steps,
+        "far-1e5-m",
+        integrator,
+        format!("Δt = 1/{:.0}", 1.0 / dt),
+    )
+}
+
+/// A tumbling asymmetric body for a long run.
+fn long_run(integrator: Integrator, steps: usize) -> Cell {
+    let mut w = world(1.0 / 60.0, integrator);
+    let mass = MassProperties::new(Mass::new(1.0).expect("valid"), Vec3::new(0.2, 1.0, 1.1))
+        .expect("valid");
+    w.spawn((
+        RigidBody,
+        MassProps(mass),
+        Velocity::angular(Vec3::new(1.5, 0.3, -0.5)),
+    ));
+    run(
+        &mut w,
+        steps,
+        "long-run",
+        integrator,
+        format!("{steps} steps"),
+    )
+}
+
+/// Every cell of the matrix. `quick` shortens the runs (1e5 instead of 1e6 steps for the long
+/// run, 2000 instead of 20000 for the others).
+pub fn matrix(quick: bool, mut progress: impl FnMut()) -> Vec<Cell> {
+    let steps = if quick { 2_000 } else { 20_000 };
+    let long = if quick { 100_000 } else { 1_000_000 };
+    let mut cells = Vec::new();
+    for &integrator in Integrator::ALL {
+        for omega_dt in [0.1, 1.0, 5.0, 10.0] {
+            cells.push(thin_rod(integrator, omega_dt, steps));
+        }
+        for omega_dt in [0.5, 1.0, 1.5, 2.0, 2.5] {
+            cells.push(stiff_spring(integrator, omega_dt, steps));
+        }
+        for dt in [1.0 / 30.0, 1.0 / 60.0, 1.0 / 240.0] {
+            cells.push(mass_ratio(integrator, dt, steps));
+            cells.push(far_away(integrator, dt, steps));
+        }
+        cells.push(long_run(integrator, long));
+        progress();
+    }
+    cells
+}

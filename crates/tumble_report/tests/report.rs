@@ -1,0 +1,139 @@
+//! The report's measurements follow theory where theory is clear, and its JSON has the
+//! documented shape.
+
+use tumble_core::Integrator;
+use tumble_report::output::{Machine, Results, replace_between_markers};
+use tumble_report::reference::cases;
+use tumble_report::stability::matrix;
+use tumble_report::workprec::{Effort, Method, measure};
+
+const EFFORT: Effort = Effort {
+    batch: 1,
+    repetitions: 1,
+};
+
+fn case(name: &str) -> tumble_report::reference::Case {
+    cases().into_iter().find(|c| c.name == name).unwrap()
+}
+
+/// Error ratio per halving of Δt, from 1/`n` to 1/(2`n`).
+fn ratio(scene: &str, integrator: Integrator, n: f64) -> f64 {
+    let c = case(scene);
+    let coarse = measure(&c, Method::Tumble(integrator), 1.0 / n, EFFORT);
+    let fine = measure(&c, Method::Tumble(integrator), 0.5 / n, EFFORT);
+    coarse.orientation_error_rad / fine.orientation_error_rad
+}
+
+#[test]
+fn error_falls_with_the_methods_order() {
+    // Order p: 2^p per halving, on the stable top where the error (≫ the f32 floor of ≈1e-5 rad
+    // over 10 s) is in the asymptotic range: rk4 from Δt = 1/15 s, splitting from 1/30 s.
+    let rk4 = ratio("top-largest", Integrator::Rk4, 15.0);
+    assert!((11.0..23.0).contains(&rk4), "rk4: {rk4} (theory 16)");
+    let splitting = ratio("top-largest", Integrator::Splitting, 30.0);
+    assert!(
+        (3.2..5.0).contains(&splitting),
+        "splitting: {splitting} (theory 4)"
+    );
+    let xyz = ratio("top-largest", Integrator::SplittingXyz, 60.0);
+    assert!((3.2..5.0).contains(&xyz), "splitting-xyz: {xyz} (theory 4)");
+}
+
+#[test]
+fn drift_kick_drift_is_exact_on_the_projectile_and_rapier_is_not() {
+    let c = case("projectile");
+    let tumble = measure(
+        &c,
+        Method::Tumble(Integrator::Splitting),
+        1.0 / 60.0,
+        EFFORT,
+    );
+    let rapier = measure(&c, Method::Rapier, 1.0 / 60.0, EFFORT);
+    let euler = measure(
+        &c,
+        Method::Tumble(Integrator::SymplecticEuler),
+        1.0 / 60.0,
+        EFFORT,
+    );
+    // Symplectic Euler's bias ½ g Δt t = ½·9.81·(1/60)·5 = 0.41 m.
+    assert!((euler.position_error_m - 0.409).abs() < 0.01, "{euler:?}");
+    // rapier's 4 substeps cut the bias 4×.
+    assert!((rapier.position_error_m - 0.102).abs() < 0.01, "{rapier:?}");
+    // 300 steps of f32 round-off at ~50 m.
+    assert!(tumble.position_error_m < 1e-3, "{tumble:?}");
+}
+
+#[test]
+fn results_json_has_the_documented_shape() {
+    let c = case("top-largest");
+    let points = vec![measure(
+        &c,
+        Method::Tumble(Integrator::Splitting),
+        1.0 / 60.0,
+        EFFORT,
+    )];
+    let cells = matrix(true, || {}).into_iter().take(3).collect();
+    let results = Results::new(Machine::detect(true), points, cells);
+    let json: serde_json::Value = serde_json::to_value(&results).unwrap();
+    assert_eq!(json["schema"], 1);
+    for key in ["cpu", "cores", "os", "tumble_version", "quick"] {
+        assert!(json["machine"].get(key).is_some(), "machine.{key}");
+    }
+    let p = &json["work_precision"][0];
+    for key in [
+        "scene",
+        "method",
+        "dt_s",
+        "steps",
+        "orientation_error_rad",
+        "position_error_m",
+        "energy_drift",
+        "momentum_drift",
+        "ns_per_body_step",
+        "finite",
+    ] {
+        assert!(p.get(key).is_some(), "work_precision[].{key}");
+    }
+    assert!(p["orientation_error_rad"].as_f64().unwrap() < 1e-3);
+    let s = &json["stability"][0];
+    for key in [
+        "scene",
+        "integrator",
+        "setting",
+        "finite",
+        "max_quaternion_error",
+        "energy_ratio",
+        "warned",
+    ] {
+        assert!(s.get(key).is_some(), "stability[].{key}");
+    }
+    assert_eq!(json["units"]["ns_per_body_step"], "ns");
+}
+
+#[test]
+fn stability_predictions_agree_with_the_matrix() {
+    for cell in matrix(true, || {}) {
+        if cell.scene == "stiff-spring" {
+            // Warned exactly where the run is unstable (at √(k/m)Δt = 2 exactly the amplitude
+            // grows linearly: finite, but the energy leaves any bound).
+            assert_eq!(cell.warned, !cell.stable(), "{cell:?}");
+        }
+        if cell.integrator == "splitting" {
+            assert!(
+                cell.finite && cell.max_quaternion_error < 1e-6 || cell.scene == "stiff-spring",
+                "{cell:?}"
+            );
+        }
+    }
+}
+
+#[test]
+fn readme_markers_are_replaced() {
+    let text = "intro\n<!-- report:begin -->\nold\n<!-- report:end -->\nrest";
+    let new = replace_between_markers(text, "| new |\n").unwrap();
+    assert_eq!(
+        new,
+        "intro\n<!-- report:begin -->\n| new |\n<!-- report:end -->\nrest"
+    );
+    assert!(replace_between_markers("no markers", "x").is_none());
+}
