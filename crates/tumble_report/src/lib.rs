@@ -8,11 +8,13 @@
 //!   body-step, measured in the same process;
 //! - **stability matrix** ([`stability`]): extreme scenes × integrator × setting: finite?
 //!   `max ||q| − 1|`? final/initial energy? and whether tumble's stability prediction warned;
+//! - **energy over time** ([`energy`]) for long spins, each method and rapier;
 //! - **outputs** ([`output`]): `report.md`, `results.json` and SVG plots.
 
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
+pub mod energy;
 pub mod output;
 pub mod reference;
 pub mod stability;

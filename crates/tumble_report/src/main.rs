@@ -6,7 +6,8 @@ use std::process::ExitCode;
 
 use clap::Parser;
 use indicatif::{ProgressBar, ProgressStyle};
-use tumble_report::output::{Machine, Results, headline_table, markdown, plot_scene};
+use tumble_report::energy::{spins, traces};
+use tumble_report::output::{Machine, Results, headline_table, markdown, plot_energy, plot_scene};
 use tumble_report::reference::cases;
 use tumble_report::stability::matrix;
 use tumble_report::workprec::{Effort, Method, measure};
@@ -83,13 +84,18 @@ fn run(args: Args) -> Result<(), Box<dyn std::error::Error>> {
     }
     bar.set_message("stability matrix");
     let cells = matrix(args.quick, || bar.inc(1));
+    bar.set_message("energy over time");
+    let energy = traces(if args.quick { 30 } else { 120 });
     bar.finish_and_clear();
 
-    let results = Results::new(Machine::detect(args.quick), points, cells);
+    let results = Results::new(Machine::detect(args.quick), points, cells, energy);
     std::fs::create_dir_all(&args.out)?;
     let mut plots = Vec::new();
     for case in &cases {
         plots.push(plot_scene(&args.out, case.name, &results.work_precision)?);
+    }
+    for (spin, _) in spins() {
+        plots.push(plot_energy(&args.out, spin, &results.energy)?);
     }
     std::fs::write(
         args.out.join("results.json"),

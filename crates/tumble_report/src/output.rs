@@ -7,6 +7,7 @@ use std::path::Path;
 use plotters::prelude::*;
 use serde::Serialize;
 
+use crate::energy::EnergyTrace;
 use crate::stability::Cell;
 use crate::workprec::Point;
 
@@ -60,11 +61,18 @@ pub struct Results {
     pub work_precision: Vec<Point>,
     /// Stability matrix.
     pub stability: Vec<Cell>,
+    /// Energy over time of the long spins.
+    pub energy: Vec<EnergyTrace>,
 }
 
 impl Results {
     /// Bundles the measurements with their units.
-    pub fn new(machine: Machine, work_precision: Vec<Point>, stability: Vec<Cell>) -> Self {
+    pub fn new(
+        machine: Machine,
+        work_precision: Vec<Point>,
+        stability: Vec<Cell>,
+        energy: Vec<EnergyTrace>,
+    ) -> Self {
         let units = BTreeMap::from([
             ("dt_s", "s"),
             ("orientation_error_rad", "rad"),
@@ -74,6 +82,10 @@ impl Results {
             ("ns_per_body_step", "ns"),
             ("max_quaternion_error", "1"),
             ("energy_ratio", "1"),
+            (
+                "relative_energy",
+                "1 (E(t)/E(0) − 1, one sample per second)",
+            ),
         ]);
         Self {
             schema: 1,
@@ -81,6 +93,7 @@ impl Results {
             machine,
             work_precision,
             stability,
+            energy,
         }
     }
 }
@@ -268,6 +281,7 @@ pub fn plot_scene(
         .configure_mesh()
         .x_desc("run time to the horizon per body (µs)")
         .y_desc("error (rad or m)")
+        .y_label_formatter(&|y| format!("{y:.0e}"))
         .draw()?;
     let mut methods: Vec<&str> = pts.iter().map(|p| p.method.as_str()).collect();
     methods.sort_unstable();
@@ -307,4 +321,59 @@ pub fn replace_between_markers(text: &str, table: &str) -> Option<String> {
     let start = text.find(BEGIN)? + BEGIN.len();
     let end = start + text[start..].find(END)?;
     Some(format!("{}\n{}{}", &text[..start], table, &text[end..]))
+}
+
+/// Draws `|E(t)/E(0) − 1|` over time (log scale) for one long spin; returns the file name.
+pub fn plot_energy(
+    dir: &Path,
+    spin: &str,
+    traces: &[EnergyTrace],
+) -> Result<String, Box<dyn std::error::Error>> {
+    let file = format!("energy-{spin}.svg");
+    let path = dir.join(&file);
+    let root = SVGBackend::new(&path, (800, 560)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let seconds = traces
+        .iter()
+        .map(|t| t.relative_energy.len())
+        .max()
+        .unwrap_or(1) as f64;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(
+            format!("{spin} spin, 10 rad/s, 60 Hz: |E(t)/E(0) − 1|"),
+            ("sans-serif", 18),
+        )
+        .margin(12)
+        .x_label_area_size(40)
+        .y_label_area_size(70)
+        .build_cartesian_2d(0.0..seconds, (1e-8..10.0).log_scale())?;
+    chart
+        .configure_mesh()
+        .x_desc("time (s)")
+        .y_desc("relative energy error")
+        .draw()?;
+    for (k, trace) in traces.iter().filter(|t| t.spin == spin).enumerate() {
+        let color = Palette99::pick(k).to_rgba();
+        let series: Vec<(f64, f64)> = trace
+            .relative_energy
+            .iter()
+            .enumerate()
+            .filter(|(_, e)| e.is_finite())
+            .map(|(i, e)| (i as f64, e.abs().clamp(1e-8, 10.0)))
+            .collect();
+        chart
+            .draw_series(LineSeries::new(series, color.stroke_width(2)))?
+            .label(trace.method.clone())
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 16, y)], color.stroke_width(2))
+            });
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::LowerRight)
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()?;
+    root.present()?;
+    Ok(file)
 }

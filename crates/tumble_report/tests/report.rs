@@ -73,7 +73,8 @@ fn results_json_has_the_documented_shape() {
         EFFORT,
     )];
     let cells = matrix(true, || {}).into_iter().take(3).collect();
-    let results = Results::new(Machine::detect(true), points, cells);
+    let energy = tumble_report::energy::traces(2);
+    let results = Results::new(Machine::detect(true), points, cells, energy);
     let json: serde_json::Value = serde_json::to_value(&results).unwrap();
     assert_eq!(json["schema"], 1);
     for key in ["cpu", "cores", "os", "tumble_version", "quick"] {
@@ -108,6 +109,13 @@ fn results_json_has_the_documented_shape() {
         assert!(s.get(key).is_some(), "stability[].{key}");
     }
     assert_eq!(json["units"]["ns_per_body_step"], "ns");
+    let e = &json["energy"][0];
+    assert_eq!(
+        e["relative_energy"].as_array().unwrap().len(),
+        3,
+        "t = 0, 1, 2 s"
+    );
+    assert!(e.get("spin").is_some() && e.get("method").is_some());
 }
 
 #[test]
