@@ -19,6 +19,7 @@ pub mod error;
 pub mod integrate;
 pub mod invariants;
 pub mod mass;
+pub mod reference;
 pub mod rotation;
 #[cfg(feature = "parry")]
 pub mod shapes;

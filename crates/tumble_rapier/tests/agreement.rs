@@ -1,7 +1,8 @@
 //! tumble against rapier 0.36: where both should agree they do, to round-off; where they
 //! differ, tumble is closer to the exact solution, by at least the factor asserted.
 
-use glam::{DQuat, DVec3, Quat, Vec3};
+use glam::{DQuat, Quat, Vec3};
+use tumble_core::reference::free_body;
 use tumble_core::{BodyState, Integrator, Mass, MassProperties};
 use tumble_rapier::{ComparisonBody, ComparisonOptions, ComparisonScene, Load, compare};
 
@@ -139,30 +140,6 @@ fn where_the_defaults_differ_tumble_is_exact() {
     );
 }
 
-/// Exact torque-free orientation and body rates from a tiny-step f64 RK4 (h = 1e-4).
-fn reference(inertia: DVec3, omega0: DVec3, times: &[f64]) -> Vec<(DQuat, DVec3)> {
-    let h = 1e-4;
-    let f = |q: DQuat, m: DVec3| {
-        let w = m / inertia;
-        (q * DQuat::from_xyzw(w.x, w.y, w.z, 0.0) * 0.5, m.cross(w))
-    };
-    let (mut q, mut m, mut t) = (DQuat::IDENTITY, inertia * omega0, 0.0);
-    let mut out = Vec::with_capacity(times.len());
-    for &target in times {
-        while t + 0.5 * h < target {
-            let (a1, b1) = f(q, m);
-            let (a2, b2) = f(q + a1 * (h / 2.0), m + b1 * (h / 2.0));
-            let (a3, b3) = f(q + a2 * (h / 2.0), m + b2 * (h / 2.0));
-            let (a4, b4) = f(q + a3 * h, m + b3 * h);
-            q = (q + (a1 + a2 * 2.0 + a3 * 2.0 + a4) * (h / 6.0)).normalize();
-            m += (b1 + b2 * 2.0 + b3 * 2.0 + b4) * (h / 6.0);
-            t += h;
-        }
-        out.push((q, m / inertia));
-    }
-    out
-}
-
 /// Largest orientation error of tumble (default) and rapier (defaults) against the exact top.
 fn top_errors(omega0: Vec3, seconds: f64) -> (f64, f64) {
     let dt = 1.0 / 60.0;
@@ -182,7 +159,7 @@ fn top_errors(omega0: Vec3, seconds: f64) -> (f64, f64) {
         )],
     };
     let times: Vec<f64> = (1..=steps).map(|n| n as f64 / 60.0).collect();
-    let exact = reference(inertia.as_dvec3(), omega0.as_dvec3(), &times);
+    let exact = free_body(inertia.as_dvec3(), omega0.as_dvec3(), &times);
     let lookup = move |_: usize, t: f64| {
         let n = (t * 60.0).round() as usize;
         let (q, _) = exact[n - 1];

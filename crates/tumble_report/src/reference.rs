@@ -1,6 +1,7 @@
 //! Reference scenes with exact solutions (f64).
 
 use glam::{DQuat, DVec3, Quat, Vec3};
+use tumble_core::reference::free_body;
 use tumble_core::{BodyState, Mass, MassProperties, Wrench};
 
 /// The load of a reference scene, evaluated at the state where the integrator samples it.
@@ -78,28 +79,6 @@ pub struct Case {
     pub rapier: bool,
 }
 
-/// Orientation and body rates of a torque-free body from a tiny-step f64 RK4 (h = 1e-4) on
-/// `q̇ = ½ q ⊗ (0, ω_b)`, `ṁ = m × ω_b`: error ≈ h⁴|ω|⁵T, below 1e-12 for these scenes.
-fn free_top(inertia: DVec3, omega0: DVec3, t: f64) -> DQuat {
-    let h = 1e-4;
-    let f = |q: DQuat, m: DVec3| {
-        let w = m / inertia;
-        (q * DQuat::from_xyzw(w.x, w.y, w.z, 0.0) * 0.5, m.cross(w))
-    };
-    let (mut q, mut m) = (DQuat::IDENTITY, inertia * omega0);
-    let steps = (t / h).round() as usize;
-    let h = t / steps as f64;
-    for _ in 0..steps {
-        let (a1, b1) = f(q, m);
-        let (a2, b2) = f(q + a1 * (h / 2.0), m + b1 * (h / 2.0));
-        let (a3, b3) = f(q + a2 * (h / 2.0), m + b2 * (h / 2.0));
-        let (a4, b4) = f(q + a3 * h, m + b3 * h);
-        q = (q + (a1 + a2 * 2.0 + a3 * 2.0 + a4) * (h / 6.0)).normalize();
-        m += (b1 + b2 * 2.0 + b3 * 2.0 + b4) * (h / 6.0);
-    }
-    q
-}
-
 /// Orientation of a spherical body (moment `inertia`) driven by the torque `(R p) × F` of a
 /// constant world force at body point `p`, from rest: f64 RK4 with h = 1e-4 on `(q, L)`.
 fn pendulum(point: DVec3, force: DVec3, inertia: f64, t: f64) -> DQuat {
@@ -139,7 +118,7 @@ fn top(name: &'static str, description: &'static str, omega0: Vec3) -> Case {
         exact: Box::new(move |t| {
             (
                 DVec3::ZERO,
-                free_top(inertia.as_dvec3(), omega0.as_dvec3(), t),
+                free_body(inertia.as_dvec3(), omega0.as_dvec3(), &[t])[0].0,
             )
         }),
         rapier: true,
