@@ -16,6 +16,7 @@
 #![warn(missing_docs)]
 
 pub mod error;
+pub mod exact;
 pub mod integrate;
 pub mod invariants;
 pub mod mass;
