@@ -1,0 +1,419 @@
+//! A validated scene, and the world built from it.
+
+use std::collections::HashMap;
+
+use bevy_ecs::prelude::*;
+use bevy_ecs::schedule::Schedule;
+use glam::{Quat, Vec3};
+use parry3d::shape::{Ball, Capsule, Cone, ConvexPolyhedron, Cuboid, Cylinder};
+use tumble_core::shapes::mass_properties_of;
+use tumble_core::{Density, Integrator, Mass, MassProperties};
+use tumble_ecs::prelude::*;
+
+use crate::error::SceneError;
+use crate::format::{BodyDef, ForceDef, SceneFile, ShapeDef};
+use crate::validate::Checker;
+
+/// A scene that passed every check: it builds a world without failing.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Scene {
+    /// The file model (for saving).
+    pub file: SceneFile,
+    /// Time step (s).
+    pub dt: f32,
+    /// Number of steps.
+    pub steps: u64,
+    /// Integrator.
+    pub integrator: Integrator,
+    /// Gravity, if any.
+    pub gravity: Option<Vec3>,
+    bodies: Vec<ValidBody>,
+    forces: Vec<ValidForce>,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+struct ValidBody {
+    name: String,
+    mass: MassProperties,
+    transform: Transform,
+    velocity: Velocity,
+    gravity_scale: f32,
+    damping: Damping,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+enum ValidForce {
+    Constant {
+        body: usize,
+        force: Vec3,
+        point: Option<Vec3>,
+    },
+    Torque {
+        body: usize,
+        torque: Vec3,
+    },
+    Spring {
+        a: usize,
+        anchor_a: Vec3,
+        b: Option<usize>,
+        anchor_b: Vec3,
+        k: f32,
+        c: f32,
+        rest: f32,
+    },
+}
+
+/// A world built from a scene, with its planned schedule and the bodies in file order.
+pub struct BuiltScene {
+    /// The world.
+    pub world: World,
+    /// The schedule holding only the systems the scene needs.
+    pub schedule: Schedule,
+    /// `(name, entity)` of every body, in file order.
+    pub bodies: Vec<(String, Entity)>,
+}
+
+/// Largest accepted step count.
+pub const MAX_STEPS: u64 = 1_000_000_000;
+
+impl Scene {
+    /// Parses and validates scene text; `file` names it in errors.
+    pub fn parse(file: &str, text: &str) -> Result<Self, SceneError> {
+        let parsed: SceneFile = toml::from_str(text).map_err(|e| {
+            let start = e.span().map_or(0, |s| s.start.min(text.len()));
+            let line = 1 + text.as_bytes()[..start]
+                .iter()
+                .filter(|&&b| b == b'\n')
+                .count();
+            let message = e.message().replace('\n', " ");
+            // The field is the key on the offending line, when there is one.
+            let field = text
+                .lines()
+                .nth(line - 1)
+                .and_then(|l| l.split_once('=').map(|(k, _)| k.trim().to_owned()))
+                .filter(|k| !k.is_empty() && !k.starts_with('['))
+                .unwrap_or_else(|| "toml".to_owned());
+            SceneError::at(file, line, field, message)
+        })?;
+        Self::validate(file, text, parsed)
+    }
+
+    fn validate(file: &str, text: &str, parsed: SceneFile) -> Result<Self, SceneError> {
+        let ck = Checker { file, text };
+        let w = parsed.world.clone();
+        let dt = ck.scalar("world", None, "dt", w.dt)?;
+        if dt <= 0.0 {
+            return Err(ck.error(
+                "world",
+                None,
+                "dt",
+                format!("expected a time step > 0, got {}", w.dt),
+            ));
+        }
+        if w.steps == 0 || w.steps > MAX_STEPS {
+            return Err(ck.error(
+                "world",
+                None,
+                "steps",
+                format!("expected 1 to {MAX_STEPS} steps, got {}", w.steps),
+            ));
+        }
+        let integrator = match &w.integrator {
+            None => Integrator::default(),
+            Some(name) => {
+                name.parse()
+                    .map_err(|e: tumble_core::integrate::UnknownIntegrator| {
+                        ck.error("world", None, "integrator", e.to_string())
+                    })?
+            }
+        };
+        let gravity = w
+            .gravity
+            .map(|g| ck.vec3("world", None, "gravity", g))
+            .transpose()?;
+        let mut names = HashMap::new();
+        let mut bodies = Vec::with_capacity(parsed.bodies.len());
+        for (i, b) in parsed.bodies.iter().enumerate() {
+            if names.insert(b.name.clone(), i).is_some() {
+                return Err(ck.error(
+                    "bodies",
+                    Some(i),
+                    "name",
+                    format!("duplicate body name `{}`", b.name),
+                ));
+            }
+            bodies.push(validate_body(&ck, i, b)?);
+        }
+        let body = |i: usize, key: &str, name: &str| {
+            names.get(name).copied().ok_or_else(|| {
+                ck.error(
+                    "forces",
+                    Some(i),
+                    key,
+                    format!("unknown body `{name}`; expected one of the [[bodies]] names"),
+                )
+            })
+        };
+        let mut forces = Vec::with_capacity(parsed.forces.len());
+        for (i, f) in parsed.forces.iter().enumerate() {
+            let v = |key: &str, x: [f64; 3]| ck.vec3("forces", Some(i), key, x);
+            forces.push(match f {
+                ForceDef::Constant {
+                    body: b,
+                    force,
+                    point,
+                } => ValidForce::Constant {
+                    body: body(i, "body", b)?,
+                    force: v("force", *force)?,
+                    point: point.map(|p| v("point", p)).transpose()?,
+                },
+                ForceDef::Torque { body: b, torque } => ValidForce::Torque {
+                    body: body(i, "body", b)?,
+                    torque: v("torque", *torque)?,
+                },
+                ForceDef::Spring {
+                    a,
+                    anchor_a,
+                    b,
+                    anchor_b,
+                    stiffness,
+                    damping,
+                    rest_length,
+                } => {
+                    let non_negative = |key: &str, x: f64| -> Result<f32, SceneError> {
+                        let y = ck.scalar("forces", Some(i), key, x)?;
+                        if y < 0.0 {
+                            return Err(ck.error(
+                                "forces",
+                                Some(i),
+                                key,
+                                format!("expected a value >= 0, got {x}"),
+                            ));
+                        }
+                        Ok(y)
+                    };
+                    ValidForce::Spring {
+                        a: body(i, "a", a)?,
+                        anchor_a: v("anchor_a", *anchor_a)?,
+                        b: b.as_ref().map(|b| body(i, "b", b)).transpose()?,
+                        anchor_b: v("anchor_b", *anchor_b)?,
+                        k: non_negative("stiffness", *stiffness)?,
+                        c: non_negative("damping", *damping)?,
+                        rest: non_negative("rest_length", *rest_length)?,
+                    }
+                }
+            });
+        }
+        Ok(Self {
+            file: parsed,
+            dt,
+            steps: w.steps,
+            integrator,
+            gravity,
+            bodies,
+            forces,
+        })
+    }
+
+    /// The scene as TOML (loading it gives the same scene).
+    pub fn to_toml(&self) -> String {
+        crate::to_toml_string(&self.file)
+    }
+
+    /// Builds the world and plans its schedule.
+    pub fn build(&self) -> BuiltScene {
+        let mut world = World::new();
+        world.insert_resource(PhysicsSettings::new(self.dt, self.integrator).unwrap_or_default());
+        if let Some(g) = self.gravity {
+            world.insert_resource(Gravity(g));
+        }
+        let mut entities = Vec::with_capacity(self.bodies.len());
+        for b in &self.bodies {
+            let mut e = world.spawn((RigidBody, MassProps(b.mass), b.transform, b.velocity));
+            if b.gravity_scale != 1.0 {
+                e.insert(GravityScale(b.gravity_scale));
+            }
+            if b.damping != Damping::default() {
+                e.insert(b.damping);
+            }
+            entities.push(e.id());
+        }
+        for f in &self.forces {
+            match *f {
+                ValidForce::Constant { body, force, point } => {
+                    world.spawn(ConstantForce {
+                        body: entities[body],
+                        force,
+                        local_point: point,
+                    });
+                }
+                ValidForce::Torque { body, torque } => {
+                    world.spawn(ConstantTorque {
+                        body: entities[body],
+                        torque,
+                    });
+                }
+                ValidForce::Spring {
+                    a,
+                    anchor_a,
+                    b,
+                    anchor_b,
+                    k,
+                    c,
+                    rest,
+                } => {
+                    let end = match b {
+                        Some(b) => SpringEnd::Body {
+                            body: entities[b],
+                            anchor: anchor_b,
+                        },
+                        None => SpringEnd::World(anchor_b),
+                    };
+                    world.spawn(Spring {
+                        a: entities[a],
+                        anchor_a,
+                        b: end,
+                        stiffness: k,
+                        damping: c,
+                        rest_length: rest,
+                    });
+                }
+            }
+        }
+        let schedule = PhysicsPlan::for_world(&mut world).build_schedule();
+        let bodies = self
+            .bodies
+            .iter()
+            .map(|b| b.name.clone())
+            .zip(entities)
+            .collect();
+        BuiltScene {
+            world,
+            schedule,
+            bodies,
+        }
+    }
+}
+
+fn validate_body(ck: &Checker<'_>, i: usize, b: &BodyDef) -> Result<ValidBody, SceneError> {
+    let t = "bodies";
+    let mass = match (&b.mass, &b.inertia, &b.shape, &b.density) {
+        (Some(m), Some(inertia), None, None) => {
+            let m = ck.scalar(t, Some(i), "mass", *m)?;
+            let mass = Mass::new(m).map_err(|e| ck.error(t, Some(i), "mass", e.to_string()))?;
+            let inertia = ck.vec3(t, Some(i), "inertia", *inertia)?;
+            MassProperties::new(mass, inertia)
+                .map_err(|e| ck.error(t, Some(i), "inertia", e.to_string()))?
+        }
+        (None, None, Some(shape), Some(rho)) => {
+            let rho = ck.scalar(t, Some(i), "density", *rho)?;
+            let density =
+                Density::new(rho).map_err(|e| ck.error(t, Some(i), "density", e.to_string()))?;
+            shape_mass(ck, i, shape, density)?
+        }
+        _ => {
+            return Err(ck.error(
+                t,
+                Some(i),
+                "mass",
+                "expected either `mass` and `inertia`, or `shape` and `density`",
+            ));
+        }
+    };
+    let position = ck.vec3(t, Some(i), "position", b.position)?;
+    let r = b.rotation;
+    let mut q = [0.0f32; 4];
+    for (o, x) in q.iter_mut().zip(r) {
+        *o = ck.scalar(t, Some(i), "rotation", x)?;
+    }
+    let rotation = Quat::from_array(q);
+    tumble_core::error::check_unit_quat("rotation", rotation).map_err(|e| {
+        ck.error(
+            t,
+            Some(i),
+            "rotation",
+            format!("{e}; expected [x, y, z, w] of length 1"),
+        )
+    })?;
+    let linear = ck.vec3(t, Some(i), "linear_velocity", b.linear_velocity)?;
+    let angular = ck.vec3(t, Some(i), "angular_velocity", b.angular_velocity)?;
+    let gravity_scale = ck.scalar(t, Some(i), "gravity_scale", b.gravity_scale)?;
+    let mut damping = Damping::default();
+    for (key, value, out) in [
+        ("linear_damping", b.linear_damping, &mut damping.linear),
+        ("angular_damping", b.angular_damping, &mut damping.angular),
+    ] {
+        *out = ck.scalar(t, Some(i), key, value)?;
+        if *out < 0.0 {
+            return Err(ck.error(
+                t,
+                Some(i),
+                key,
+                format!("expected a value >= 0, got {value}"),
+            ));
+        }
+    }
+    Ok(ValidBody {
+        name: b.name.clone(),
+        mass,
+        transform: Transform {
+            translation: position,
+            rotation: rotation.normalize(),
+        },
+        velocity: Velocity { linear, angular },
+        gravity_scale,
+        damping,
+    })
+}
+
+fn shape_mass(
+    ck: &Checker<'_>,
+    i: usize,
+    shape: &ShapeDef,
+    density: Density,
+) -> Result<MassProperties, SceneError> {
+    let positive = |x: f64| -> Result<f32, SceneError> {
+        let y = ck.scalar("bodies", Some(i), "shape", x)?;
+        if y <= 0.0 {
+            return Err(ck.error(
+                "bodies",
+                Some(i),
+                "shape",
+                format!("expected dimensions > 0, got {x}"),
+            ));
+        }
+        Ok(y)
+    };
+    let result = match shape {
+        ShapeDef::Ball(r) => mass_properties_of(&Ball::new(positive(*r)?), density),
+        ShapeDef::Cuboid(h) => mass_properties_of(
+            &Cuboid::new(Vec3::new(positive(h[0])?, positive(h[1])?, positive(h[2])?)),
+            density,
+        ),
+        ShapeDef::Capsule([hh, r]) => {
+            mass_properties_of(&Capsule::new_y(positive(*hh)?, positive(*r)?), density)
+        }
+        ShapeDef::Cylinder([hh, r]) => {
+            mass_properties_of(&Cylinder::new(positive(*hh)?, positive(*r)?), density)
+        }
+        ShapeDef::Cone([hh, r]) => {
+            mass_properties_of(&Cone::new(positive(*hh)?, positive(*r)?), density)
+        }
+        ShapeDef::ConvexHull(points) => {
+            let pts: Vec<Vec3> = points
+                .iter()
+                .map(|p| ck.vec3("bodies", Some(i), "shape", *p))
+                .collect::<Result<_, _>>()?;
+            let hull = ConvexPolyhedron::from_convex_hull(&pts).ok_or_else(|| {
+                ck.error(
+                    "bodies",
+                    Some(i),
+                    "shape",
+                    "convex hull is degenerate (needs 4 points spanning a volume)",
+                )
+            })?;
+            mass_properties_of(&hull, density)
+        }
+    };
+    result.map_err(|e| ck.error("bodies", Some(i), "shape", e.to_string()))
+}
