@@ -1,5 +1,7 @@
 //! `tumble`: run a scene file headless, write its trajectory, list the bundled scenes.
 
+mod compare;
+
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
@@ -77,6 +79,29 @@ enum Command {
     },
     /// List the bundled scenes.
     Scenes,
+    /// Run a scene in tumble and in rapier 0.36 side by side and print the differences.
+    Compare {
+        /// Scene file, or the name of a bundled scene.
+        scene: String,
+        /// tumble's integrator (default: the scene's).
+        #[arg(long)]
+        integrator: Option<String>,
+        /// rapier's gyroscopic term.
+        #[arg(long, default_value = "on", value_parser = ["on", "off"])]
+        gyroscopic: String,
+    },
+    /// The accuracy report: work–precision, stability matrix, plots.
+    Report {
+        /// The one-minute version.
+        #[arg(long)]
+        quick: bool,
+        /// Output directory.
+        #[arg(long, default_value = "report")]
+        out: PathBuf,
+        /// Replace the headline table in this markdown file (e.g. README.md).
+        #[arg(long)]
+        readme: Option<PathBuf>,
+    },
 }
 
 fn main() -> ExitCode {
@@ -107,6 +132,29 @@ fn run(cli: Cli) -> Result<(), String> {
                 println!("{name:<16} {first}");
             }
             Ok(())
+        }
+        Command::Compare {
+            scene,
+            integrator,
+            gyroscopic,
+        } => {
+            let (file, text) = load(&scene)?;
+            let scene = Scene::parse(&file, &text).map_err(|e| e.to_string())?;
+            let integrator = match integrator {
+                Some(name) => name
+                    .parse()
+                    .map_err(|e: tumble_core::integrate::UnknownIntegrator| e.to_string())?,
+                None => scene.integrator,
+            };
+            compare::run(&scene, integrator, gyroscopic == "on")
+        }
+        Command::Report { quick, out, readme } => {
+            tumble_report::run::run_report(&tumble_report::run::ReportOptions {
+                quick,
+                out,
+                readme,
+            })
+            .map_err(|e| e.to_string())
         }
         Command::Run {
             scene,

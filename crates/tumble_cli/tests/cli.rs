@@ -125,3 +125,30 @@ fn scenes_lists_the_bundled_scenes_and_plan_prints_the_systems() {
         "{plan}"
     );
 }
+
+#[test]
+fn compare_reports_rapier_and_exact_differences() {
+    let out = tumble().args(["compare", "dzhanibekov"]).output().unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    let row = text
+        .lines()
+        .find(|l| l.starts_with("t-handle"))
+        .expect(&text);
+    // The last column is "tumble / rapier" max orientation error against the exact top.
+    let cells: Vec<&str> = row.split_whitespace().collect();
+    let (ours, theirs): (f64, f64) = (
+        cells[cells.len() - 3].parse().unwrap(),
+        cells[cells.len() - 1].parse().unwrap(),
+    );
+    assert!(ours * 10.0 < theirs, "{row}");
+    assert!(text.contains("rapier/tumble"), "{text}");
+    // Springs are outside what rapier models here: a clear one-line error.
+    let out = tumble().args(["compare", "spring_chain"]).output().unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("springs"));
+}

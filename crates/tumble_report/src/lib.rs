@@ -17,5 +17,6 @@
 pub mod energy;
 pub mod output;
 pub mod reference;
+pub mod run;
 pub mod stability;
 pub mod workprec;

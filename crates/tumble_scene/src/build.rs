@@ -215,6 +215,35 @@ impl Scene {
         })
     }
 
+    /// Each body as `(name, mass properties, initial state with the centre-of-mass position,
+    /// gravity scale, linear damping, angular damping)`, in file order.
+    pub fn body_states(
+        &self,
+    ) -> Vec<(
+        String,
+        MassProperties,
+        tumble_core::BodyState,
+        f32,
+        f32,
+        f32,
+    )> {
+        self.bodies
+            .iter()
+            .map(|b| {
+                let props = MassProps(b.mass);
+                let state = tumble_ecs::components::body_state(&b.transform, &b.velocity, &props);
+                (
+                    b.name.clone(),
+                    b.mass,
+                    state,
+                    b.gravity_scale,
+                    b.damping.linear,
+                    b.damping.angular,
+                )
+            })
+            .collect()
+    }
+
     /// The scene as TOML (loading it gives the same scene).
     pub fn to_toml(&self) -> String {
         crate::to_toml_string(&self.file)

@@ -1,0 +1,149 @@
+//! `tumble compare`: the scene in tumble and in rapier 0.36, side by side.
+
+use glam::{DQuat, Quat};
+use tumble_core::exact::TorqueFreeTop;
+use tumble_core::{BodyState, Integrator};
+use tumble_rapier::{ComparisonBody, ComparisonOptions, ComparisonScene, Load, compare};
+use tumble_scene::{ForceDef, Scene};
+
+/// Builds the comparison and prints, per body, the largest difference to rapier and to the
+/// exact solution where one exists, and the speed ratio.
+pub fn run(scene: &Scene, integrator: Integrator, gyroscopic: bool) -> Result<(), String> {
+    let states = scene.body_states();
+    let mut bodies: Vec<ComparisonBody> = states
+        .iter()
+        .map(|(name, mass, state, scale, lin, ang)| {
+            let mut b = ComparisonBody::new(name.clone(), *mass, *state);
+            b.gravity_scale = *scale;
+            b.linear_damping = *lin;
+            b.angular_damping = *ang;
+            b
+        })
+        .collect();
+    let index = |name: &str| states.iter().position(|s| s.0 == name);
+    for force in &scene.file.forces {
+        match force {
+            ForceDef::Constant { body, force, point } => {
+                let i = index(body).ok_or("unknown body")?;
+                let f = glam::DVec3::from_array(*force).as_vec3();
+                let p = point.map(|p| glam::DVec3::from_array(p).as_vec3());
+                bodies[i].loads.push(Load::Force {
+                    force: f,
+                    local_point: p,
+                });
+            }
+            ForceDef::Torque { body, torque } => {
+                let i = index(body).ok_or("unknown body")?;
+                bodies[i]
+                    .loads
+                    .push(Load::Torque(glam::DVec3::from_array(*torque).as_vec3()));
+            }
+            ForceDef::Spring { .. } => {
+                return Err(format!(
+                    "scene `{}` has springs, which the rapier comparison does not model (rapier \
+                     has no spring force generator); supported: free bodies, gravity, gravity \
+                     scale, constant forces (at points) and torques, damping",
+                    scene.file.name
+                ));
+            }
+        }
+    }
+    let comparison = ComparisonScene {
+        dt: scene.dt,
+        gravity: scene.gravity,
+        bodies,
+    };
+    // Exact solutions for bodies without loads or damping: the position is the parabola
+    // x₀ + v₀t + ½ g s t²; the orientation is a steady rotation for a spherical body, or the
+    // elliptic torque-free top for distinct moments (identity principal frame).
+    let gravity = scene.gravity.unwrap_or(glam::Vec3::ZERO).as_dvec3();
+    let exact_for: Vec<Option<(Option<TorqueFreeTop>, bool)>> = comparison
+        .bodies
+        .iter()
+        .map(|b| {
+            let free = b.loads.is_empty() && b.linear_damping == 0.0 && b.angular_damping == 0.0;
+            if !free {
+                return None;
+            }
+            if b.mass.is_spherical() {
+                return Some((None, true));
+            }
+            if b.mass.principal_frame() != Quat::IDENTITY {
+                return None;
+            }
+            let w_body = b.state.rotation.inverse() * b.state.angular_velocity;
+            TorqueFreeTop::new(
+                b.mass.principal_inertia().as_dvec3(),
+                w_body.as_dvec3(),
+                b.state.rotation.as_dquat(),
+            )
+            .ok()
+            .map(|top| (Some(top), false))
+        })
+        .collect();
+    let exact = |i: usize, t: f64| -> Option<BodyState> {
+        let (top, spherical) = exact_for[i].as_ref()?;
+        let b = &comparison.bodies[i];
+        let q: DQuat = match top {
+            Some(top) => top.orientation(t),
+            None if *spherical => {
+                DQuat::from_scaled_axis(b.state.angular_velocity.as_dvec3() * t)
+                    * b.state.rotation.as_dquat()
+            }
+            None => return None,
+        };
+        let x = b.state.position.as_dvec3()
+            + b.state.linear_velocity.as_dvec3() * t
+            + 0.5 * gravity * f64::from(b.gravity_scale) * t * t;
+        Some(BodyState {
+            position: x.as_vec3(),
+            rotation: Quat::from_xyzw(q.x as f32, q.y as f32, q.z as f32, q.w as f32),
+            ..Default::default()
+        })
+    };
+    let options = ComparisonOptions {
+        integrator,
+        gyroscopic,
+        rapier_solver_iterations: 4,
+        steps: scene.steps.min(1_000_000) as usize,
+    };
+    let result = compare(&comparison, &options, Some(&exact));
+    println!(
+        "scene {} · tumble `{integrator}` vs rapier 0.36 (gyroscopic {}, 4 substeps) · {} steps of {} s",
+        scene.file.name,
+        if gyroscopic { "on" } else { "off" },
+        options.steps,
+        scene.dt
+    );
+    println!(
+        "{:<16} {:>11} {:>12} {:>11} {:>11} {:>21} {:>21}",
+        "body",
+        "Δx (m)",
+        "Δangle (rad)",
+        "Δv (m/s)",
+        "Δω (rad/s)",
+        "exact Δx tumble/rapier",
+        "exact angle t/r"
+    );
+    let pair =
+        |p: Option<(f64, f64)>| p.map_or("—".to_owned(), |(t, r)| format!("{t:.2e} / {r:.2e}"));
+    for d in &result.bodies {
+        println!(
+            "{:<16} {:>11.3e} {:>12.3e} {:>11.3e} {:>11.3e} {:>21} {:>21}",
+            d.name,
+            d.position,
+            d.angle,
+            d.linear_velocity,
+            d.angular_velocity,
+            pair(d.exact_position),
+            pair(d.exact_angle)
+        );
+    }
+    println!(
+        "time per step: tumble {:.0} ns, rapier {:.0} ns (rapier/tumble = {:.1})",
+        result.tumble_ns_per_step,
+        result.rapier_ns_per_step,
+        result.speed_ratio()
+    );
+    Ok(())
+}

@@ -1,0 +1,106 @@
+//! The whole report in one call, shared by `tumble-report` and `tumble report`.
+
+use std::path::{Path, PathBuf};
+
+use indicatif::{ProgressBar, ProgressStyle};
+
+use crate::energy::{spins, traces};
+use crate::output::{Machine, Results, headline_table, markdown, plot_energy, plot_scene};
+use crate::reference::cases;
+use crate::stability::matrix;
+use crate::workprec::{Effort, Method, measure};
+
+/// What to run and where to write it.
+#[derive(Debug, Clone)]
+pub struct ReportOptions {
+    /// Fewer time steps, smaller batches, shorter stability runs (< 60 s on 2 cores).
+    pub quick: bool,
+    /// Output directory.
+    pub out: PathBuf,
+    /// A markdown file whose headline table (between the report markers) is replaced.
+    pub readme: Option<PathBuf>,
+}
+
+/// Runs the work–precision study, the stability matrix and the energy traces; writes
+/// `report.md`, `results.json` and the SVG plots; prints the headline table.
+pub fn run_report(options: &ReportOptions) -> Result<(), Box<dyn std::error::Error>> {
+    let dts: Vec<f64> = if options.quick {
+        [15.0, 30.0, 60.0, 120.0, 240.0, 480.0]
+            .iter()
+            .map(|n| 1.0 / n)
+            .collect()
+    } else {
+        [15.0, 30.0, 60.0, 120.0, 240.0, 480.0, 960.0, 1920.0]
+            .iter()
+            .map(|n| 1.0 / n)
+            .collect()
+    };
+    let effort = if options.quick {
+        Effort {
+            batch: 8,
+            repetitions: 1,
+        }
+    } else {
+        Effort {
+            batch: 64,
+            repetitions: 3,
+        }
+    };
+    let cases = cases();
+    let methods = Method::all();
+    let total = cases.len() * methods.len() * dts.len() + tumble_core::Integrator::ALL.len();
+    let bar = ProgressBar::new(total as u64);
+    bar.set_style(ProgressStyle::with_template(
+        "{bar:40} {pos}/{len} {msg} [{elapsed}]",
+    )?);
+    let mut points = Vec::new();
+    for case in &cases {
+        for &method in &methods {
+            if method == Method::Rapier && !case.rapier {
+                bar.inc(dts.len() as u64);
+                continue;
+            }
+            bar.set_message(format!("{} · {}", case.name, method.name()));
+            for &dt in &dts {
+                points.push(measure(case, method, dt, effort));
+                bar.inc(1);
+            }
+        }
+    }
+    bar.set_message("stability matrix");
+    let cells = matrix(options.quick, || bar.inc(1));
+    bar.set_message("energy over time");
+    let energy = traces(if options.quick { 30 } else { 120 });
+    bar.finish_and_clear();
+
+    let results = Results::new(Machine::detect(options.quick), points, cells, energy);
+    let out: &Path = &options.out;
+    std::fs::create_dir_all(out)?;
+    let mut plots = Vec::new();
+    for case in &cases {
+        plots.push(plot_scene(out, case.name, &results.work_precision)?);
+    }
+    for (spin, _) in spins() {
+        plots.push(plot_energy(out, spin, &results.energy)?);
+    }
+    std::fs::write(
+        out.join("results.json"),
+        serde_json::to_string_pretty(&results)?,
+    )?;
+    std::fs::write(out.join("report.md"), markdown(&results, &plots))?;
+    let headline = headline_table(&results.work_precision);
+    println!("{headline}");
+    if let Some(readme) = &options.readme {
+        let text = std::fs::read_to_string(readme)?;
+        let updated = crate::output::replace_between_markers(&text, &headline)
+            .ok_or("README has no <!-- report:begin --> … <!-- report:end --> markers")?;
+        std::fs::write(readme, updated)?;
+        println!("updated the headline table in {}", readme.display());
+    }
+    println!(
+        "wrote {}/report.md, results.json and {} plots",
+        out.display(),
+        plots.len()
+    );
+    Ok(())
+}
