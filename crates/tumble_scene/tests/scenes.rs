@@ -25,201 +25,48 @@ fn bundled_scenes_load_build_and_round_trip() {
     assert!(count >= 9, "bundled scenes: {count}");
 }
 
-const VALID: &str = "name = \"ok\"\n[world]\ndt = 0.01\nsteps = 10\n[[bodies]]\nname = \"a\"\nmass = 1.0\ninertia = [1.0, 2.0, 3.0]\n";
-
-fn error(text: &str) -> SceneError {
-    Scene::parse("bad.toml", text).expect_err("must be rejected")
-}
-
+/// Every file in `tests/bad/` is rejected with the line, field and message listed in
+/// `tests/bad/expected.txt`, and the error names the file.
 #[test]
-fn bad_input_names_line_and_field() {
-    let cases: &[(&str, usize, &str, &str)] = &[
-        // (text, line, field fragment, message fragment)
-        (
-            "name = \"x\"\n[world]\ndt = 0.0\nsteps = 1\n",
-            3,
-            "world.dt",
-            "> 0",
-        ),
-        (
-            "name = \"x\"\n[world]\ndt = -1.0\nsteps = 1\n",
-            3,
-            "world.dt",
-            "> 0",
-        ),
-        (
-            "name = \"x\"\n[world]\ndt = nan\nsteps = 1\n",
-            3,
-            "world.dt",
-            "finite",
-        ),
-        (
-            "name = \"x\"\n[world]\ndt = inf\nsteps = 1\n",
-            3,
-            "world.dt",
-            "finite",
-        ),
-        (
-            "name = \"x\"\n[world]\ndt = 1e39\nsteps = 1\n",
-            3,
-            "world.dt",
-            "overflows f32",
-        ),
-        (
-            "name = \"x\"\n[world]\ndt = 0.01\nsteps = 0\n",
-            4,
-            "world.steps",
-            "1 to",
-        ),
-        (
-            "name = \"x\"\n[world]\ndt = 0.01\nsteps = 99999999999\n",
-            4,
-            "world.steps",
-            "1 to",
-        ),
-        (
-            "name = \"x\"\n[world]\ndt = 0.01\nsteps = 1\nintegrator = \"magic\"\n",
-            5,
-            "world.integrator",
-            "unknown integrator",
-        ),
-        (
-            "name = \"x\"\n[world]\ndt = 0.01\nsteps = 1\nwarp = 9\n",
-            5,
-            "warp",
-            "unknown field",
-        ),
-        (
-            "name = \"x\"\n[world]\ndt = \"fast\"\nsteps = 1\n",
-            3,
-            "dt",
-            "invalid type",
-        ),
-        ("name = \"x\"\n[world\ndt = 0.01\n", 2, "toml", ""),
-        ("", 1, "toml", "missing field"),
-        ("\u{1}\u{2}garbage\u{ff}", 1, "toml", ""),
-        (
-            &format!("{VALID}[[bodies]]\nname = \"a\"\nmass = 1.0\ninertia = [1.0, 1.0, 1.0]\n"),
-            10,
-            "bodies[1].name",
-            "duplicate",
-        ),
-        (
-            &VALID.replace("mass = 1.0", "mass = 0.0"),
-            7,
-            "bodies[0].mass",
-            "mass must be > 0",
-        ),
-        (
-            &VALID.replace("mass = 1.0", "mass = -3.0"),
-            7,
-            "bodies[0].mass",
-            "mass must be > 0",
-        ),
-        (
-            &VALID.replace("mass = 1.0", "mass = nan"),
-            7,
-            "bodies[0].mass",
-            "finite",
-        ),
-        (
-            &VALID.replace("[1.0, 2.0, 3.0]", "[1.0, -2.0, 3.0]"),
-            8,
-            "bodies[0].inertia",
-            ">= 0",
-        ),
-        (
-            &VALID.replace("[1.0, 2.0, 3.0]", "[0.0, 0.0, 0.0]"),
-            8,
-            "bodies[0].inertia",
-            "zero on every axis",
-        ),
-        (
-            &format!("{VALID}rotation = [0.0, 0.0, 0.0, 2.0]\n"),
-            9,
-            "bodies[0].rotation",
-            "unit quaternion",
-        ),
-        (
-            &format!("{VALID}rotation = [0.0, 0.0, 0.0, 0.0]\n"),
-            9,
-            "bodies[0].rotation",
-            "unit quaternion",
-        ),
-        (
-            &format!("{VALID}angular_velocity = [1e40, 0.0, 0.0]\n"),
-            9,
-            "bodies[0].angular_velocity",
-            "overflows f32",
-        ),
-        (
-            &format!("{VALID}position = [1.0, 2.0]\n"),
-            9,
-            "position",
-            "",
-        ),
-        (
-            &format!(
-                "{VALID}[[forces]]\ntype = \"torque\"\nbody = \"ghost\"\ntorque = [0.0, 0.0, 1.0]\n"
-            ),
-            11,
-            "forces[0].body",
-            "unknown body `ghost`",
-        ),
-        (
-            &format!("{VALID}[[forces]]\ntype = \"laser\"\nbody = \"a\"\n"),
-            10,
-            "type",
-            "unknown variant",
-        ),
-        (
-            &format!("{VALID}[[forces]]\ntype = \"spring\"\na = \"a\"\nstiffness = -5.0\n"),
-            12,
-            "forces[0].stiffness",
-            ">= 0",
-        ),
-        (
-            "name = \"x\"\n[world]\ndt = 0.01\nsteps = 1\n[[bodies]]\nname = \"b\"\nmass = 1.0\n",
-            7,
-            "bodies[0].mass",
-            "either `mass` and `inertia`",
-        ),
-        (
-            "name = \"x\"\n[world]\ndt = 0.01\nsteps = 1\n[[bodies]]\nname = \"b\"\nshape = { ball = -1.0 }\ndensity = 5.0\n",
-            7,
-            "bodies[0].shape",
-            "> 0",
-        ),
-        (
-            "name = \"x\"\n[world]\ndt = 0.01\nsteps = 1\n[[bodies]]\nname = \"b\"\nshape = { ball = 1.0 }\ndensity = 0.0\n",
-            8,
-            "bodies[0].density",
-            "density must be > 0",
-        ),
-        (
-            "name = \"x\"\n[world]\ndt = 0.01\nsteps = 1\n[[bodies]]\nname = \"b\"\nshape = { convex_hull = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]] }\ndensity = 1.0\n",
-            7,
-            "bodies[0].shape",
-            "",
-        ),
-    ];
-    for (text, line, field, message) in cases {
-        let e = error(text);
-        assert_eq!(e.file, "bad.toml");
-        assert_eq!(e.line, *line, "{text:?}: {e}");
-        assert!(
-            e.field.contains(field),
-            "{text:?}: field `{}` lacks `{field}` ({e})",
-            e.field
-        );
-        assert!(
-            e.message.contains(message),
-            "{text:?}: message `{}` lacks `{message}`",
-            e.message
-        );
-        let shown = e.to_string();
-        assert!(shown.starts_with(&format!("bad.toml:{line}: ")), "{shown}");
+fn bad_scene_files_name_file_line_and_field() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/bad");
+    let manifest = std::fs::read_to_string(dir.join("expected.txt")).unwrap();
+    let mut checked = 0;
+    let mut failures = Vec::new();
+    for entry in manifest
+        .lines()
+        .filter(|l| !l.starts_with('#') && !l.trim().is_empty())
+    {
+        let parts: Vec<&str> = entry.splitn(4, '|').collect();
+        let (file, line, field, message) = (parts[0], parts[1], parts[2], parts[3]);
+        let path = dir.join(file);
+        let e: SceneError = load_scene(&path).expect_err(file);
+        let ok = e.file.ends_with(file)
+            && e.line.to_string() == line
+            && e.field.contains(field)
+            && e.message.contains(message)
+            && e.to_string().contains(&format!("{file}:{line}: "));
+        if !ok {
+            failures.push(format!(
+                "{file}: expected line {line}, field ~`{field}`, message ~`{message}`; got {e}"
+            ));
+        }
+        checked += 1;
     }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+    let files = std::fs::read_dir(&dir).unwrap().filter(|e| {
+        e.as_ref()
+            .unwrap()
+            .path()
+            .extension()
+            .is_some_and(|x| x == "toml")
+    });
+    assert_eq!(
+        files.count(),
+        checked,
+        "every bad file is listed in expected.txt"
+    );
+    assert!(checked >= 50, "{checked} bad files");
 }
 
 #[test]
