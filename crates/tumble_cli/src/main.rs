@@ -53,6 +53,22 @@ struct Cli {
 }
 
 #[derive(Subcommand)]
+enum GenKind {
+    /// Many tumbling bodies under gravity, on a grid.
+    Many {
+        /// Number of bodies.
+        #[arg(long, default_value_t = 100_000)]
+        n: usize,
+        /// Steps.
+        #[arg(long, default_value_t = 600)]
+        steps: u64,
+        /// Output file (default: stdout).
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
+}
+
+#[derive(Subcommand)]
 enum Command {
     /// Run a scene file (or a bundled scene by name) and print a summary.
     Run {
@@ -79,6 +95,11 @@ enum Command {
     },
     /// List the bundled scenes.
     Scenes,
+    /// Generate a scene.
+    Gen {
+        #[command(subcommand)]
+        kind: GenKind,
+    },
     /// Run a scene in tumble and in rapier 0.36 side by side and print the differences.
     Compare {
         /// Scene file, or the name of a bundled scene.
@@ -126,6 +147,20 @@ fn load(scene: &str) -> Result<(String, String), String> {
 
 fn run(cli: Cli) -> Result<(), String> {
     match cli.command {
+        Command::Gen {
+            kind: GenKind::Many { n, steps, out },
+        } => {
+            let text = many_bodies(n, steps);
+            match out {
+                Some(path) => {
+                    std::fs::write(&path, text).map_err(|e| format!("{}: {e}", path.display()))
+                }
+                None => {
+                    print!("{text}");
+                    Ok(())
+                }
+            }
+        }
         Command::Scenes => {
             for (name, text) in BUNDLED {
                 let first = text.lines().find(|l| l.starts_with("name")).unwrap_or("");
@@ -239,4 +274,31 @@ fn totals(world: &mut World) -> (f64, f64) {
         l += angular_momentum(&s, m).as_dvec3();
     }
     (e, l.length())
+}
+
+/// A scene of `n` asymmetric bodies on a cubic grid, each with its own spin, under gravity.
+fn many_bodies(n: usize, steps: u64) -> String {
+    use std::fmt::Write as _;
+    let side = (n as f64).cbrt().ceil().max(1.0) as usize;
+    let mut text = format!(
+        "name = \"many-{n}\"\n[world]\ndt = 0.016666668\nsteps = {steps}\ngravity = [0.0, -9.81, 0.0]\n"
+    );
+    for i in 0..n {
+        let (x, y, z) = (i % side, (i / side) % side, i / (side * side));
+        let f = i as f64 / n.max(1) as f64;
+        let _ = write!(
+            text,
+            "[[bodies]]\nname = \"b{i}\"\nmass = {}\ninertia = [1.0, {}, {}]\nposition = [{}, {}, {}]\nlinear_velocity = [0.0, {}, 0.0]\nangular_velocity = [{}, {}, 0.3]\n",
+            1.0 + f,
+            2.0 + f,
+            3.0 + f,
+            2 * x,
+            2 * y,
+            2 * z,
+            5.0 * f,
+            0.3 + f,
+            1.0 - f
+        );
+    }
+    text
 }

@@ -152,3 +152,23 @@ fn compare_reports_rapier_and_exact_differences() {
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("springs"));
 }
+
+#[test]
+fn gen_many_writes_a_valid_scene() {
+    let out = temp("many.toml");
+    let status = tumble()
+        .args(["gen", "many", "--n", "1000", "--steps", "5", "--out"])
+        .arg(&out)
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let scene = load_scene(&out).unwrap();
+    assert_eq!(scene.file.bodies.len(), 1000);
+    let run = tumble().args(["run"]).arg(&out).output().unwrap();
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    assert!(String::from_utf8_lossy(&run.stdout).contains("bodies     1000"));
+}
