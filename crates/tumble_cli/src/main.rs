@@ -112,17 +112,7 @@ enum Command {
         gyroscopic: String,
     },
     /// The accuracy report: work–precision, stability matrix, plots.
-    Report {
-        /// The one-minute version.
-        #[arg(long)]
-        quick: bool,
-        /// Output directory.
-        #[arg(long, default_value = "report")]
-        out: PathBuf,
-        /// Replace the headline table in this markdown file (e.g. README.md).
-        #[arg(long)]
-        readme: Option<PathBuf>,
-    },
+    Report(tumble_report::run::ReportOptions),
 }
 
 fn main() -> ExitCode {
@@ -183,13 +173,8 @@ fn run(cli: Cli) -> Result<(), String> {
             };
             compare::run(&scene, integrator, gyroscopic == "on")
         }
-        Command::Report { quick, out, readme } => {
-            tumble_report::run::run_report(&tumble_report::run::ReportOptions {
-                quick,
-                out,
-                readme,
-            })
-            .map_err(|e| e.to_string())
+        Command::Report(options) => {
+            tumble_report::run::run_report(&options).map_err(|e| e.to_string())
         }
         Command::Run {
             scene,

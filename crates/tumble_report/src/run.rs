@@ -10,14 +10,19 @@ use crate::reference::cases;
 use crate::stability::matrix;
 use crate::workprec::{Effort, Method, measure};
 
-/// What to run and where to write it.
-#[derive(Debug, Clone)]
+/// What to run and where to write it (also the command-line arguments of `tumble report` and
+/// `tumble-report`).
+#[derive(Debug, Clone, clap::Args)]
 pub struct ReportOptions {
     /// Fewer time steps, smaller batches, shorter stability runs (< 60 s on 2 cores).
+    #[arg(long)]
     pub quick: bool,
     /// Output directory.
+    #[arg(long, default_value = "report")]
     pub out: PathBuf,
-    /// A markdown file whose headline table (between the report markers) is replaced.
+    /// Also replace the headline table in this markdown file (between the
+    /// `<!-- report:begin -->` and `<!-- report:end -->` markers), e.g. README.md.
+    #[arg(long)]
     pub readme: Option<PathBuf>,
 }
 
