@@ -1,5 +1,12 @@
-//! Analytic reference solutions in f64: projectile, undamped harmonic spring, and the
-//! torque-free asymmetric top through Jacobi elliptic functions (Landau & Lifshitz §37).
+//! Analytic reference solutions in f64, for measuring the integrators against:
+//!
+//! - [`projectile`]: uniform acceleration, `x = x₀ + v₀t + ½gt²`;
+//! - [`harmonic_spring`] / [`HarmonicSpring`]: undamped spring, `x = x₀ cos ωt + (v₀/ω) sin ωt`,
+//!   `ω = √(k/m)`;
+//! - [`TorqueFreeTop`]: the torque-free rigid body through Jacobi elliptic functions (Landau &
+//!   Lifshitz, *Mechanics*, §37), with the symmetric top and steady spins in closed form;
+//! - [`elliptic`]: the Jacobi functions `sn, cn, dn` and the integrals `K(m)`, `F(φ | m)` it
+//!   rests on (descending Landen / AGM, Carlson's `R_F`).
 
 pub mod elliptic;
 pub mod linear;
@@ -7,23 +14,34 @@ pub mod top;
 
 use thiserror::Error;
 
-pub use elliptic::{complete_k, incomplete_f, jacobi_sn_cn_dn};
-pub use linear::{harmonic_spring, projectile};
-pub use top::TorqueFreeTop;
+pub use elliptic::{complete_k, incomplete_f, jacobi_amplitude, jacobi_sn_cn_dn};
+pub use linear::{HarmonicSpring, harmonic_spring, projectile};
+pub use top::{TopMotion, TorqueFreeTop};
 
-/// Invalid input to an exact solution.
+/// Largest accepted `||q₀| − 1|` of an initial orientation; it is renormalized on input.
+///
+/// Same as the crate-wide [`crate::UNIT_QUATERNION_TOLERANCE`], so any state the f32 engine
+/// accepts can seed a reference.
+pub const ORIENTATION_TOLERANCE: f64 = crate::UNIT_QUATERNION_TOLERANCE as f64;
+
+/// Why an exact solution could not be built from its input.
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum ExactError {
-    /// Principal moments must be finite and > 0.
+    /// Every principal moment must be finite and `> 0`.
     #[error("principal moments must be finite and > 0, got {0:?}")]
     BadInertia([f64; 3]),
-    /// Two principal moments are (nearly) equal: use the symmetric-top closed form instead.
-    #[error("principal moments {0:?} are not distinct (relative gap < 1e-9)")]
-    NotAsymmetric([f64; 3]),
-    /// Initial rates or orientation not finite, or the quaternion is not unit.
-    #[error("initial state is not finite or the orientation is not a unit quaternion")]
-    BadState,
-    /// Stiffness and mass must be finite and > 0.
-    #[error("stiffness and mass must be finite and > 0")]
-    BadSpring,
+    /// An initial value (rate, position, velocity, orientation) is NaN or infinite.
+    #[error("{0} is not finite")]
+    NonFinite(&'static str),
+    /// The initial orientation is not a unit quaternion within [`ORIENTATION_TOLERANCE`].
+    #[error("initial orientation is not a unit quaternion: |q| = {0}")]
+    NonUnitQuaternion(f64),
+    /// Spring stiffness and mass must be finite and `> 0`.
+    #[error("spring stiffness and mass must be finite and > 0, got k = {stiffness}, m = {mass}")]
+    BadSpring {
+        /// The stiffness given (N/m).
+        stiffness: f64,
+        /// The mass given (kg).
+        mass: f64,
+    },
 }
