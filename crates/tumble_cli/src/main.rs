@@ -11,7 +11,7 @@ use clap::{Parser, Subcommand};
 use tumble_core::invariants::{angular_momentum, kinetic_energy};
 use tumble_ecs::components::body_state;
 use tumble_ecs::prelude::*;
-use tumble_scene::{Scene, SceneError, load_scene, write_trajectory};
+use tumble_scene::{Scene, SceneError, read_scene_text, write_trajectory};
 
 /// The scenes shipped in `scenes/`, embedded so `tumble scenes` works from anywhere.
 const BUNDLED: &[(&str, &str)] = &[
@@ -129,10 +129,20 @@ fn load(scene: &str) -> Result<(String, String), String> {
     if let Some((_, text)) = BUNDLED.iter().find(|(name, _)| *name == scene) {
         return Ok((format!("scenes/{scene}.toml"), (*text).to_owned()));
     }
-    let path = PathBuf::from(scene);
-    load_scene(&path).map_err(|e| e.to_string())?;
-    let text = std::fs::read_to_string(&path).map_err(|e| format!("{scene}: {e}"))?;
+    let text = read_scene_text(std::path::Path::new(scene)).map_err(|e| e.to_string())?;
     Ok((scene.to_owned(), text))
+}
+
+/// Names the command-line flag behind an error in an overridden world setting, so the message
+/// does not point at a line of a file the user never wrote.
+fn override_error(e: SceneError, dt: Option<f64>, steps: Option<u64>, integrator: bool) -> String {
+    let flag = match e.field.as_str() {
+        "world.dt" if dt.is_some() => "--dt",
+        "world.steps" if steps.is_some() => "--steps",
+        "world.integrator" if integrator => "--integrator",
+        _ => return e.to_string(),
+    };
+    format!("{flag}: {}", e.message)
 }
 
 fn run(cli: Cli) -> Result<(), String> {
@@ -156,6 +166,10 @@ fn run(cli: Cli) -> Result<(), String> {
                 let first = text.lines().find(|l| l.starts_with("name")).unwrap_or("");
                 println!("{name:<16} {first}");
             }
+            println!(
+                "{:<16} generated: tumble gen many --n 100000 --out many.toml",
+                "many"
+            );
             Ok(())
         }
         Command::Compare {
@@ -185,31 +199,35 @@ fn run(cli: Cli) -> Result<(), String> {
             every,
             plan,
         } => {
-            let (file, mut text) = load(&scene)?;
-            // Overrides are applied to the file model, then validated like the file itself.
-            let parsed = Scene::parse(&file, &text).map_err(|e| e.to_string())?;
-            let mut model = parsed.file.clone();
-            if let Some(s) = steps {
-                model.world.steps = s;
-            }
-            if let Some(d) = dt {
-                model.world.dt = d;
-            }
-            if let Some(i) = integrator {
-                model.world.integrator = Some(i);
-            }
             if every == 0 {
                 return Err("--every: expected a value >= 1".into());
             }
-            text = tumble_scene::to_toml_string(&model);
-            let scene = Scene::parse(&format!("{file} (with overrides)"), &text)
-                .map_err(|e: SceneError| e.to_string())?;
+            let (file, text) = load(&scene)?;
+            let mut scene = Scene::parse(&file, &text).map_err(|e| e.to_string())?;
+            if steps.is_some() || dt.is_some() || integrator.is_some() {
+                // Overrides are applied to the file model, then validated like the file itself.
+                let mut model = scene.file.clone();
+                model.world.steps = steps.unwrap_or(model.world.steps);
+                model.world.dt = dt.unwrap_or(model.world.dt);
+                let overridden = integrator.is_some();
+                model.world.integrator = integrator.or(model.world.integrator);
+                let text = tumble_scene::to_toml_string(&model);
+                scene = Scene::parse(&file, &text)
+                    .map_err(|e| override_error(e, dt, steps, overridden))?;
+            }
             let mut built = scene.build();
             if plan {
                 println!("{}", PhysicsPlan::for_world(&mut built.world));
                 return Ok(());
             }
-            let invariant = scene.gravity.is_none() && scene.file.forces.is_empty();
+            // Energy and angular momentum are invariants only of free, undamped bodies.
+            let invariant = scene.gravity.is_none()
+                && scene.file.forces.is_empty()
+                && scene
+                    .file
+                    .bodies
+                    .iter()
+                    .all(|b| b.linear_damping == 0.0 && b.angular_damping == 0.0);
             let before = totals(&mut built.world);
             let start = Instant::now();
             match &out {
@@ -237,8 +255,8 @@ fn run(cli: Cli) -> Result<(), String> {
                 wall.as_nanos() as f64 / body_steps
             );
             if invariant {
-                println!("energy     relative drift {:.3e}", after.0 / before.0 - 1.0);
-                println!("|L|        relative drift {:.3e}", after.1 / before.1 - 1.0);
+                println!("energy     {}", drift(before.0, after.0));
+                println!("|L|        {}", drift(before.1, after.1));
             }
             let rejected = built.world.query::<&Rejected>().iter(&built.world).count();
             if rejected > 0 {
@@ -246,6 +264,15 @@ fn run(cli: Cli) -> Result<(), String> {
             }
             Ok(())
         }
+    }
+}
+
+/// The relative drift `after/before − 1`, or the absolute change when `before` is zero.
+fn drift(before: f64, after: f64) -> String {
+    if before == 0.0 {
+        format!("absolute change {:.3e} (zero at the start)", after - before)
+    } else {
+        format!("relative drift {:.3e}", after / before - 1.0)
     }
 }
 

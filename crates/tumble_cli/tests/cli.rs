@@ -99,7 +99,28 @@ fn bad_scene_exits_non_zero_with_file_and_line_and_writes_nothing() {
         .output()
         .unwrap();
     assert!(!output.status.success());
-    assert!(String::from_utf8_lossy(&output.stderr).contains("world.dt"));
+    // A bad flag is named as the flag, not as a line of a file the user never wrote.
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(
+        stderr.trim(),
+        "error: --dt: expected a time step > 0, got 0"
+    );
+    for (flag, value, expected) in [
+        ("--steps", "0", "error: --steps: expected 1 to"),
+        (
+            "--integrator",
+            "magic",
+            "error: --integrator: unknown integrator `magic`",
+        ),
+    ] {
+        let output = tumble()
+            .args(["run", "projectile", flag, value])
+            .output()
+            .unwrap();
+        assert!(!output.status.success());
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(stderr.starts_with(expected), "{stderr}");
+    }
 }
 
 #[test]
@@ -171,4 +192,11 @@ fn gen_many_writes_a_valid_scene() {
         String::from_utf8_lossy(&run.stderr)
     );
     assert!(String::from_utf8_lossy(&run.stdout).contains("bodies     1000"));
+    // The generator's headline size fits under the loader's size limit.
+    let big = tumble()
+        .args(["gen", "many", "--n", "100000"])
+        .output()
+        .unwrap();
+    assert!(big.status.success());
+    assert!((big.stdout.len() as u64) < tumble_scene::MAX_SCENE_BYTES);
 }

@@ -81,17 +81,17 @@ impl Scene {
     pub fn parse(file: &str, text: &str) -> Result<Self, SceneError> {
         let parsed: SceneFile = toml::from_str(text).map_err(|e| {
             let start = e.span().map_or(0, |s| s.start.min(text.len()));
-            let line = 1 + text.as_bytes()[..start]
-                .iter()
-                .filter(|&&b| b == b'\n')
-                .count();
+            let line = crate::validate::line_at(text, start);
             let message = e.message().replace('\n', " ");
-            // The field is the key on the offending line, when there is one.
-            let field = text
-                .lines()
-                .nth(line - 1)
-                .and_then(|l| l.split_once('=').map(|(k, _)| k.trim().to_owned()))
-                .filter(|k| !k.is_empty() && !k.starts_with('['))
+            // The field is the key path at the error, when the text parses as TOML at all;
+            // otherwise (a syntax error) the key on the offending line, when there is one.
+            let field = crate::validate::path_at(text, start)
+                .or_else(|| {
+                    text.lines()
+                        .nth(line - 1)
+                        .and_then(|l| l.split_once('=').map(|(k, _)| k.trim().to_owned()))
+                        .filter(|k| !k.is_empty() && !k.starts_with('['))
+                })
                 .unwrap_or_else(|| "toml".to_owned());
             SceneError::at(file, line, field, message)
         })?;
@@ -134,6 +134,9 @@ impl Scene {
         let mut names = HashMap::new();
         let mut bodies = Vec::with_capacity(parsed.bodies.len());
         for (i, b) in parsed.bodies.iter().enumerate() {
+            if let Some(why) = bad_name(&b.name) {
+                return Err(ck.error("bodies", Some(i), "name", why));
+            }
             if names.insert(b.name.clone(), i).is_some() {
                 return Err(ck.error(
                     "bodies",
@@ -192,10 +195,23 @@ impl Scene {
                         }
                         Ok(y)
                     };
+                    let a_index = body(i, "a", a)?;
+                    let b_index = b.as_ref().map(|b| body(i, "b", b)).transpose()?;
+                    if b_index == Some(a_index) {
+                        return Err(ck.error(
+                            "forces",
+                            Some(i),
+                            "b",
+                            format!(
+                                "spring joins `{a}` to itself; expected a different body, \
+                                 or no `b` to anchor `a` to the world point `anchor_b`"
+                            ),
+                        ));
+                    }
                     ValidForce::Spring {
-                        a: body(i, "a", a)?,
+                        a: a_index,
                         anchor_a: v("anchor_a", *anchor_a)?,
-                        b: b.as_ref().map(|b| body(i, "b", b)).transpose()?,
+                        b: b_index,
                         anchor_b: v("anchor_b", *anchor_b)?,
                         k: non_negative("stiffness", *stiffness)?,
                         c: non_negative("damping", *damping)?,
@@ -444,5 +460,35 @@ fn shape_mass(
             mass_properties_of(&hull, density)
         }
     };
-    result.map_err(|e| ck.error("bodies", Some(i), "shape", e.to_string()))
+    result.map_err(|e| {
+        ck.error(
+            "bodies",
+            Some(i),
+            "shape",
+            format!(
+                "{e}: expected dimensions and a density whose mass and moments of inertia are \
+                 finite and > 0 in f32"
+            ),
+        )
+    })
+}
+
+/// Why a body name cannot be used, if it cannot: names are CSV cells and must stay one cell.
+fn bad_name(name: &str) -> Option<String> {
+    if name.trim().is_empty() {
+        return Some("expected a non-empty name".to_owned());
+    }
+    if name.len() > 256 {
+        return Some(format!(
+            "name is {} bytes long; expected at most 256",
+            name.len()
+        ));
+    }
+    if name.chars().any(|c| c == ',' || c == '"' || c.is_control()) {
+        return Some(format!(
+            "name {name:?} contains a comma, a quote or a control character; expected a name \
+             that fits in one CSV cell"
+        ));
+    }
+    None
 }

@@ -27,8 +27,8 @@ impl SceneError {
         Self {
             file: file.to_owned(),
             line,
-            field: field.into(),
-            message: message.into(),
+            field: one_line(field.into(), MAX_FIELD_CHARS),
+            message: one_line(message.into(), MAX_MESSAGE_CHARS),
         }
     }
 
@@ -36,4 +36,22 @@ impl SceneError {
     pub fn io(file: &str, e: std::io::Error) -> Self {
         Self::at(file, 0, "file", format!("cannot be read: {e}"))
     }
+}
+
+/// Longest field path kept in an error (a 10 MB key would otherwise be echoed whole).
+const MAX_FIELD_CHARS: usize = 120;
+/// Longest message kept in an error.
+const MAX_MESSAGE_CHARS: usize = 400;
+
+/// `text` on one line (line breaks become spaces), cut to `max` characters with an ellipsis.
+fn one_line(text: String, max: usize) -> String {
+    let mut out: String = text
+        .chars()
+        .take(max)
+        .map(|c| if c.is_control() { ' ' } else { c })
+        .collect();
+    if text.chars().nth(max).is_some() {
+        out.push('…');
+    }
+    out
 }

@@ -1,38 +1,78 @@
 //! Semantic checks of a parsed scene file, with the line of each offending field.
 
+use toml::de::{DeTable, DeValue};
+
 use crate::error::SceneError;
 
-/// Finds the line of `key` inside the `index`-th `[[table]]` (or `[table]` when `index` is
-/// `None`); falls back to the table header, then to line 1.
+/// The 1-based line holding byte offset `at` of `text`.
+pub fn line_at(text: &str, at: usize) -> usize {
+    let at = at.min(text.len());
+    1 + text.as_bytes()[..at]
+        .iter()
+        .filter(|&&b| b == b'\n')
+        .count()
+}
+
+/// Finds the line of `key` inside `table` (the `index`-th element when `table` is an array of
+/// tables), from the spans of the parsed document, so that headers with comments, inline tables,
+/// dotted and quoted keys and multi-line strings are all located correctly. Falls back to the
+/// table (or element), then to line 1.
 pub fn line_of(text: &str, table: &str, index: Option<usize>, key: &str) -> usize {
-    let header = match index {
-        Some(_) => format!("[[{table}]]"),
-        None => format!("[{table}]"),
+    let Ok(doc) = DeTable::parse(text) else {
+        return 1;
     };
-    let mut seen = 0;
-    let mut in_table = false;
-    let mut header_line = 0;
-    for (n, raw) in text.lines().enumerate() {
-        let line = raw.trim();
-        if line.starts_with('[') {
-            in_table = false;
-            if line.replace(' ', "") == header {
-                if index.is_none_or(|i| i == seen) {
-                    in_table = true;
-                    header_line = n + 1;
-                }
-                seen += 1;
-            }
-            continue;
-        }
-        if in_table {
-            let name = line.split('=').next().unwrap_or("").trim();
-            if name == key {
-                return n + 1;
-            }
-        }
+    let Some(entry) = doc.get_ref().get(table) else {
+        return 1;
+    };
+    let scope = match (index, entry.get_ref()) {
+        (Some(i), DeValue::Array(items)) => items.get(i).unwrap_or(entry),
+        _ => entry,
+    };
+    if let DeValue::Table(fields) = scope.get_ref()
+        && let Some((k, _)) = fields.get_key_value(key)
+    {
+        return line_at(text, k.span().start);
     }
-    header_line.max(1)
+    line_at(text, scope.span().start)
+}
+
+/// The dotted path (e.g. `bodies[1].mass`) of the deepest key or value whose span holds byte
+/// offset `at`, or `None` when the text does not parse or no key is there.
+pub fn path_at(text: &str, at: usize) -> Option<String> {
+    let doc = DeTable::parse(text).ok()?;
+    let mut path = String::new();
+    table_path(doc.get_ref(), at, &mut path).then_some(path)
+}
+
+fn table_path(table: &DeTable<'_>, at: usize, path: &mut String) -> bool {
+    for (k, v) in table.iter() {
+        let len = path.len();
+        if !path.is_empty() {
+            path.push('.');
+        }
+        path.push_str(k.get_ref());
+        if value_path(v.get_ref(), at, path) || k.span().contains(&at) || v.span().contains(&at) {
+            return true;
+        }
+        path.truncate(len);
+    }
+    false
+}
+
+fn value_path(value: &DeValue<'_>, at: usize, path: &mut String) -> bool {
+    match value {
+        DeValue::Table(t) => table_path(t, at, path),
+        DeValue::Array(items) => items.iter().enumerate().any(|(i, item)| {
+            let len = path.len();
+            path.push_str(&format!("[{i}]"));
+            if value_path(item.get_ref(), at, path) || item.span().contains(&at) {
+                return true;
+            }
+            path.truncate(len);
+            false
+        }),
+        _ => false,
+    }
 }
 
 /// Context for the checks of one scene: the file name and its text.

@@ -113,3 +113,26 @@ fn random_garbage_never_panics() {
         }
     }
 }
+
+/// Devices and pipes report no size: they are cut off at the limit instead of read forever.
+#[cfg(unix)]
+#[test]
+fn endless_files_are_cut_off_at_the_limit() {
+    let e = load_scene(std::path::Path::new("/dev/zero")).unwrap_err();
+    assert_eq!((e.line, e.field.as_str()), (1, "file"), "{e}");
+    assert!(e.message.contains("limited to"), "{e}");
+}
+
+/// A huge key or value is not echoed whole: the message stays one short line.
+#[test]
+fn errors_stay_one_short_line() {
+    let key = "k".repeat(1_000_000);
+    let e = Scene::parse("long.toml", &format!("name = \"x\"\n{key} = 1\n")).unwrap_err();
+    let shown = e.to_string();
+    assert!(shown.starts_with("long.toml:2: "), "{}", &shown[..80]);
+    assert!(
+        shown.len() < 1_000 && !shown.contains('\n'),
+        "{} bytes",
+        shown.len()
+    );
+}
