@@ -44,6 +44,29 @@ fn step_all(c: &mut Criterion) {
             },
         );
     }
+    for &integrator in &[Integrator::Splitting, Integrator::SymplecticEuler] {
+        group.bench_with_input(
+            BenchmarkId::new("try", integrator),
+            &integrator,
+            |b, &it| {
+                let mut states = states0.clone();
+                b.iter(|| {
+                    for (state, mass) in states.iter_mut().zip(&masses) {
+                        let _ = it.try_step(state, mass, &Wrench::ZERO, 1.0 / 60.0);
+                    }
+                });
+            },
+        );
+        group.bench_with_input(
+            BenchmarkId::new("many", integrator),
+            &integrator,
+            |b, &it| {
+                let mut states = states0.clone();
+                let wrenches = vec![Wrench::ZERO; n];
+                b.iter(|| it.try_step_many(&mut states, &masses, &wrenches, 1.0 / 60.0));
+            },
+        );
+    }
     group.finish();
 }
 

@@ -2,6 +2,7 @@
 //! detection, and observed order of convergence against the exact torque-free top.
 
 mod integrators {
+    pub mod batch;
     pub mod convergence;
     pub mod extremes;
     pub mod gyroscopic;

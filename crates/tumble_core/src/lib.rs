@@ -12,7 +12,7 @@
 //!   `R I_b⁻¹ Rᵀ` is applied by rotating into the principal frame, never inverted numerically.
 //! - A zero principal moment locks that axis (its inverse is 0), never NaN.
 
-#![forbid(unsafe_code)]
+#![deny(unsafe_code)]
 #![warn(missing_docs)]
 
 pub mod error;

@@ -35,10 +35,17 @@ impl BodyState {
     /// True when every component is finite.
     #[inline]
     pub fn is_finite(&self) -> bool {
-        self.position.is_finite()
-            && self.rotation.is_finite()
-            && self.linear_velocity.is_finite()
-            && self.angular_velocity.is_finite()
+        // Branch-free: `0 · x` is 0 for finite x and NaN for ±Inf and NaN, and one NaN makes
+        // the sum NaN.
+        let (p, v, w, q) = (
+            self.position,
+            self.linear_velocity,
+            self.angular_velocity,
+            self.rotation,
+        );
+        let vectors = p * 0.0 + v * 0.0 + w * 0.0;
+        let quat = glam::Vec4::from(q) * 0.0;
+        (vectors.x + vectors.y + vectors.z + quat.x + quat.y + quat.z + quat.w) == 0.0
     }
 
     /// Checks that every component is finite and the rotation is a unit quaternion.

@@ -25,11 +25,14 @@
 //! | `yoshida4` | Yoshida composition of `splitting` | 4 | round-off | bounded |
 //! | `rk4` | RK4 on `Q̇ = ½ ω(Q) Q` at constant `L` | 4 | exact | slow drift |
 
+mod batch;
 mod frame;
 mod implicit_gyroscopic;
+pub mod lanes;
 mod lclamp;
 mod rk4;
 mod splitting;
+mod symmetric_kernel;
 mod symplectic_euler;
 mod yoshida;
 
@@ -46,8 +49,8 @@ pub use implicit_gyroscopic::{implicit_gyroscopic, implicit_gyroscopic_rate};
 pub use lclamp::lclamp;
 pub use rk4::rk4_free_flow;
 pub use splitting::{
-    FreeBody, FreeFlow, begin_dkd, drift, finish_dkd, kick, rotate_freely, strang_free_flow,
-    symmetric_free_flow, torque_free_dkd,
+    FreeBody, FreeFlow, Rotation, begin_dkd, drift, finish_dkd, kick, rotate_freely,
+    rotate_symmetric, strang_free_flow, symmetric_free_flow, torque_free_dkd, translate_dkd,
 };
 pub use symplectic_euler::{explicit_gyroscopic_kick, symplectic_euler, symplectic_euler_linear};
 pub use yoshida::yoshida_free_flow;
@@ -133,12 +136,13 @@ impl Integrator {
         )
     }
 
-    fn free_flow(self) -> FreeFlow {
+    /// The free rotation of a drift–kick–drift method.
+    fn free_rotation(self) -> Rotation {
         match self {
-            Integrator::Yoshida4 => yoshida_free_flow,
-            Integrator::Rk4 => rk4_free_flow,
-            Integrator::SplittingXyz => strang_free_flow,
-            _ => symmetric_free_flow,
+            Integrator::Yoshida4 => |s, m, h| rotate_freely(s, m, h, yoshida_free_flow),
+            Integrator::Rk4 => |s, m, h| rotate_freely(s, m, h, rk4_free_flow),
+            Integrator::SplittingXyz => |s, m, h| rotate_freely(s, m, h, strang_free_flow),
+            _ => rotate_symmetric,
         }
     }
 
@@ -147,7 +151,7 @@ impl Integrator {
     #[inline]
     pub fn begin_step(self, state: &mut BodyState, mass: &MassProperties, dt: f32) {
         if self.samples_forces_at_midpoint() {
-            begin_dkd(state, mass, dt, self.free_flow());
+            begin_dkd(state, mass, dt, self.free_rotation());
         }
     }
 
@@ -168,7 +172,7 @@ impl Integrator {
             Integrator::Splitting
             | Integrator::SplittingXyz
             | Integrator::Yoshida4
-            | Integrator::Rk4 => finish_dkd(state, mass, wrench, dt, self.free_flow()),
+            | Integrator::Rk4 => finish_dkd(state, mass, wrench, dt, self.free_rotation()),
         }
     }
 
@@ -181,7 +185,7 @@ impl Integrator {
     /// order. The ECS takes this path for bodies without a `ForceAccumulator`.
     pub fn step(self, state: &mut BodyState, mass: &MassProperties, wrench: &Wrench, dt: f32) {
         if self.samples_forces_at_midpoint() && wrench.torque == glam::Vec3::ZERO {
-            torque_free_dkd(state, mass, wrench, dt, self.free_flow());
+            torque_free_dkd(state, mass, wrench, dt, self.free_rotation());
         } else {
             self.begin_step(state, mass, dt);
             self.finish_step(state, mass, wrench, dt);

@@ -46,6 +46,7 @@
 use glam::{DQuat, DVec3};
 
 use super::frame::{recip, rotate64};
+use super::symmetric_kernel::{SymmetricInput, rotate_symmetric_one};
 use crate::mass::MassProperties;
 use crate::rotation::rotate_exact;
 use crate::state::{BodyState, Wrench};
@@ -143,12 +144,28 @@ pub fn symmetric_free_flow(body: &mut FreeBody, r: DVec3, h: f64) {
     body.axis_flow(c, residual, 0.5 * h);
 }
 
-/// Drift for `h`: `x += h v` and the free rotation over `h` at constant `L` (spherical bodies
-/// rotate exactly about `ω`, since `ω ∥ L` for them).
+/// The rotational part of a drift over `h` at constant world `L`: a method's free rotation.
+pub type Rotation = fn(&mut BodyState, &MassProperties, f32);
+
+/// Drift for `h`: `x += h v` and the free rotation over `h` at constant `L`.
 #[inline]
-pub fn drift(state: &mut BodyState, mass: &MassProperties, h: f32, flow: FreeFlow) {
+pub fn drift(state: &mut BodyState, mass: &MassProperties, h: f32, rotation: Rotation) {
     state.position += h * state.linear_velocity;
-    rotate_freely(state, mass, h, flow);
+    rotation(state, mass, h);
+}
+
+/// The free rotation of the `splitting` method over `h`: spherical bodies exactly about `ω`
+/// (`ω ∥ L` for them), the others through the lane kernel of
+/// [`symmetric_kernel`](super::symmetric_kernel) — the same code the batched step runs, so one
+/// body gets the same bits alone or in a batch.
+#[inline]
+pub fn rotate_symmetric(state: &mut BodyState, mass: &MassProperties, h: f32) {
+    if mass.is_spherical() {
+        state.rotation = rotate_exact(state.rotation, state.angular_velocity, h);
+        return;
+    }
+    let input = SymmetricInput::new(state.rotation, state.angular_velocity, mass);
+    (state.rotation, state.angular_velocity) = rotate_symmetric_one(&input, h);
 }
 
 /// The rotational part of a drift: the free flow over `h` at constant world `L`.
@@ -183,8 +200,8 @@ pub fn kick(state: &mut BodyState, mass: &MassProperties, wrench: &Wrench, h: f3
 
 /// First half of a drift–kick–drift step: `D(h/2)`, before forces are sampled.
 #[inline]
-pub fn begin_dkd(state: &mut BodyState, mass: &MassProperties, h: f32, flow: FreeFlow) {
-    drift(state, mass, 0.5 * h, flow);
+pub fn begin_dkd(state: &mut BodyState, mass: &MassProperties, h: f32, rotation: Rotation) {
+    drift(state, mass, 0.5 * h, rotation);
 }
 
 /// Second half of a drift–kick–drift step: `K(h)` then `D(h/2)`.
@@ -194,10 +211,10 @@ pub fn finish_dkd(
     mass: &MassProperties,
     wrench: &Wrench,
     h: f32,
-    flow: FreeFlow,
+    rotation: Rotation,
 ) {
     kick(state, mass, wrench, h);
-    drift(state, mass, 0.5 * h, flow);
+    drift(state, mass, 0.5 * h, rotation);
 }
 
 /// A whole drift–kick–drift step under a torque-free `wrench`: the translation is
@@ -209,10 +226,17 @@ pub fn torque_free_dkd(
     mass: &MassProperties,
     wrench: &Wrench,
     h: f32,
-    flow: FreeFlow,
+    rotation: Rotation,
 ) {
+    translate_dkd(state, mass, wrench, h);
+    rotation(state, mass, h);
+}
+
+/// The translational part of a whole drift–kick–drift step:
+/// `x += ½h v; v += h F/m; x += ½h v` (exact for a constant force).
+#[inline]
+pub fn translate_dkd(state: &mut BodyState, mass: &MassProperties, wrench: &Wrench, h: f32) {
     state.position += (0.5 * h) * state.linear_velocity;
     state.linear_velocity += (h * mass.inv_mass()) * wrench.force;
     state.position += (0.5 * h) * state.linear_velocity;
-    rotate_freely(state, mass, h, flow);
 }

@@ -1,0 +1,234 @@
+//! Stepping many bodies at once: the entry points the ECS systems and the raw benchmark loop
+//! share.
+//!
+//! For `splitting` (the default) the free rotations of up to [`LANES`] non-spherical bodies are
+//! computed together in SIMD lanes by the kernel of [`super::symmetric_kernel`]; the translation,
+//! the kicks and spherical bodies stay scalar. Every other method steps body by body. Either way
+//! each body's result is bit-identical to [`Integrator::try_step`] and friends on that body
+//! alone, whatever the batch, its order or the thread that runs it.
+
+use std::borrow::Borrow;
+
+use super::Integrator;
+use super::lanes::LANES;
+use super::splitting::{kick, translate_dkd};
+use super::symmetric_kernel::{SymmetricInput, rotate_symmetric_lanes, rotate_symmetric_one};
+use crate::mass::MassProperties;
+use crate::rotation::rotate_exact;
+use crate::state::{BodyState, Wrench};
+
+/// Bodies waiting for their free rotation, flushed [`LANES`] at a time.
+struct PendingRotations {
+    index: [usize; LANES],
+    state: [BodyState; LANES],
+    input: [SymmetricInput; LANES],
+    h: [f32; LANES],
+    len: usize,
+}
+
+impl PendingRotations {
+    fn new() -> Self {
+        let idle = SymmetricInput::new(glam::Quat::IDENTITY, glam::Vec3::ZERO, &IDLE_MASS);
+        Self {
+            index: [0; LANES],
+            state: [BodyState::default(); LANES],
+            input: [idle; LANES],
+            h: [0.0; LANES],
+            len: 0,
+        }
+    }
+
+    /// Queues body `index` (already translated, as `state`) for a free rotation over `h`;
+    /// spherical bodies rotate at once, exactly about `ω`.
+    #[inline]
+    fn push(
+        &mut self,
+        index: usize,
+        mut state: BodyState,
+        mass: &MassProperties,
+        h: f32,
+        done: &mut impl FnMut(usize, BodyState),
+    ) {
+        if mass.is_spherical() {
+            state.rotation = rotate_exact(state.rotation, state.angular_velocity, h);
+            done(index, state);
+            return;
+        }
+        let lane = self.len;
+        self.index[lane] = index;
+        self.input[lane] = SymmetricInput::new(state.rotation, state.angular_velocity, mass);
+        self.state[lane] = state;
+        self.h[lane] = h;
+        self.len += 1;
+        if self.len == LANES {
+            self.flush(done);
+        }
+    }
+
+    /// Rotates the queued bodies (a partial batch goes through the scalar kernel, which gives
+    /// the same bits) and hands each result to `done`.
+    #[inline]
+    fn flush(&mut self, done: &mut impl FnMut(usize, BodyState)) {
+        if self.len == LANES {
+            let rotated = rotate_symmetric_lanes(&self.input, self.h);
+            for (lane, (rotation, omega)) in rotated.into_iter().enumerate() {
+                self.finish_lane(lane, rotation, omega, done);
+            }
+        } else {
+            for lane in 0..self.len {
+                let (rotation, omega) = rotate_symmetric_one(&self.input[lane], self.h[lane]);
+                self.finish_lane(lane, rotation, omega, done);
+            }
+        }
+        self.len = 0;
+    }
+
+    #[inline]
+    fn finish_lane(
+        &mut self,
+        lane: usize,
+        rotation: glam::Quat,
+        omega: glam::Vec3,
+        done: &mut impl FnMut(usize, BodyState),
+    ) {
+        let mut state = self.state[lane];
+        state.rotation = rotation;
+        state.angular_velocity = omega;
+        done(self.index[lane], state);
+    }
+}
+
+/// Mass properties for idle lanes (never written back).
+static IDLE_MASS: std::sync::LazyLock<MassProperties> = std::sync::LazyLock::new(|| {
+    MassProperties::new(
+        crate::Mass::new(1.0).expect("1 kg is valid"),
+        glam::Vec3::new(1.0, 2.0, 3.0),
+    )
+    .expect("valid inertia")
+});
+
+/// Commits `next` into `states[index]` if it is finite, else records the divergence.
+#[inline]
+fn commit(states: &mut [BodyState], diverged: &mut Vec<usize>, index: usize, next: BodyState) {
+    if next.is_finite() {
+        states[index] = next;
+    } else {
+        diverged.push(index);
+    }
+}
+
+impl Integrator {
+    /// [`try_step`](Self::try_step) for every body: `states[i]` advances by `dt` under
+    /// `wrenches[i]` with mass `masses[i]`. A body whose result is not finite keeps its state and
+    /// its index is returned (in increasing order); no other body is affected. Allocates only
+    /// when a body diverges.
+    pub fn try_step_many<M: Borrow<MassProperties>>(
+        self,
+        states: &mut [BodyState],
+        masses: &[M],
+        wrenches: &[Wrench],
+        dt: f32,
+    ) -> Vec<usize> {
+        assert!(states.len() == masses.len() && states.len() == wrenches.len());
+        let mut diverged = Vec::new();
+        if self != Integrator::Splitting {
+            for (i, state) in states.iter_mut().enumerate() {
+                if self
+                    .try_step(state, masses[i].borrow(), &wrenches[i], dt)
+                    .is_err()
+                {
+                    diverged.push(i);
+                }
+            }
+            return diverged;
+        }
+        let mut pending = PendingRotations::new();
+        for i in 0..states.len() {
+            let mass = masses[i].borrow();
+            let wrench = &wrenches[i];
+            let mut next = states[i];
+            if wrench.torque == glam::Vec3::ZERO {
+                translate_dkd(&mut next, mass, wrench, dt);
+                pending.push(i, next, mass, dt, &mut |j, s| {
+                    commit(states, &mut diverged, j, s)
+                });
+            } else if self.try_step(&mut states[i], mass, wrench, dt).is_err() {
+                diverged.push(i);
+            }
+        }
+        pending.flush(&mut |j, s| commit(states, &mut diverged, j, s));
+        diverged.sort_unstable();
+        diverged
+    }
+
+    /// [`try_begin_step`](Self::try_begin_step) for every body (see
+    /// [`try_step_many`](Self::try_step_many) for the contract).
+    pub fn try_begin_step_many<M: Borrow<MassProperties>>(
+        self,
+        states: &mut [BodyState],
+        masses: &[M],
+        dt: f32,
+    ) -> Vec<usize> {
+        assert!(states.len() == masses.len());
+        let mut diverged = Vec::new();
+        if self != Integrator::Splitting {
+            for (i, state) in states.iter_mut().enumerate() {
+                if self.try_begin_step(state, masses[i].borrow(), dt).is_err() {
+                    diverged.push(i);
+                }
+            }
+            return diverged;
+        }
+        let mut pending = PendingRotations::new();
+        let h = 0.5 * dt;
+        for i in 0..states.len() {
+            let mass = masses[i].borrow();
+            let mut next = states[i];
+            next.position += h * next.linear_velocity;
+            pending.push(i, next, mass, h, &mut |j, s| {
+                commit(states, &mut diverged, j, s)
+            });
+        }
+        pending.flush(&mut |j, s| commit(states, &mut diverged, j, s));
+        diverged.sort_unstable();
+        diverged
+    }
+
+    /// [`try_finish_step`](Self::try_finish_step) for every body (see
+    /// [`try_step_many`](Self::try_step_many) for the contract).
+    pub fn try_finish_step_many<M: Borrow<MassProperties>>(
+        self,
+        states: &mut [BodyState],
+        masses: &[M],
+        wrenches: &[Wrench],
+        dt: f32,
+    ) -> Vec<usize> {
+        assert!(states.len() == masses.len() && states.len() == wrenches.len());
+        let mut diverged = Vec::new();
+        if self != Integrator::Splitting {
+            for (i, state) in states.iter_mut().enumerate() {
+                if self
+                    .try_finish_step(state, masses[i].borrow(), &wrenches[i], dt)
+                    .is_err()
+                {
+                    diverged.push(i);
+                }
+            }
+            return diverged;
+        }
+        let mut pending = PendingRotations::new();
+        let h = 0.5 * dt;
+        for i in 0..states.len() {
+            let mass = masses[i].borrow();
+            let mut next = states[i];
+            kick(&mut next, mass, &wrenches[i], dt);
+            next.position += h * next.linear_velocity;
+            pending.push(i, next, mass, h, &mut |j, s| {
+                commit(states, &mut diverged, j, s)
+            });
+        }
+        pending.flush(&mut |j, s| commit(states, &mut diverged, j, s));
+        diverged.sort_unstable();
+        diverged
+    }
+}
