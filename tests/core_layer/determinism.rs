@@ -119,3 +119,88 @@ fn ecs_matches_the_raw_loop_bit_for_bit() {
         assert_eq!(v.angular, raw.angular_velocity, "{integrator}");
     }
 }
+
+/// A large mixed world (free bodies under gravity, bodies with accumulators, springs, spheres,
+/// asymmetric and locked-axis bodies) stepped with the given threading policy.
+fn big_world_bits(parallelism: Parallelism, integrator: Integrator) -> Vec<u32> {
+    let mut world = world_with(1.0 / 60.0, integrator);
+    world.insert_resource(Gravity(Vec3::new(0.0, -9.81, 0.0)));
+    world.insert_resource(parallelism);
+    let mut bodies = Vec::new();
+    for i in 0..6000u32 {
+        let f = i as f32 / 6000.0;
+        let inertia = match i % 4 {
+            0 => [1.0, 2.0 + f, 3.0],
+            1 => [0.5, 0.5, 0.5],
+            2 => [0.0, 1.0, 1.2],
+            _ => [2.0, 1.0, 2.1],
+        };
+        let mut e = world.spawn((
+            RigidBody,
+            mass_props(1.0 + f, inertia),
+            Transform {
+                translation: Vec3::new(f * 100.0, 0.0, (i % 7) as f32),
+                rotation: Quat::from_rotation_y(f * 9.0),
+            },
+            Velocity {
+                linear: Vec3::new(1.0, 2.0, f),
+                angular: Vec3::new(0.3 + f, 1.0 - f, 0.2 + 3.0 * f),
+            },
+        ));
+        if i % 3 == 0 {
+            e.insert(ForceAccumulator::default());
+        }
+        bodies.push(e.id());
+    }
+    for pair in bodies.chunks(6) {
+        world.spawn(Spring {
+            a: pair[0],
+            anchor_a: Vec3::new(0.1, 0.0, 0.0),
+            b: SpringEnd::Body {
+                body: pair[3],
+                anchor: Vec3::ZERO,
+            },
+            stiffness: 10.0,
+            damping: 0.1,
+            rest_length: 0.5,
+        });
+    }
+    run(&mut world, 40);
+    let mut bits = Vec::new();
+    for e in bodies {
+        let t = world.get::<Transform>(e).unwrap();
+        let v = world.get::<Velocity>(e).unwrap();
+        let values = t
+            .translation
+            .to_array()
+            .into_iter()
+            .chain(t.rotation.to_array())
+            .chain(v.linear.to_array())
+            .chain(v.angular.to_array());
+        bits.extend(values.map(f32::to_bits));
+    }
+    bits
+}
+
+#[test]
+fn one_and_several_threads_give_identical_bits() {
+    // Small batches force the work over every thread of the pool, in different splits.
+    let threaded = Parallelism {
+        enabled: true,
+        min_bodies: 0,
+        min_batch: 64,
+    };
+    if std::thread::available_parallelism().map_or(1, |n| n.get()) >= 2 {
+        assert!(tumble::ecs::parallel::pool_threads() >= 2 || !cfg!(feature = "parallel"));
+    }
+    for integrator in [Integrator::Splitting, Integrator::SymplecticEuler] {
+        let single = big_world_bits(Parallelism::SINGLE_THREAD, integrator);
+        let parallel = big_world_bits(threaded, integrator);
+        assert_eq!(single.len(), parallel.len());
+        assert!(
+            single == parallel,
+            "{integrator}: thread count changed the result"
+        );
+        assert!(single.iter().all(|&x| f32::from_bits(x).is_finite()));
+    }
+}

@@ -14,6 +14,7 @@
 
 pub mod components;
 pub mod forces;
+pub mod parallel;
 pub mod schedule;
 pub mod stability;
 pub mod stepper;
@@ -27,6 +28,7 @@ pub mod prelude {
         Transform, Velocity,
     };
     pub use crate::forces::{ConstantForce, ConstantTorque, Spring, SpringEnd};
+    pub use crate::parallel::Parallelism;
     pub use crate::schedule::{PhysicsPlan, PhysicsSchedule, PhysicsSet, Stage};
     pub use crate::stability::{StabilityWarning, check_stability};
     pub use crate::stepper::{FixedStepper, FrameSteps, interpolate};

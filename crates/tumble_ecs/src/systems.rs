@@ -4,50 +4,262 @@
 //! `&mut` borrow) and after (the method may have left its stable region); a failing body is
 //! quarantined with [`Rejected`] and keeps its last valid state, and the others step on unharmed.
 
+use std::sync::Mutex;
+
+use arrayvec::ArrayVec;
 use bevy_ecs::prelude::*;
-use tumble_core::Wrench;
+use tumble_core::{BodyState, MassProperties, Wrench};
 
 use crate::components::{
     Damping, ForceAccumulator, Gravity, GravityScale, MassProps, PhysicsSettings, RigidBody,
     Transform, Velocity, body_state, write_body_state,
 };
-use crate::validate::{BodyError, BodyErrorKind, Rejected, check_body, reject};
+use crate::parallel::Parallelism;
+use crate::validate::{BodyError, BodyErrorKind, Rejected, check_accumulator, check_body, reject};
 
 /// Which part of a step the integrate system performs for a body.
 #[derive(Clone, Copy, PartialEq, Eq)]
 enum Phase {
     /// The whole step (forces sampled at the start, or constant).
     Whole,
+    /// The first half-drift of a drift–kick–drift step, before forces are sampled.
+    Begin,
     /// The rest of a step whose first half-drift already ran in [`begin_step`].
     Finish,
 }
 
-/// Steps one body under `wrench`; on failure leaves it untouched and returns the error.
-#[inline]
-fn step_body(
+/// Bodies are gathered from a table slice in chunks of this many (stack arrays, no allocation).
+const CHUNK: usize = 64;
+
+/// Where each body's load comes from.
+enum Loads<'a> {
+    /// A uniform field (or nothing): `F = m s g`, no torque.
+    Field {
+        gravity: Option<glam::Vec3>,
+        scales: Option<&'a [GravityScale]>,
+    },
+    /// Accumulators that are only checked (the first half-drift samples no load).
+    Checked(&'a [ForceAccumulator]),
+    /// Accumulators that are checked and consumed.
+    Consumed(&'a mut [ForceAccumulator]),
+}
+
+impl Loads<'_> {
+    /// Splits at `mid` like `split_at_mut`.
+    fn split_at(self, mid: usize) -> (Self, Self) {
+        match self {
+            Loads::Field { gravity, scales } => {
+                let (a, b) = scales.map_or((None, None), |s| {
+                    let (a, b) = s.split_at(mid);
+                    (Some(a), Some(b))
+                });
+                (
+                    Loads::Field { gravity, scales: a },
+                    Loads::Field { gravity, scales: b },
+                )
+            }
+            Loads::Checked(accs) => {
+                let (a, b) = accs.split_at(mid);
+                (Loads::Checked(a), Loads::Checked(b))
+            }
+            Loads::Consumed(accs) => {
+                let (a, b) = accs.split_at_mut(mid);
+                (Loads::Consumed(a), Loads::Consumed(b))
+            }
+        }
+    }
+
+    /// Checks body `i`'s load and returns it (consuming an accumulator).
+    #[inline]
+    fn take(&mut self, i: usize, mass: &MassProps) -> Result<Wrench, BodyErrorKind> {
+        match self {
+            Loads::Field { gravity, scales } => Ok(match gravity {
+                Some(g) => Wrench {
+                    force: (mass.mass() * scales.map_or(1.0, |s| s[i].0)) * *g,
+                    torque: glam::Vec3::ZERO,
+                },
+                None => Wrench::ZERO,
+            }),
+            Loads::Checked(accs) => check_accumulator(&accs[i]).map(|()| Wrench::ZERO),
+            Loads::Consumed(accs) => check_accumulator(&accs[i]).map(|()| accs[i].take()),
+        }
+    }
+}
+
+/// A run of bodies from one table, as plain slices.
+struct Bodies<'a> {
+    entities: &'a [Entity],
+    transforms: &'a mut [Transform],
+    velocities: &'a mut [Velocity],
+    masses: &'a [MassProps],
+    dampings: Option<&'a [Damping]>,
+    loads: Loads<'a>,
+}
+
+impl<'a> Bodies<'a> {
+    fn len(&self) -> usize {
+        self.entities.len()
+    }
+
+    /// Splits into bodies `[0, mid)` and `[mid, len)`.
+    fn split_at(self, mid: usize) -> (Self, Self) {
+        let (e0, e1) = self.entities.split_at(mid);
+        let (t0, t1) = self.transforms.split_at_mut(mid);
+        let (v0, v1) = self.velocities.split_at_mut(mid);
+        let (m0, m1) = self.masses.split_at(mid);
+        let (d0, d1) = self.dampings.map_or((None, None), |d| {
+            let (a, b) = d.split_at(mid);
+            (Some(a), Some(b))
+        });
+        let (l0, l1) = self.loads.split_at(mid);
+        (
+            Bodies {
+                entities: e0,
+                transforms: t0,
+                velocities: v0,
+                masses: m0,
+                dampings: d0,
+                loads: l0,
+            },
+            Bodies {
+                entities: e1,
+                transforms: t1,
+                velocities: v1,
+                masses: m1,
+                dampings: d1,
+                loads: l1,
+            },
+        )
+    }
+}
+
+/// Steps every body of `bodies` through `phase`, in chunks, with the batched core entry points
+/// (bit-identical to stepping each body alone). A body whose data is bad or whose step diverges
+/// keeps its state and is reported in `errors`.
+fn step_bodies(
     settings: &PhysicsSettings,
     phase: Phase,
-    transform: &mut Transform,
-    velocity: &mut Velocity,
-    mass: &MassProps,
-    wrench: &Wrench,
-    damping: Option<&Damping>,
-) -> Result<(), BodyErrorKind> {
+    mut bodies: Bodies<'_>,
+    errors: &mut Vec<BodyError>,
+) {
     let dt = settings.dt();
-    let mut state = body_state(transform, velocity, mass);
-    match phase {
-        Phase::Whole => settings.integrator.try_step(&mut state, mass, wrench, dt)?,
-        Phase::Finish => settings
-            .integrator
-            .try_finish_step(&mut state, mass, wrench, dt)?,
+    let integrator = settings.integrator;
+    let total = bodies.len();
+    for start in (0..total).step_by(CHUNK) {
+        let end = (start + CHUNK).min(total);
+        // Not initialised up front: a one-body world pays for one body, not for CHUNK.
+        let mut index = ArrayVec::<usize, CHUNK>::new();
+        let mut states = ArrayVec::<BodyState, CHUNK>::new();
+        let mut masses = ArrayVec::<&MassProperties, CHUNK>::new();
+        let mut wrenches = ArrayVec::<Wrench, CHUNK>::new();
+        for i in start..end {
+            let (transform, velocity) = (&bodies.transforms[i], &bodies.velocities[i]);
+            let mass = &bodies.masses[i];
+            match check_body(transform, velocity, None).and_then(|()| bodies.loads.take(i, mass)) {
+                Ok(wrench) => {
+                    index.push(i);
+                    states.push(body_state(transform, velocity, mass));
+                    masses.push(&mass.0);
+                    wrenches.push(wrench);
+                }
+                Err(kind) => errors.push(BodyError {
+                    entity: bodies.entities[i],
+                    kind,
+                }),
+            }
+        }
+        let (states, masses, wrenches) = (&mut states[..], &masses[..], &wrenches[..]);
+        let diverged = match phase {
+            Phase::Whole => integrator.try_step_many(states, masses, wrenches, dt),
+            Phase::Begin => integrator.try_begin_step_many(states, masses, dt),
+            Phase::Finish => integrator.try_finish_step_many(states, masses, wrenches, dt),
+        };
+        let mut diverged = diverged.into_iter().peekable();
+        for (k, state) in states.iter_mut().enumerate() {
+            let i = index[k];
+            if diverged.next_if_eq(&k).is_some() {
+                let kind = BodyErrorKind::Diverged(tumble_core::StepError::Diverged { integrator });
+                errors.push(BodyError {
+                    entity: bodies.entities[i],
+                    kind,
+                });
+                continue;
+            }
+            if phase != Phase::Begin
+                && let Some(d) = bodies.dampings.map(|d| &d[i])
+            {
+                // Padé damping v ← v / (1 + Δt c): unconditionally stable, as in rapier and avian.
+                state.linear_velocity /= 1.0 + dt * d.linear;
+                state.angular_velocity /= 1.0 + dt * d.angular;
+            }
+            write_body_state(
+                state,
+                &bodies.masses[i],
+                &mut bodies.transforms[i],
+                &mut bodies.velocities[i],
+            );
+        }
     }
-    if let Some(d) = damping {
-        // Padé damping v ← v / (1 + Δt c): unconditionally stable, as in rapier and avian.
-        state.linear_velocity /= 1.0 + dt * d.linear;
-        state.angular_velocity /= 1.0 + dt * d.angular;
+}
+
+/// Steps one table's bodies, split over the compute pool's threads when [`Parallelism`] says
+/// the table is big enough. Each body is stepped by the same code in any split, so the result
+/// does not depend on the number of threads. Errors are returned sorted by entity.
+fn step_table(
+    settings: &PhysicsSettings,
+    parallelism: &Parallelism,
+    phase: Phase,
+    bodies: Bodies<'_>,
+    errors: &mut Vec<BodyError>,
+) {
+    let threads = parallelism.threads_for(bodies.len());
+    if threads <= 1 {
+        step_bodies(settings, phase, bodies, errors);
+        return;
     }
-    write_body_state(&state, mass, transform, velocity);
-    Ok(())
+    let parts = split_evenly(bodies, threads);
+    let found = Mutex::new(Vec::new());
+    crate::parallel::scope(|spawn| {
+        for part in parts {
+            let found = &found;
+            spawn(Box::new(move || {
+                let mut local = Vec::new();
+                step_bodies(settings, phase, part, &mut local);
+                if !local.is_empty() {
+                    found
+                        .lock()
+                        .unwrap_or_else(|poisoned| poisoned.into_inner())
+                        .extend(local);
+                }
+            }));
+        }
+    });
+    let mut found = found
+        .into_inner()
+        .unwrap_or_else(|poisoned| poisoned.into_inner());
+    found.sort_by_key(|e| e.entity);
+    errors.extend(found);
+}
+
+/// Splits `bodies` into `parts` runs of nearly equal length.
+fn split_evenly(bodies: Bodies<'_>, parts: usize) -> Vec<Bodies<'_>> {
+    let mut out = Vec::with_capacity(parts);
+    let mut rest = bodies;
+    for k in (1..=parts).rev() {
+        let take = rest.len() / k;
+        let (head, tail) = rest.split_at(take);
+        out.push(head);
+        rest = tail;
+    }
+    out
+}
+
+/// Quarantines the bodies in `errors` (in the order found: table by table, entity order
+/// within a table).
+fn reject_all(commands: &mut Commands, errors: Vec<BodyError>) {
+    for error in errors {
+        reject(commands, error);
+    }
 }
 
 /// Set by [`begin_step`] when it has drifted the bodies with accumulators half a step, so that
@@ -61,6 +273,7 @@ pub struct HalfDrifted(pub bool);
 /// state-dependent force and take their whole step in [`integrate_without_forces`].
 pub fn begin_step(
     settings: Res<PhysicsSettings>,
+    parallelism: Option<Res<Parallelism>>,
     mut drifted: ResMut<HalfDrifted>,
     mut commands: Commands,
     mut bodies: Query<
@@ -78,18 +291,20 @@ pub fn begin_step(
         return;
     }
     drifted.0 = true;
-    let dt = settings.dt();
-    for (entity, mut transform, mut velocity, mass, acc) in &mut bodies {
-        let result = check_body(&transform, &velocity, Some(acc)).and_then(|()| {
-            let mut state = body_state(&transform, &velocity, mass);
-            settings.integrator.try_begin_step(&mut state, mass, dt)?;
-            write_body_state(&state, mass, &mut transform, &mut velocity);
-            Ok(())
-        });
-        if let Err(kind) = result {
-            reject(&mut commands, BodyError { entity, kind });
-        }
+    let parallelism = parallelism.map_or_else(Parallelism::default, |p| *p);
+    let mut errors = Vec::new();
+    for (entities, mut t, mut v, masses, accs) in dense(bodies.contiguous_iter_mut()) {
+        let bodies = Bodies {
+            entities,
+            transforms: &mut t,
+            velocities: &mut v,
+            masses,
+            dampings: None,
+            loads: Loads::Checked(accs),
+        };
+        step_table(&settings, &parallelism, Phase::Begin, bodies, &mut errors);
     }
+    reject_all(&mut commands, errors);
 }
 
 /// Integrates bodies that have a [`ForceAccumulator`], consuming (reading and zeroing) it.
@@ -99,6 +314,7 @@ pub fn begin_step(
 /// whole step with the forces sampled at the start, and warns once.
 pub fn integrate_with_forces(
     settings: Res<PhysicsSettings>,
+    parallelism: Option<Res<Parallelism>>,
     mut drifted: ResMut<HalfDrifted>,
     mut warned: Local<bool>,
     mut commands: Commands,
@@ -128,29 +344,28 @@ pub fn integrate_with_forces(
         );
     }
     drifted.0 = false;
-    for (entity, mut transform, mut velocity, mass, mut acc, damping) in &mut bodies {
-        let result = check_body(&transform, &velocity, Some(&acc)).and_then(|()| {
-            let wrench = acc.take();
-            step_body(
-                &settings,
-                phase,
-                &mut transform,
-                &mut velocity,
-                mass,
-                &wrench,
-                damping,
-            )
-        });
-        if let Err(kind) = result {
-            reject(&mut commands, BodyError { entity, kind });
-        }
+    let parallelism = parallelism.map_or_else(Parallelism::default, |p| *p);
+    let mut errors = Vec::new();
+    for (entities, mut t, mut v, masses, mut accs, dampings) in dense(bodies.contiguous_iter_mut())
+    {
+        let bodies = Bodies {
+            entities,
+            transforms: &mut t,
+            velocities: &mut v,
+            masses,
+            dampings,
+            loads: Loads::Consumed(&mut accs),
+        };
+        step_table(&settings, &parallelism, phase, bodies, &mut errors);
     }
+    reject_all(&mut commands, errors);
 }
 
 /// Integrates bodies without a [`ForceAccumulator`]: free motion, plus gravity when a
 /// [`Gravity`] resource exists (a uniform field needs no accumulator).
 pub fn integrate_without_forces(
     settings: Res<PhysicsSettings>,
+    parallelism: Option<Res<Parallelism>>,
     gravity: Option<Res<Gravity>>,
     mut commands: Commands,
     mut bodies: Query<
@@ -169,28 +384,25 @@ pub fn integrate_without_forces(
         ),
     >,
 ) {
-    let g = gravity.map(|g| g.0);
-    for (entity, mut transform, mut velocity, mass, scale, damping) in &mut bodies {
-        let wrench = match g {
-            Some(g) => Wrench {
-                force: (mass.mass() * scale.map_or(1.0, |s| s.0)) * g,
-                torque: glam::Vec3::ZERO,
-            },
-            None => Wrench::ZERO,
+    let gravity = gravity.map(|g| g.0);
+    let parallelism = parallelism.map_or_else(Parallelism::default, |p| *p);
+    let mut errors = Vec::new();
+    for (entities, mut t, mut v, masses, scales, dampings) in dense(bodies.contiguous_iter_mut()) {
+        let bodies = Bodies {
+            entities,
+            transforms: &mut t,
+            velocities: &mut v,
+            masses,
+            dampings,
+            loads: Loads::Field { gravity, scales },
         };
-        let result = check_body(&transform, &velocity, None).and_then(|()| {
-            step_body(
-                &settings,
-                Phase::Whole,
-                &mut transform,
-                &mut velocity,
-                mass,
-                &wrench,
-                damping,
-            )
-        });
-        if let Err(kind) = result {
-            reject(&mut commands, BodyError { entity, kind });
-        }
+        step_table(&settings, &parallelism, Phase::Whole, bodies, &mut errors);
     }
+    reject_all(&mut commands, errors);
+}
+
+/// The physics queries hold only table components and archetype filters, so they are always
+/// dense (contiguously iterable).
+fn dense<I>(iter: Result<I, bevy_ecs::query::QueryNotDenseError>) -> I {
+    iter.expect("physics queries use table storage and archetype filters only")
 }

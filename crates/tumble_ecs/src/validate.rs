@@ -67,11 +67,21 @@ pub fn check_body(
     check_unit_quat("rotation", transform.rotation).map_err(invalid("Transform"))?;
     check_finite_vec3("linear velocity", velocity.linear).map_err(invalid("Velocity"))?;
     check_finite_vec3("angular velocity", velocity.angular).map_err(invalid("Velocity"))?;
-    if let Some(acc) = forces {
-        check_finite_vec3("force", acc.force).map_err(invalid("ForceAccumulator"))?;
-        check_finite_vec3("torque", acc.torque).map_err(invalid("ForceAccumulator"))?;
+    match forces {
+        Some(acc) => check_accumulator(acc),
+        None => Ok(()),
     }
-    Ok(())
+}
+
+/// Checks that a [`ForceAccumulator`] holds finite values.
+pub fn check_accumulator(acc: &ForceAccumulator) -> Result<(), BodyErrorKind> {
+    use tumble_core::error::check_finite_vec3;
+    let invalid = |source| BodyErrorKind::Invalid {
+        component: "ForceAccumulator",
+        source,
+    };
+    check_finite_vec3("force", acc.force).map_err(invalid)?;
+    check_finite_vec3("torque", acc.torque).map_err(invalid)
 }
 
 /// Quarantines `entity`: logs the error, records it in [`PhysicsErrors`] and inserts

@@ -9,6 +9,8 @@
 
 use std::borrow::Borrow;
 
+use arrayvec::ArrayVec;
+
 use super::Integrator;
 use super::lanes::LANES;
 use super::splitting::{kick, translate_dkd};
@@ -17,25 +19,15 @@ use crate::mass::MassProperties;
 use crate::rotation::rotate_exact;
 use crate::state::{BodyState, Wrench};
 
+/// A body waiting for its free rotation: index, translated state, kernel input, `h`.
+type Pending = (usize, BodyState, SymmetricInput, f32);
+
 /// Bodies waiting for their free rotation, flushed [`LANES`] at a time.
-struct PendingRotations {
-    index: [usize; LANES],
-    state: [BodyState; LANES],
-    input: [SymmetricInput; LANES],
-    h: [f32; LANES],
-    len: usize,
-}
+struct PendingRotations(ArrayVec<Pending, LANES>);
 
 impl PendingRotations {
     fn new() -> Self {
-        let idle = SymmetricInput::new(glam::Quat::IDENTITY, glam::Vec3::ZERO, &IDLE_MASS);
-        Self {
-            index: [0; LANES],
-            state: [BodyState::default(); LANES],
-            input: [idle; LANES],
-            h: [0.0; LANES],
-            len: 0,
-        }
+        Self(ArrayVec::new())
     }
 
     /// Queues body `index` (already translated, as `state`) for a free rotation over `h`;
@@ -54,13 +46,9 @@ impl PendingRotations {
             done(index, state);
             return;
         }
-        let lane = self.len;
-        self.index[lane] = index;
-        self.input[lane] = SymmetricInput::new(state.rotation, state.angular_velocity, mass);
-        self.state[lane] = state;
-        self.h[lane] = h;
-        self.len += 1;
-        if self.len == LANES {
+        let input = SymmetricInput::new(state.rotation, state.angular_velocity, mass);
+        self.0.push((index, state, input, h));
+        if self.0.is_full() {
             self.flush(done);
         }
     }
@@ -69,43 +57,35 @@ impl PendingRotations {
     /// the same bits) and hands each result to `done`.
     #[inline]
     fn flush(&mut self, done: &mut impl FnMut(usize, BodyState)) {
-        if self.len == LANES {
-            let rotated = rotate_symmetric_lanes(&self.input, self.h);
-            for (lane, (rotation, omega)) in rotated.into_iter().enumerate() {
-                self.finish_lane(lane, rotation, omega, done);
+        if let Ok(full) = <&[Pending; LANES]>::try_from(self.0.as_slice()) {
+            let inputs = full.each_ref().map(|p| p.2);
+            let rotated = rotate_symmetric_lanes(&inputs, full.each_ref().map(|p| p.3));
+            for (pending, (rotation, omega)) in full.iter().zip(rotated) {
+                finish(pending, rotation, omega, done);
             }
         } else {
-            for lane in 0..self.len {
-                let (rotation, omega) = rotate_symmetric_one(&self.input[lane], self.h[lane]);
-                self.finish_lane(lane, rotation, omega, done);
+            for pending in &self.0 {
+                let (rotation, omega) = rotate_symmetric_one(&pending.2, pending.3);
+                finish(pending, rotation, omega, done);
             }
         }
-        self.len = 0;
-    }
-
-    #[inline]
-    fn finish_lane(
-        &mut self,
-        lane: usize,
-        rotation: glam::Quat,
-        omega: glam::Vec3,
-        done: &mut impl FnMut(usize, BodyState),
-    ) {
-        let mut state = self.state[lane];
-        state.rotation = rotation;
-        state.angular_velocity = omega;
-        done(self.index[lane], state);
+        self.0.clear();
     }
 }
 
-/// Mass properties for idle lanes (never written back).
-static IDLE_MASS: std::sync::LazyLock<MassProperties> = std::sync::LazyLock::new(|| {
-    MassProperties::new(
-        crate::Mass::new(1.0).expect("1 kg is valid"),
-        glam::Vec3::new(1.0, 2.0, 3.0),
-    )
-    .expect("valid inertia")
-});
+/// Hands a rotated body to `done`.
+#[inline]
+fn finish(
+    pending: &Pending,
+    rotation: glam::Quat,
+    omega: glam::Vec3,
+    done: &mut impl FnMut(usize, BodyState),
+) {
+    let mut state = pending.1;
+    state.rotation = rotation;
+    state.angular_velocity = omega;
+    done(pending.0, state);
+}
 
 /// Commits `next` into `states[index]` if it is finite, else records the divergence.
 #[inline]

@@ -1,0 +1,81 @@
+//! How the integrate systems spread bodies over threads.
+//!
+//! With the `parallel` feature the integrate systems split each body table into one run per
+//! thread of bevy's `ComputeTaskPool`; without it, or for small worlds, they run on the calling
+//! thread. (The split is ours rather than `contiguous_par_iter_mut`'s: bevy 0.20.1 trips a
+//! debug assertion when it hands out part of a table.) Every body is stepped by the same code whichever batch or thread it
+//! lands in, so the results are bit-identical for any thread count (tested).
+
+use bevy_ecs::prelude::*;
+
+/// Threading policy of the physics systems. Optional resource: without it the defaults apply.
+#[derive(Resource, Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Parallelism {
+    /// Use the thread pool at all (only has an effect with the `parallel` feature).
+    pub enabled: bool,
+    /// Worlds with fewer bodies than this run on the calling thread: below a few thousand
+    /// bodies, waking the pool costs more than it saves.
+    pub min_bodies: usize,
+    /// The smallest batch handed to one task.
+    pub min_batch: usize,
+}
+
+impl Default for Parallelism {
+    /// Enabled from 4096 bodies, batches of at least 1024.
+    fn default() -> Self {
+        Self {
+            enabled: true,
+            min_bodies: 4096,
+            min_batch: 1024,
+        }
+    }
+}
+
+impl Parallelism {
+    /// Everything on the calling thread.
+    pub const SINGLE_THREAD: Self = Self {
+        enabled: false,
+        min_bodies: usize::MAX,
+        min_batch: usize::MAX,
+    };
+
+    /// How many threads to spread `bodies` bodies over: 1 unless the `parallel` feature is on,
+    /// the policy allows it and the run is big enough; never more than the pool has, and never
+    /// batches smaller than `min_batch`.
+    pub fn threads_for(&self, bodies: usize) -> usize {
+        if !cfg!(feature = "parallel") || !self.enabled || bodies < self.min_bodies {
+            return 1;
+        }
+        pool_threads().min(bodies / self.min_batch.max(1)).max(1)
+    }
+}
+
+/// A unit of work for [`scope`].
+pub type Job<'a> = Box<dyn FnOnce() + Send + 'a>;
+
+/// Runs every job handed to `spawn` on the compute pool and returns when all are done.
+#[cfg(feature = "parallel")]
+pub fn scope<'env>(jobs: impl FnOnce(&mut dyn FnMut(Job<'env>))) {
+    let pool = bevy_tasks::ComputeTaskPool::get_or_init(bevy_tasks::TaskPool::default);
+    pool.scope(|s| {
+        jobs(&mut |job: Job<'env>| s.spawn(async move { job() }));
+    });
+}
+
+/// Without the `parallel` feature the jobs run one after another on this thread.
+#[cfg(not(feature = "parallel"))]
+pub fn scope<'env>(jobs: impl FnOnce(&mut dyn FnMut(Job<'env>))) {
+    jobs(&mut |job: Job<'env>| job());
+}
+
+/// Threads of the compute pool, creating the pool (one thread per core) on first use.
+#[cfg(feature = "parallel")]
+pub fn pool_threads() -> usize {
+    bevy_tasks::ComputeTaskPool::get_or_init(bevy_tasks::TaskPool::default).thread_num()
+}
+
+/// Without the `parallel` feature there is one thread.
+#[cfg(not(feature = "parallel"))]
+pub fn pool_threads() -> usize {
+    1
+}
