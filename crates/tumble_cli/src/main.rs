@@ -113,6 +113,8 @@ enum Command {
     },
     /// The accuracy report: work–precision, stability matrix, plots.
     Report(tumble_report::run::ReportOptions),
+    /// Throughput: ECS vs raw loop vs rapier, 1 and 2 threads, N = 1 … 10⁶, memory bandwidth.
+    Bench(tumble_bench::BenchOptions),
 }
 
 fn main() -> ExitCode {
@@ -190,6 +192,7 @@ fn run(cli: Cli) -> Result<(), String> {
         Command::Report(options) => {
             tumble_report::run::run_report(&options).map_err(|e| e.to_string())
         }
+        Command::Bench(options) => tumble_bench::run_and_write(&options).map_err(|e| e.to_string()),
         Command::Run {
             scene,
             steps,

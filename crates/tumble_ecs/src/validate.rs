@@ -56,7 +56,32 @@ pub struct Rejected(pub BodyError);
 pub struct PhysicsErrors(pub Vec<BodyError>);
 
 /// Checks the body data of a [`Transform`], [`Velocity`] and optional [`ForceAccumulator`].
+///
+/// Runs for every body every step, so valid data takes an inlined fast test (finite values, unit
+/// quaternion within [`UNIT_QUATERNION_TOLERANCE`](tumble_core::error::UNIT_QUATERNION_TOLERANCE));
+/// only bad data goes through the detailed checks that build the error.
+#[inline]
 pub fn check_body(
+    transform: &Transform,
+    velocity: &Velocity,
+    forces: Option<&ForceAccumulator>,
+) -> Result<(), BodyErrorKind> {
+    let finite = transform.translation.is_finite()
+        && velocity.linear.is_finite()
+        && velocity.angular.is_finite()
+        && forces.is_none_or(|acc| acc.force.is_finite() && acc.torque.is_finite());
+    // NaN or Inf in the rotation makes the norm test false as well.
+    let unit =
+        (transform.rotation.length() - 1.0).abs() <= tumble_core::error::UNIT_QUATERNION_TOLERANCE;
+    if finite && unit {
+        return Ok(());
+    }
+    check_body_in_detail(transform, velocity, forces)
+}
+
+/// The detailed checks behind [`check_body`], naming the component and field at fault.
+#[cold]
+fn check_body_in_detail(
     transform: &Transform,
     velocity: &Velocity,
     forces: Option<&ForceAccumulator>,

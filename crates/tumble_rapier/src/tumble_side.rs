@@ -69,6 +69,11 @@ impl TumbleScene {
         }
     }
 
+    /// The world, to add resources (e.g. a threading policy) or read components.
+    pub fn world_mut(&mut self) -> &mut World {
+        &mut self.world
+    }
+
     /// Advances tumble by one step.
     pub fn step(&mut self) {
         self.schedule.run(&mut self.world);

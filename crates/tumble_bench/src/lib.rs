@@ -1,0 +1,273 @@
+//! # tumble_bench
+//!
+//! `tumble bench`: ns per body-step of tumble through its ECS schedule, of a raw loop over plain
+//! arrays calling the same `tumble_core` entry point, and of rapier 0.36 on the same bodies, for
+//! N = 1 … 10⁶, on one and two threads, with the machine's memory bandwidth measured in the same
+//! run. Results as a table, JSON and a README section; ratios, because the machines are shared
+//! and noisy.
+
+#![forbid(unsafe_code)]
+#![warn(missing_docs)]
+
+pub mod bandwidth;
+pub mod engines;
+pub mod measure;
+pub mod output;
+pub mod population;
+
+use std::path::PathBuf;
+
+use serde::Serialize;
+use tumble_core::Integrator;
+use tumble_ecs::parallel::{Parallelism, pool_threads};
+
+use crate::engines::{Ecs, Engine, Rapier, RawLoop};
+use crate::measure::{Effort, compare};
+
+/// What to measure and where to write it (the arguments of `tumble bench` and `tumble-bench`).
+#[derive(Debug, Clone, clap::Args)]
+pub struct BenchOptions {
+    /// Smaller worlds (up to 10⁴ bodies) and shorter timings: a smoke run of a few seconds.
+    #[arg(long)]
+    pub quick: bool,
+    /// Largest world for tumble (default 10⁶, 10⁴ with --quick).
+    #[arg(long)]
+    pub max_bodies: Option<usize>,
+    /// Largest world for rapier (default 10⁵: a million rapier bodies take gigabytes and
+    /// minutes).
+    #[arg(long, default_value_t = 100_000)]
+    pub rapier_max_bodies: usize,
+    /// Write `bench.json` and `bench.md` into this directory.
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Also replace the ratios section of this markdown file (between `<!-- bench:begin -->`
+    /// and `<!-- bench:end -->`), e.g. README.md.
+    #[arg(long)]
+    pub readme: Option<PathBuf>,
+}
+
+/// One world size and integrator: median ns per body-step of each engine.
+#[derive(Debug, Clone, Serialize)]
+pub struct Row {
+    /// Integrator name.
+    pub integrator: String,
+    /// Number of bodies.
+    pub bodies: usize,
+    /// Steps per timing.
+    pub steps: usize,
+    /// Raw loop over plain arrays, one thread.
+    pub raw_1t: f64,
+    /// Raw loop, split over the pool as the ECS splits (same threading policy).
+    pub raw_2t: f64,
+    /// tumble's ECS schedule, one thread.
+    pub ecs_1t: f64,
+    /// tumble's ECS schedule with the default threading policy.
+    pub ecs_2t: f64,
+    /// rapier 0.36 (single-threaded build), if measured at this size.
+    pub rapier: Option<f64>,
+}
+
+/// The cost of a feature a scene does not use.
+#[derive(Debug, Clone, Serialize)]
+pub struct UnusedFeature {
+    /// What is compared.
+    pub what: String,
+    /// ns per body-step without the feature (no `Gravity` resource).
+    pub without: f64,
+    /// ns per body-step with the feature present but doing nothing (`Gravity(0)`).
+    pub with_zero: f64,
+}
+
+/// A target of issue #7 and whether this run met it.
+#[derive(Debug, Clone, Serialize)]
+pub struct Target {
+    /// What is measured.
+    pub name: String,
+    /// The measured value.
+    pub value: f64,
+    /// The bound.
+    pub bound: f64,
+    /// `"<="` or `">="`.
+    pub relation: String,
+    /// Whether the value meets the bound.
+    pub met: bool,
+}
+
+/// Everything one run measured.
+#[derive(Debug, Clone, Serialize)]
+pub struct BenchResults {
+    /// JSON schema version.
+    pub schema: u32,
+    /// Threads of the compute pool.
+    pub pool_threads: usize,
+    /// Copy bandwidth (read + write), GB/s, one thread and all pool threads.
+    pub bandwidth_gb_s: [f64; 2],
+    /// Bytes a body-step must move through memory in the ECS (read + write), for the floor.
+    pub bytes_per_body_step: usize,
+    /// All rows.
+    pub rows: Vec<Row>,
+    /// ns per step of a one-body world through the ECS schedule, per integrator.
+    pub fixed_cost_ns: Vec<(String, f64)>,
+    /// The cost of an unused feature.
+    pub unused_feature: UnusedFeature,
+    /// The targets of issue #7.
+    pub targets: Vec<Target>,
+}
+
+/// The two integrators measured: the default and the textbook step.
+pub const INTEGRATORS: [Integrator; 2] = [Integrator::Splitting, Integrator::SymplecticEuler];
+
+/// Bytes moved per ECS body-step: `Transform` and `Velocity` read and written, `MassProps`
+/// read, one changed-tick written per mutated component.
+pub fn bytes_per_body_step() -> usize {
+    use tumble_ecs::components::{MassProps, Transform, Velocity};
+    let state = size_of::<Transform>() + size_of::<Velocity>();
+    2 * state + size_of::<MassProps>() + 2 * size_of::<u32>()
+}
+
+/// Runs the benchmark; `progress` receives one line per measurement.
+pub fn run_bench(options: &BenchOptions, mut progress: impl FnMut(&str)) -> BenchResults {
+    let max = options
+        .max_bodies
+        .unwrap_or(if options.quick { 10_000 } else { 1_000_000 });
+    let sizes: Vec<usize> = [1, 10, 100, 1_000, 10_000, 100_000, 1_000_000]
+        .into_iter()
+        .filter(|&n| n <= max)
+        .collect();
+    let effort = if options.quick {
+        Effort {
+            body_steps: 100_000,
+            min_steps: 2,
+            max_steps: 10_000,
+            repetitions: 3,
+        }
+    } else {
+        Effort {
+            body_steps: 1_000_000,
+            min_steps: 3,
+            max_steps: 20_000,
+            repetitions: 5,
+        }
+    };
+    progress("memory bandwidth");
+    let bandwidth = [
+        bandwidth::copy_bandwidth(1, 3),
+        bandwidth::copy_bandwidth(pool_threads().max(1), 3),
+    ];
+    let threaded = Parallelism::default();
+    let single = Parallelism::SINGLE_THREAD;
+    let mut rows = Vec::new();
+    for &n in &sizes {
+        let scene = population::scene(n);
+        let mut rapier = (n <= options.rapier_max_bodies).then(|| Rapier::new(&scene));
+        for (k, &integrator) in INTEGRATORS.iter().enumerate() {
+            progress(&format!("{n} bodies · {integrator}"));
+            let mut raw1 = RawLoop::new(&scene, integrator, single);
+            let mut raw2 = RawLoop::new(&scene, integrator, threaded);
+            let mut ecs1 = Ecs::new(&scene, integrator, single);
+            let mut ecs2 = Ecs::new(&scene, integrator, threaded);
+            let mut engines: Vec<&mut dyn Engine> =
+                vec![&mut raw1, &mut raw2, &mut ecs1, &mut ecs2];
+            // rapier does not depend on tumble's integrator: timed once per size.
+            let with_rapier = k == 0 && rapier.is_some();
+            if with_rapier && let Some(r) = rapier.as_mut() {
+                engines.push(r);
+            }
+            let ns = compare(&mut engines, n, &effort);
+            check_moved(&raw1, &ecs1, &scene);
+            rows.push(Row {
+                integrator: integrator.name().to_owned(),
+                bodies: n,
+                steps: effort.steps(n),
+                raw_1t: ns[0],
+                raw_2t: ns[1],
+                ecs_1t: ns[2],
+                ecs_2t: ns[3],
+                rapier: if with_rapier {
+                    Some(ns[4])
+                } else {
+                    rows.iter()
+                        .rev()
+                        .find(|r: &&Row| r.bodies == n)
+                        .and_then(|r| r.rapier)
+                },
+            });
+        }
+    }
+    let fixed_cost_ns = INTEGRATORS
+        .iter()
+        .filter_map(|i| {
+            rows.iter()
+                .find(|r| r.bodies == 1 && r.integrator == i.name())
+                .map(|r| (i.name().to_owned(), r.ecs_1t))
+        })
+        .collect();
+    progress("unused feature: no gravity vs zero gravity");
+    let unused_feature = unused_gravity(sizes.last().copied().unwrap_or(1).min(10_000), &effort);
+    let mut results = BenchResults {
+        schema: 1,
+        pool_threads: pool_threads(),
+        bandwidth_gb_s: bandwidth,
+        bytes_per_body_step: bytes_per_body_step(),
+        rows,
+        fixed_cost_ns,
+        unused_feature,
+        targets: Vec::new(),
+    };
+    results.targets = output::targets(&results);
+    results
+}
+
+/// Both the raw loop and the ECS really moved the bodies, to the same place bit for bit (the
+/// same core function on the same data, the same number of steps).
+fn check_moved(raw: &RawLoop, ecs: &Ecs, scene: &tumble_rapier::ComparisonScene) {
+    let last = scene.bodies.len() - 1;
+    for i in [0, last / 2, last] {
+        let (a, b) = (raw.state(i), ecs.state(i));
+        assert!(a.position != scene.bodies[i].state.position, "bodies moved");
+        assert!(a.is_finite(), "benchmark stays finite");
+        assert_eq!(a, b, "raw loop and ECS agree bit for bit");
+    }
+}
+
+/// ECS without a `Gravity` resource against the same world with `Gravity(0)`.
+fn unused_gravity(n: usize, effort: &Effort) -> UnusedFeature {
+    let mut scene = population::scene(n);
+    scene.gravity = None;
+    let mut without = Ecs::new(&scene, Integrator::default(), Parallelism::SINGLE_THREAD);
+    scene.gravity = Some(glam::Vec3::ZERO);
+    let mut with_zero = Ecs::new(&scene, Integrator::default(), Parallelism::SINGLE_THREAD);
+    let ns = compare(&mut [&mut without, &mut with_zero], n, effort);
+    UnusedFeature {
+        what: format!("{n} free bodies, default integrator, one thread"),
+        without: ns[0],
+        with_zero: ns[1],
+    }
+}
+
+/// Runs the benchmark, prints the table, and writes the files the options ask for.
+pub fn run_and_write(options: &BenchOptions) -> Result<(), Box<dyn std::error::Error>> {
+    let results = run_bench(options, |line| eprintln!("… {line}"));
+    let table = output::markdown(&results);
+    println!("{table}");
+    if let Some(dir) = &options.out {
+        std::fs::create_dir_all(dir)?;
+        std::fs::write(dir.join("bench.md"), &table)?;
+        std::fs::write(
+            dir.join("bench.json"),
+            serde_json::to_string_pretty(&results)? + "\n",
+        )?;
+    }
+    if let Some(readme) = &options.readme {
+        let text = std::fs::read_to_string(readme)?;
+        let section = output::readme_section(&results);
+        let updated = output::replace_between_markers(&text, &section).ok_or_else(|| {
+            format!(
+                "{}: no <!-- bench:begin --> … <!-- bench:end --> markers",
+                readme.display()
+            )
+        })?;
+        std::fs::write(readme, updated)?;
+    }
+    Ok(())
+}

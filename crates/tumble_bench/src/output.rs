@@ -1,0 +1,239 @@
+//! The benchmark's outputs: a markdown table, the targets of issue #7, JSON, and the README
+//! section.
+
+use std::fmt::Write;
+
+use crate::{BenchResults, Row, Target};
+
+/// The default integrator's name (the targets are stated for it).
+const DEFAULT: &str = "splitting";
+
+fn rows_of<'a>(results: &'a BenchResults, integrator: &'a str) -> impl Iterator<Item = &'a Row> {
+    results
+        .rows
+        .iter()
+        .filter(move |r| r.integrator == integrator)
+}
+
+fn row(results: &BenchResults, integrator: &str, bodies: usize) -> Option<Row> {
+    rows_of(results, integrator)
+        .find(|r| r.bodies == bodies)
+        .cloned()
+}
+
+fn target(name: &str, value: f64, relation: &str, bound: f64) -> Target {
+    let met = match relation {
+        "<=" => value <= bound,
+        _ => value >= bound,
+    };
+    Target {
+        name: name.to_owned(),
+        value,
+        bound,
+        relation: relation.to_owned(),
+        met,
+    }
+}
+
+/// Evaluates the targets of issue #7 on the measured rows (those whose sizes were measured).
+pub fn targets(results: &BenchResults) -> Vec<Target> {
+    let mut out = Vec::new();
+    for integrator in [DEFAULT, "symplectic-euler"] {
+        let big: Vec<&Row> = rows_of(results, integrator)
+            .filter(|r| r.bodies >= 10_000)
+            .collect();
+        if !big.is_empty() {
+            let worst_1t = big.iter().map(|r| r.ecs_1t / r.raw_1t).fold(0.0, f64::max);
+            let worst_2t = big.iter().map(|r| r.ecs_2t / r.raw_2t).fold(0.0, f64::max);
+            out.push(target(
+                &format!("{integrator}: ECS / raw, 1 thread, worst N ≥ 1e4"),
+                worst_1t,
+                "<=",
+                1.2,
+            ));
+            out.push(target(
+                &format!("{integrator}: ECS / raw, 2 threads, worst N ≥ 1e4"),
+                worst_2t,
+                "<=",
+                1.2,
+            ));
+        }
+    }
+    if let Some(r) = row(results, DEFAULT, 100_000) {
+        if let Some(rapier) = r.rapier {
+            out.push(target(
+                "rapier / tumble at 1e5, default integrator, 1 thread each",
+                rapier / r.ecs_1t,
+                ">=",
+                10.0,
+            ));
+            out.push(target(
+                "rapier (1 thread) / tumble (2 threads) at 1e5, default integrator",
+                rapier / r.ecs_2t,
+                ">=",
+                10.0,
+            ));
+        }
+        out.push(target(
+            "2 threads / 1 thread speed-up at 1e5, default integrator",
+            r.ecs_1t / r.ecs_2t,
+            ">=",
+            1.7,
+        ));
+    }
+    for (integrator, ns) in &results.fixed_cost_ns {
+        out.push(target(
+            &format!("{integrator}: fixed cost per step at N = 1 (µs)"),
+            ns / 1000.0,
+            "<=",
+            2.0,
+        ));
+    }
+    let flat: Vec<f64> = rows_of(results, DEFAULT)
+        .filter(|r| r.bodies >= 1_000)
+        .map(|r| r.ecs_1t)
+        .collect();
+    if flat.len() >= 2 && results.rows.iter().any(|r| r.bodies >= 1_000_000) {
+        let max = flat.iter().copied().fold(0.0, f64::max);
+        let min = flat.iter().copied().fold(f64::INFINITY, f64::min);
+        out.push(target(
+            "default integrator: max / min cost per body, N = 1e3 … 1e6",
+            max / min,
+            "<=",
+            1.5,
+        ));
+    }
+    let u = &results.unused_feature;
+    out.push(target(
+        "no gravity / zero gravity (unused feature costs nothing)",
+        u.without / u.with_zero,
+        "<=",
+        1.05,
+    ));
+    out
+}
+
+fn fmt_ns(ns: f64) -> String {
+    if ns >= 100.0 {
+        format!("{ns:.0}")
+    } else {
+        format!("{ns:.1}")
+    }
+}
+
+/// The full markdown report: machine, per-size table per integrator, targets.
+pub fn markdown(results: &BenchResults) -> String {
+    let mut s = String::new();
+    let [bw1, bwn] = results.bandwidth_gb_s;
+    let floor = results.bytes_per_body_step as f64 / bw1;
+    let _ = writeln!(
+        s,
+        "Memory: {bw1:.1} GB/s copy on one thread, {bwn:.1} GB/s on {} threads; an ECS \
+         body-step moves {} bytes, so one thread cannot go below {floor:.1} ns per body-step.\n",
+        results.pool_threads, results.bytes_per_body_step
+    );
+    for integrator in crate::INTEGRATORS.map(|i| i.name()) {
+        let _ = writeln!(s, "**{integrator}** — ns per body-step (median)\n");
+        let _ = writeln!(
+            s,
+            "| bodies | raw 1t | ECS 1t | ECS/raw | raw 2t | ECS 2t | ECS/raw | 1t/2t | rapier | rapier/ECS 1t | ECS 1t / memory floor |"
+        );
+        let _ = writeln!(
+            s,
+            "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+        );
+        for r in rows_of(results, integrator) {
+            let rapier = r.rapier.map_or("–".into(), fmt_ns);
+            let vs = r
+                .rapier
+                .map_or("–".into(), |x| format!("{:.1}×", x / r.ecs_1t));
+            let _ = writeln!(
+                s,
+                "| {} | {} | {} | {:.2} | {} | {} | {:.2} | {:.2} | {} | {} | {:.1} |",
+                r.bodies,
+                fmt_ns(r.raw_1t),
+                fmt_ns(r.ecs_1t),
+                r.ecs_1t / r.raw_1t,
+                fmt_ns(r.raw_2t),
+                fmt_ns(r.ecs_2t),
+                r.ecs_2t / r.raw_2t,
+                r.ecs_1t / r.ecs_2t,
+                rapier,
+                vs,
+                r.ecs_1t / floor,
+            );
+        }
+        s.push('\n');
+    }
+    let u = &results.unused_feature;
+    let _ = writeln!(
+        s,
+        "Unused feature ({}): no `Gravity` {} ns vs `Gravity(0)` {} ns per body-step.\n",
+        u.what,
+        fmt_ns(u.without),
+        fmt_ns(u.with_zero)
+    );
+    s.push_str(&targets_table(&results.targets));
+    s
+}
+
+/// The targets as a markdown table.
+pub fn targets_table(targets: &[Target]) -> String {
+    let mut s = String::from("| target | measured | bound | met |\n|---|---:|---:|:---:|\n");
+    for t in targets {
+        let _ = writeln!(
+            s,
+            "| {} | {:.2} | {} {} | {} |",
+            t.name,
+            t.value,
+            t.relation,
+            t.bound,
+            if t.met { "yes" } else { "**no**" }
+        );
+    }
+    s
+}
+
+/// Replaces the text between `<!-- bench:begin -->` and `<!-- bench:end -->`; `None` when the
+/// markers are missing.
+pub fn replace_between_markers(text: &str, section: &str) -> Option<String> {
+    const BEGIN: &str = "<!-- bench:begin -->";
+    const END: &str = "<!-- bench:end -->";
+    let start = text.find(BEGIN)? + BEGIN.len();
+    let end = start + text[start..].find(END)?;
+    Some(format!("{}\n{}{}", &text[..start], section, &text[end..]))
+}
+
+/// The README's section: the latest ratios of the default integrator, and the targets.
+pub fn readme_section(results: &BenchResults) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "Latest `tumble bench` ({} pool threads, {:.1} GB/s copy bandwidth), default integrator, \
+         ns per body-step:\n",
+        results.pool_threads, results.bandwidth_gb_s[0]
+    );
+    let _ = writeln!(
+        s,
+        "| bodies | raw loop | ECS | ECS/raw | ECS, 2 threads | speed-up | rapier | rapier/ECS |"
+    );
+    let _ = writeln!(s, "|---:|---:|---:|---:|---:|---:|---:|---:|");
+    for r in rows_of(results, DEFAULT) {
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {:.2} | {} | {:.2}× | {} | {} |",
+            r.bodies,
+            fmt_ns(r.raw_1t),
+            fmt_ns(r.ecs_1t),
+            r.ecs_1t / r.raw_1t,
+            fmt_ns(r.ecs_2t),
+            r.ecs_1t / r.ecs_2t,
+            r.rapier.map_or("–".into(), fmt_ns),
+            r.rapier
+                .map_or("–".into(), |x| format!("{:.1}×", x / r.ecs_1t)),
+        );
+    }
+    s.push('\n');
+    s.push_str(&targets_table(&results.targets));
+    s
+}

@@ -1,0 +1,63 @@
+//! The benchmark runs end to end on small worlds, its JSON has the documented shape, the
+//! engines agree bit for bit (checked inside the run), and the targets are evaluated.
+
+use tumble_bench::{BenchOptions, output, run_bench};
+
+fn small() -> BenchOptions {
+    BenchOptions {
+        quick: true,
+        max_bodies: Some(100),
+        rapier_max_bodies: 10,
+        out: None,
+        readme: None,
+    }
+}
+
+#[test]
+fn small_run_measures_every_engine_and_writes_json() {
+    let mut lines = Vec::new();
+    let results = run_bench(&small(), |l| lines.push(l.to_owned()));
+    assert!(lines.iter().any(|l| l.contains("bandwidth")));
+    // Sizes 1, 10, 100 × two integrators.
+    assert_eq!(results.rows.len(), 6);
+    for row in &results.rows {
+        for ns in [row.raw_1t, row.raw_2t, row.ecs_1t, row.ecs_2t] {
+            assert!(ns.is_finite() && ns > 0.0, "{row:?}");
+        }
+        assert_eq!(row.rapier.is_some(), row.bodies <= 10, "{row:?}");
+    }
+    assert!(results.bandwidth_gb_s.iter().all(|b| *b > 0.1));
+    assert_eq!(results.fixed_cost_ns.len(), 2);
+    // Targets that need big worlds are left out; the fixed cost and unused-feature ones are in.
+    assert!(
+        results
+            .targets
+            .iter()
+            .any(|t| t.name.contains("fixed cost"))
+    );
+    assert!(!results.targets.iter().any(|t| t.name.contains("1e5")));
+    let json: serde_json::Value = serde_json::to_value(&results).unwrap();
+    assert_eq!(json["schema"], 1);
+    assert!(json["rows"][0]["ecs_1t"].is_number());
+    assert!(json["rows"][0]["rapier"].is_number());
+    let table = output::markdown(&results);
+    assert!(table.contains("| bodies |") && table.contains("splitting"));
+}
+
+#[test]
+fn readme_section_replaces_only_between_markers() {
+    let text = "intro\n<!-- bench:begin -->\nold\n<!-- bench:end -->\noutro\n";
+    let new = output::replace_between_markers(text, "new\n").unwrap();
+    assert_eq!(
+        new,
+        "intro\n<!-- bench:begin -->\nnew\n<!-- bench:end -->\noutro\n"
+    );
+    assert!(output::replace_between_markers("no markers", "x").is_none());
+}
+
+#[test]
+fn bytes_per_body_step_counts_the_ecs_data() {
+    // Transform (32) + Velocity (24) read and written, MassProps read, two change ticks.
+    let bytes = tumble_bench::bytes_per_body_step();
+    assert!((150..=250).contains(&bytes), "{bytes}");
+}
