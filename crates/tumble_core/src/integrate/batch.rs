@@ -9,8 +9,6 @@
 
 use std::borrow::Borrow;
 
-use arrayvec::ArrayVec;
-
 use super::Integrator;
 use super::lanes::LANES;
 use super::splitting::{kick, translate_dkd};
@@ -19,79 +17,94 @@ use crate::mass::MassProperties;
 use crate::rotation::rotate_exact;
 use crate::state::{BodyState, Wrench};
 
-/// A body waiting for its free rotation: index, translated state, kernel input, `h`.
-type Pending = (usize, BodyState, SymmetricInput, f32);
-
-/// Bodies waiting for their free rotation, flushed [`LANES`] at a time.
-struct PendingRotations(ArrayVec<Pending, LANES>);
+/// Bodies waiting for their free rotation, flushed [`LANES`] at a time: each body's translated
+/// state and its kernel inputs. (Inputs stored as structure of arrays were slower: four scalar
+/// stores then one vector load of the same bytes stalls store forwarding.)
+struct PendingRotations {
+    index: [usize; LANES],
+    state: [BodyState; LANES],
+    input: [SymmetricInput; LANES],
+    h: [f32; LANES],
+    len: usize,
+}
 
 impl PendingRotations {
     fn new() -> Self {
-        Self(ArrayVec::new())
+        Self {
+            index: [0; LANES],
+            state: [BodyState::default(); LANES],
+            input: [SymmetricInput::default(); LANES],
+            h: [0.0; LANES],
+            len: 0,
+        }
     }
 
     /// Queues body `index` (already translated, as `state`) for a free rotation over `h`;
     /// spherical bodies rotate at once, exactly about `ω`.
-    #[inline]
+    #[inline(always)]
     fn push(
         &mut self,
         index: usize,
         mut state: BodyState,
         mass: &MassProperties,
         h: f32,
-        done: &mut impl FnMut(usize, BodyState),
+        done: &mut impl FnMut(usize, &BodyState),
     ) {
         if mass.is_spherical() {
             state.rotation = rotate_exact(state.rotation, state.angular_velocity, h);
-            done(index, state);
+            done(index, &state);
             return;
         }
-        let input = SymmetricInput::new(state.rotation, state.angular_velocity, mass);
-        self.0.push((index, state, input, h));
-        if self.0.is_full() {
+        let lane = self.len;
+        self.input[lane] = SymmetricInput::new(state.rotation, state.angular_velocity, mass);
+        self.index[lane] = index;
+        self.state[lane] = state;
+        self.h[lane] = h;
+        self.len = lane + 1;
+        if self.len == LANES {
             self.flush(done);
         }
     }
 
     /// Rotates the queued bodies (a partial batch goes through the scalar kernel, which gives
     /// the same bits) and hands each result to `done`.
-    #[inline]
-    fn flush(&mut self, done: &mut impl FnMut(usize, BodyState)) {
-        if let Ok(full) = <&[Pending; LANES]>::try_from(self.0.as_slice()) {
-            let inputs = full.each_ref().map(|p| p.2);
-            let rotated = rotate_symmetric_lanes(&inputs, full.each_ref().map(|p| p.3));
-            for (pending, (rotation, omega)) in full.iter().zip(rotated) {
-                finish(pending, rotation, omega, done);
+    #[inline(always)]
+    fn flush(&mut self, done: &mut impl FnMut(usize, &BodyState)) {
+        if self.len == LANES {
+            let rotated = rotate_symmetric_lanes(&self.input, self.h);
+            for (lane, (rotation, omega)) in rotated.into_iter().enumerate() {
+                self.finish(lane, rotation, omega, done);
             }
         } else {
-            for pending in &self.0 {
-                let (rotation, omega) = rotate_symmetric_one(&pending.2, pending.3);
-                finish(pending, rotation, omega, done);
+            for lane in 0..self.len {
+                let (rotation, omega) = rotate_symmetric_one(&self.input[lane], self.h[lane]);
+                self.finish(lane, rotation, omega, done);
             }
         }
-        self.0.clear();
+        self.len = 0;
     }
-}
 
-/// Hands a rotated body to `done`.
-#[inline]
-fn finish(
-    pending: &Pending,
-    rotation: glam::Quat,
-    omega: glam::Vec3,
-    done: &mut impl FnMut(usize, BodyState),
-) {
-    let mut state = pending.1;
-    state.rotation = rotation;
-    state.angular_velocity = omega;
-    done(pending.0, state);
+    /// Hands lane `lane`'s rotated body to `done`.
+    #[inline(always)]
+    fn finish(
+        &self,
+        lane: usize,
+        rotation: glam::Quat,
+        omega: glam::Vec3,
+        done: &mut impl FnMut(usize, &BodyState),
+    ) {
+        let mut state = self.state[lane];
+        state.rotation = rotation;
+        state.angular_velocity = omega;
+        done(self.index[lane], &state);
+    }
 }
 
 /// Commits `next` into `states[index]` if it is finite, else records the divergence.
 #[inline]
-fn commit(states: &mut [BodyState], diverged: &mut Vec<usize>, index: usize, next: BodyState) {
+fn commit(states: &mut [BodyState], diverged: &mut Vec<usize>, index: usize, next: &BodyState) {
     if next.is_finite() {
-        states[index] = next;
+        states[index] = *next;
     } else {
         diverged.push(index);
     }
@@ -126,8 +139,8 @@ impl Integrator {
         for i in 0..states.len() {
             let mass = masses[i].borrow();
             let wrench = &wrenches[i];
-            let mut next = states[i];
             if wrench.torque == glam::Vec3::ZERO {
+                let mut next = states[i];
                 translate_dkd(&mut next, mass, wrench, dt);
                 pending.push(i, next, mass, dt, &mut |j, s| {
                     commit(states, &mut diverged, j, s)

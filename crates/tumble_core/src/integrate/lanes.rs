@@ -152,6 +152,25 @@ impl Real for F64x4 {
     }
 }
 
+/// A [`Real`] of exactly [`LANES`] f64 lanes, to load and store batches.
+pub trait Lanes4: Real {
+    /// Lanes from an array.
+    fn from_lanes(lanes: [f64; LANES]) -> Self;
+    /// The lanes as an array.
+    fn lanes(self) -> [f64; LANES];
+}
+
+impl Lanes4 for F64x4 {
+    #[inline(always)]
+    fn from_lanes(lanes: [f64; LANES]) -> Self {
+        Self::new(lanes)
+    }
+    #[inline(always)]
+    fn lanes(self) -> [f64; LANES] {
+        self.to_array()
+    }
+}
+
 /// Round to the nearest integer (ties to even) for `|x| < 2⁵¹`, in plain IEEE additions.
 #[inline(always)]
 fn round_nearest<T: Real>(x: T) -> T {

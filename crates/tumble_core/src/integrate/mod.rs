@@ -25,6 +25,8 @@
 //! | `yoshida4` | Yoshida composition of `splitting` | 4 | round-off | bounded |
 //! | `rk4` | RK4 on `Q̇ = ½ ω(Q) Q` at constant `L` | 4 | exact | slow drift |
 
+#[cfg(target_arch = "x86_64")]
+mod avx;
 mod batch;
 mod frame;
 mod implicit_gyroscopic;

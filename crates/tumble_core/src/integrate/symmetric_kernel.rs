@@ -18,7 +18,7 @@
 
 use glam::{Quat, Vec3};
 
-use super::lanes::{F64x4, LANES, Real, sin_cos};
+use super::lanes::{F64x4, LANES, Lanes4, Real, sin_cos};
 use crate::mass::MassProperties;
 
 /// A quaternion `(x, y, z, w)` in lanes.
@@ -105,8 +105,8 @@ impl<T: Real> Free<T> {
     }
 }
 
-/// Inputs of the kernel for one body (`T = f64`) or four (`T = f64x4`).
-#[derive(Debug, Clone, Copy)]
+/// Inputs of the kernel for one body (`T = f64`) or four (`T = F64x4`).
+#[derive(Debug, Clone, Copy, Default)]
 pub struct SymmetricInput<T = f64> {
     /// Body orientation `q`.
     pub rotation: Quat4<T>,
@@ -166,7 +166,11 @@ fn reciprocal<T: Real>(moment: T) -> T {
 #[inline(always)]
 pub fn symmetric_rotation<T: Real>(input: &SymmetricInput<T>, h: T) -> (Quat4<T>, Vec3L<T>) {
     let inertia = input.inertia;
-    let r = inertia.map(reciprocal);
+    let r = [
+        reciprocal(inertia[0]),
+        reciprocal(inertia[1]),
+        reciprocal(inertia[2]),
+    ];
     let frame = mul(input.frame, input.relabel);
     let q = mul(input.rotation, frame);
     let body = rotate(conjugate(q), input.omega);
@@ -207,8 +211,8 @@ pub fn rotate_symmetric_one(input: &SymmetricInput, h: f32) -> (Quat, Vec3) {
     to_f32(q, w)
 }
 
-/// Four bodies through the kernel at once (`F64x4` lanes), each over its own `h`; lane `i` of
-/// the result is bit-identical to [`rotate_symmetric_one`]`(&inputs[i], h[i])`.
+/// Four bodies through the kernel at once (SIMD lanes), each over its own `h`; lane `i` of the
+/// result is bit-identical to [`rotate_symmetric_one`]`(&inputs[i], h[i])`.
 #[inline]
 pub fn rotate_symmetric_lanes(
     inputs: &[SymmetricInput; LANES],
@@ -224,36 +228,71 @@ pub fn rotate_symmetric_lanes(
     rotate_symmetric_lanes_portable(inputs, h)
 }
 
-/// [`rotate_symmetric_lanes_portable`] compiled with AVX enabled: the same IEEE operations (so
-/// the same bits) in 256-bit registers with three-operand instructions.
+/// The kernel compiled with AVX enabled, on 256-bit registers ([`Avx4`]): the same IEEE
+/// operations, so the same bits.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx")]
 fn rotate_symmetric_lanes_avx(
     inputs: &[SymmetricInput; LANES],
     h: [f32; LANES],
 ) -> [(Quat, Vec3); LANES] {
-    rotate_symmetric_lanes_portable(inputs, h)
+    rotate_symmetric_lanes_in::<super::avx::Avx4>(inputs, h)
 }
 
+/// The kernel on [`F64x4`] lanes (SSE2 pairs on a portable build).
 #[inline(always)]
 fn rotate_symmetric_lanes_portable(
     inputs: &[SymmetricInput; LANES],
     h: [f32; LANES],
 ) -> [(Quat, Vec3); LANES] {
-    fn gather<const N: usize>(lanes: [&[f64; N]; LANES]) -> [F64x4; N] {
-        std::array::from_fn(|c| F64x4::new(lanes.map(|l| l[c])))
+    rotate_symmetric_lanes_in::<F64x4>(inputs, h)
+}
+
+/// Transposes four bodies' inputs into lanes of `T`, runs the kernel, transposes back.
+#[inline(always)]
+fn rotate_symmetric_lanes_in<T: Lanes4>(
+    inputs: &[SymmetricInput; LANES],
+    h: [f32; LANES],
+) -> [(Quat, Vec3); LANES] {
+    // Plain indexing, no closures: inside the AVX function every helper must inline.
+    macro_rules! lane {
+        ($field:ident[$k:expr]) => {
+            T::from_lanes([
+                inputs[0].$field[$k],
+                inputs[1].$field[$k],
+                inputs[2].$field[$k],
+                inputs[3].$field[$k],
+            ])
+        };
     }
     let input = SymmetricInput {
-        rotation: gather(inputs.each_ref().map(|b| &b.rotation)),
-        omega: gather(inputs.each_ref().map(|b| &b.omega)),
-        frame: gather(inputs.each_ref().map(|b| &b.frame)),
-        relabel: gather(inputs.each_ref().map(|b| &b.relabel)),
-        inertia: gather(inputs.each_ref().map(|b| &b.inertia)),
+        rotation: [
+            lane!(rotation[0]),
+            lane!(rotation[1]),
+            lane!(rotation[2]),
+            lane!(rotation[3]),
+        ],
+        omega: [lane!(omega[0]), lane!(omega[1]), lane!(omega[2])],
+        frame: [
+            lane!(frame[0]),
+            lane!(frame[1]),
+            lane!(frame[2]),
+            lane!(frame[3]),
+        ],
+        relabel: [
+            lane!(relabel[0]),
+            lane!(relabel[1]),
+            lane!(relabel[2]),
+            lane!(relabel[3]),
+        ],
+        inertia: [lane!(inertia[0]), lane!(inertia[1]), lane!(inertia[2])],
     };
-    let (q, w) = symmetric_rotation::<F64x4>(&input, F64x4::new(h.map(f64::from)));
-    let q = q.map(|c| c.to_array());
-    let w = w.map(|c| c.to_array());
-    std::array::from_fn(|i| to_f32(q.map(|c| c[i]), w.map(|c| c[i])))
+    let hs = T::from_lanes([h[0] as f64, h[1] as f64, h[2] as f64, h[3] as f64]);
+    let (q, w) = symmetric_rotation::<T>(&input, hs);
+    let [qx, qy, qz, qw] = [q[0].lanes(), q[1].lanes(), q[2].lanes(), q[3].lanes()];
+    let [wx, wy, wz] = [w[0].lanes(), w[1].lanes(), w[2].lanes()];
+    let one = |i: usize| to_f32([qx[i], qy[i], qz[i], qw[i]], [wx[i], wy[i], wz[i]]);
+    [one(0), one(1), one(2), one(3)]
 }
 
 #[cfg(test)]
@@ -272,7 +311,7 @@ mod tests {
             (Vec3::new(3.0, 3.1, 0.2), Vec3::new(1.0, 1.0, 90.0)),
             (Vec3::new(0.0, 1.0, 1.5), Vec3::new(2.0, -1.0, 0.5)),
         ];
-        let inputs: [SymmetricInput; LANES] = std::array::from_fn(|i| {
+        let owned: [SymmetricInput; LANES] = std::array::from_fn(|i| {
             let (inertia, omega) = bodies[i];
             let mass = MassProperties::new(Mass::new(1.0).unwrap(), inertia)
                 .unwrap()
@@ -282,7 +321,7 @@ mod tests {
         });
         let h = [1.0 / 60.0, 0.1, 0.05, 1.0 / 240.0];
         let expected: Vec<(Quat, Vec3)> = (0..LANES)
-            .map(|i| rotate_symmetric_one(&inputs[i], h[i]))
+            .map(|i| rotate_symmetric_one(&owned[i], h[i]))
             .collect();
         let bits = |r: &[(Quat, Vec3)]| -> Vec<u32> {
             r.iter()
@@ -294,10 +333,11 @@ mod tests {
                 })
                 .collect()
         };
+        let inputs = &owned;
         assert_eq!(
-            bits(&rotate_symmetric_lanes_portable(&inputs, h)),
+            bits(&rotate_symmetric_lanes_portable(inputs, h)),
             bits(&expected)
         );
-        assert_eq!(bits(&rotate_symmetric_lanes(&inputs, h)), bits(&expected));
+        assert_eq!(bits(&rotate_symmetric_lanes(inputs, h)), bits(&expected));
     }
 }
