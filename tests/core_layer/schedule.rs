@@ -18,11 +18,9 @@ fn gravity_free_world_has_no_gravity_system() {
     let body = world.spawn((RigidBody, ForceAccumulator::default())).id();
     let plan = PhysicsPlan::for_world(&mut world);
     assert!(!plan.contains(Stage::Gravity));
-    assert_eq!(
-        plan.stages(),
-        &[Stage::IntegrateWithForces, Stage::IntegrateWithoutForces]
-    );
-    assert_eq!(system_count(&mut world, &plan), 2);
+    // One body, with an accumulator: nothing but its integrate system.
+    assert_eq!(plan.stages(), &[Stage::IntegrateWithForces]);
+    assert_eq!(system_count(&mut world, &plan), 1);
     let mut schedule = plan.build_schedule();
     for _ in 0..10 {
         schedule.run(&mut world);
@@ -50,13 +48,12 @@ fn each_generator_kind_adds_exactly_its_system() {
             Stage::Gravity,
             Stage::ConstantForces,
             Stage::IntegrateWithForces,
-            Stage::IntegrateWithoutForces
         ]
     );
-    assert_eq!(system_count(&mut world, &plan), 4);
+    assert_eq!(system_count(&mut world, &plan), 3);
     assert_eq!(
         plan.to_string(),
-        "apply_gravity → apply_constant_forces → integrate_with_forces → integrate_without_forces"
+        "apply_gravity → apply_constant_forces → integrate_with_forces"
     );
     world.spawn(Spring {
         a: body,
@@ -71,9 +68,107 @@ fn each_generator_kind_adds_exactly_its_system() {
         torque: Vec3::Y,
     });
     let plan = PhysicsPlan::for_world(&mut world);
-    assert_eq!(plan.stages().len(), 6);
+    assert_eq!(plan.stages().len(), 5);
     assert!(plan.contains(Stage::Springs) && plan.contains(Stage::ConstantTorques));
-    assert_eq!(system_count(&mut world, &plan), 6);
+    assert_eq!(system_count(&mut world, &plan), 5);
+}
+
+#[test]
+fn static_and_kinematic_bodies_are_never_integrated() {
+    let mut world = world_with(0.01, Integrator::Splitting);
+    world.insert_resource(Gravity::EARTH_Y_DOWN);
+    let moving = Velocity {
+        linear: Vec3::X,
+        angular: Vec3::new(0.0, 2.0, 1.0),
+    };
+    let wall = world.spawn((RigidBody, Static, moving)).id();
+    let platform = world.spawn((RigidBody, Kinematic, moving)).id();
+    // Only fixed bodies: nothing to integrate, no system at all.
+    assert!(PhysicsPlan::for_world(&mut world).stages().is_empty());
+    // A dynamic body hanging from the static one by a spring: the spring pulls on both ends, the
+    // static end's share is discarded every step.
+    let ball = world
+        .spawn((
+            RigidBody,
+            Transform::from_translation(Vec3::new(0.0, -1.0, 0.0)),
+        ))
+        .id();
+    world.spawn(Spring {
+        a: ball,
+        anchor_a: Vec3::ZERO,
+        b: SpringEnd::Body {
+            body: wall,
+            anchor: Vec3::ZERO,
+        },
+        stiffness: 50.0,
+        damping: 0.0,
+        rest_length: 0.5,
+    });
+    let plan = PhysicsPlan::for_world(&mut world);
+    assert_eq!(
+        plan.to_string(),
+        "begin_step → apply_gravity → apply_springs → integrate_with_forces → \
+         discard_fixed_body_forces"
+    );
+    let mut schedule = plan.build_schedule();
+    for _ in 0..100 {
+        schedule.run(&mut world);
+        world.clear_trackers();
+    }
+    for fixed in [wall, platform] {
+        assert_eq!(*world.get::<Transform>(fixed).unwrap(), Transform::IDENTITY);
+        assert_eq!(*world.get::<Velocity>(fixed).unwrap(), moving);
+    }
+    assert_eq!(
+        *world.get::<ForceAccumulator>(wall).unwrap(),
+        ForceAccumulator::default()
+    );
+    let y = world.get::<Transform>(ball).unwrap().translation.y;
+    assert!(
+        y < -0.5 && y > -2.0,
+        "the ball oscillates on its spring: y = {y}"
+    );
+}
+
+#[test]
+fn the_runner_replans_when_the_world_changes() {
+    let mut world = world_with(0.01, Integrator::SymplecticEuler);
+    let body = world.spawn(RigidBody).id();
+    let mut physics = PhysicsRunner::new(&mut world);
+    assert_eq!(physics.plan().to_string(), "integrate_without_forces");
+    physics.step(&mut world);
+    assert_eq!(physics.replans(), 0);
+    // Gravity for a body without accumulator needs no extra system: same plan.
+    world.insert_resource(Gravity::EARTH_Y_DOWN);
+    physics.step(&mut world);
+    assert_eq!(physics.replans(), 0);
+    // A torque generator: an accumulator appears, the plan changes.
+    let torque = world
+        .spawn(ConstantTorque {
+            body,
+            torque: Vec3::Y,
+        })
+        .id();
+    physics.step(&mut world);
+    assert_eq!(
+        physics.plan().to_string(),
+        "apply_gravity → apply_constant_torques → integrate_with_forces"
+    );
+    assert_eq!(physics.replans(), 1);
+    assert!(world.get::<Velocity>(body).unwrap().angular.y > 0.0);
+    // The generator goes away: its system goes too.
+    world.despawn(torque);
+    physics.step(&mut world);
+    assert_eq!(
+        physics.plan().to_string(),
+        "apply_gravity → integrate_with_forces"
+    );
+    // Switching to a drift–kick–drift integrator adds the first half-drift.
+    world.resource_mut::<PhysicsSettings>().integrator = Integrator::Splitting;
+    physics.step(&mut world);
+    assert!(physics.plan().contains(Stage::BeginStep));
+    assert_eq!(physics.replans(), 3);
+    assert_eq!(format!("{physics}"), physics.plan().to_string());
 }
 
 #[test]

@@ -137,14 +137,22 @@ fn scenes_lists_the_bundled_scenes_and_plan_prints_the_systems() {
         assert!(text.contains(name), "{text}");
     }
     let plan = tumble()
-        .args(["run", "projectile", "--plan"])
+        .args(["run", "spinning_top", "--plan"])
         .output()
         .unwrap();
     let plan = String::from_utf8_lossy(&plan.stdout);
     assert!(
-        plan.contains("apply_gravity") && !plan.contains("apply_springs"),
+        plan.contains("apply_constant_forces") && !plan.contains("apply_springs"),
         "{plan}"
     );
+    // The projectile's bodies have no accumulator: gravity needs no system of its own.
+    let plan = tumble()
+        .args(["run", "projectile", "--plan"])
+        .output()
+        .unwrap();
+    let plan = String::from_utf8_lossy(&plan.stdout);
+    assert!(plan.trim_end().ends_with("integrate_without_forces"), "{plan}");
+    assert!(!plan.contains("apply_gravity"), "{plan}");
 }
 
 #[test]

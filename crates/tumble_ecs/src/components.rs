@@ -15,6 +15,17 @@ use crate::validate::revalidate_body_hook;
 #[require(Transform, Velocity, MassProps)]
 pub struct RigidBody;
 
+/// Marks a rigid body that never moves: it is never integrated (forces on it are discarded), but
+/// springs may anchor to it and its mass properties still count where they are read.
+#[derive(Component, Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Static;
+
+/// Marks a rigid body that game code moves (by writing its [`Transform`] and [`Velocity`]): tumble
+/// never integrates it and discards forces on it; springs attached to it see its pose and
+/// velocity as the game sets them.
+#[derive(Component, Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Kinematic;
+
 /// Pose of the body origin in world coordinates.
 ///
 /// The centre of mass sits at `translation + rotation * c`, with `c` the local centre of mass of

@@ -111,13 +111,13 @@ pub type ForceTargets<'w, 's> = Query<
     (With<RigidBody>, Without<Rejected>),
 >;
 
-/// Adds `m g s` to every body with an accumulator (`s` = [`GravityScale`], default 1).
+/// Adds `m g s` to every dynamic body with an accumulator (`s` = [`GravityScale`], default 1).
 /// Only in the schedule when a [`Gravity`] resource exists.
 pub fn apply_gravity(
     gravity: Res<Gravity>,
     mut bodies: Query<
         (&MassProps, Option<&GravityScale>, &mut ForceAccumulator),
-        (With<RigidBody>, Without<Rejected>),
+        crate::systems::Dynamic,
     >,
 ) {
     let g = gravity.0;

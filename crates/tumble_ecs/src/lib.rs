@@ -15,6 +15,7 @@
 pub mod components;
 pub mod forces;
 pub mod parallel;
+pub mod runner;
 pub mod schedule;
 pub mod stability;
 pub mod stepper;
@@ -24,11 +25,12 @@ pub mod validate;
 /// Everything a game loop needs, in one import.
 pub mod prelude {
     pub use crate::components::{
-        Damping, ForceAccumulator, Gravity, GravityScale, MassProps, PhysicsSettings, RigidBody,
-        Transform, Velocity,
+        Damping, ForceAccumulator, Gravity, GravityScale, Kinematic, MassProps, PhysicsSettings,
+        RigidBody, Static, Transform, Velocity,
     };
     pub use crate::forces::{ConstantForce, ConstantTorque, Spring, SpringEnd};
     pub use crate::parallel::Parallelism;
+    pub use crate::runner::PhysicsRunner;
     pub use crate::schedule::{PhysicsPlan, PhysicsSchedule, PhysicsSet, Stage};
     pub use crate::stability::{StabilityWarning, check_stability};
     pub use crate::stepper::{FixedStepper, FrameSteps, interpolate};

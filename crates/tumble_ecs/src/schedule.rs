@@ -18,12 +18,17 @@ use std::fmt;
 use bevy_ecs::prelude::*;
 use bevy_ecs::schedule::{ScheduleBuildSettings, ScheduleLabel};
 
-use crate::components::{ForceAccumulator, Gravity, PhysicsSettings};
+use bevy_ecs::component::ComponentId;
+
+use crate::components::{ForceAccumulator, Gravity, Kinematic, PhysicsSettings, RigidBody, Static};
 use crate::forces::{
     ConstantForce, ConstantTorque, Spring, apply_constant_forces, apply_constant_torques,
     apply_gravity, apply_springs,
 };
-use crate::systems::{HalfDrifted, begin_step, integrate_with_forces, integrate_without_forces};
+use crate::systems::{
+    HalfDrifted, begin_step, discard_fixed_body_forces, integrate_with_forces,
+    integrate_without_forces,
+};
 
 /// Label of the schedule that advances physics by one fixed step.
 #[derive(ScheduleLabel, Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
@@ -59,6 +64,8 @@ pub enum Stage {
     IntegrateWithForces,
     /// [`integrate_without_forces`].
     IntegrateWithoutForces,
+    /// [`discard_fixed_body_forces`].
+    DiscardFixedBodyForces,
 }
 
 impl Stage {
@@ -72,47 +79,121 @@ impl Stage {
             Stage::Springs => "apply_springs",
             Stage::IntegrateWithForces => "integrate_with_forces",
             Stage::IntegrateWithoutForces => "integrate_without_forces",
+            Stage::DiscardFixedBodyForces => "discard_fixed_body_forces",
         }
     }
 }
 
 /// Which systems a world needs, decided from its resources and entities.
 ///
-/// Build it after spawning the force generators; plan again when the world gains a kind of
-/// generator or a [`Gravity`] resource it did not have.
+/// - `begin_step` only for a drift–kick–drift integrator and dynamic bodies with accumulators;
+/// - `apply_gravity` only with a [`Gravity`] resource and dynamic bodies with accumulators
+///   (bodies without one get gravity inside `integrate_without_forces`, at no extra pass);
+/// - one system per kind of force generator that exists;
+/// - `integrate_with_forces` / `integrate_without_forces` only if there are dynamic bodies with
+///   / without an accumulator ([`Static`] and [`Kinematic`] bodies are never integrated);
+/// - `discard_fixed_body_forces` only if a static or kinematic body has an accumulator.
+///
+/// [`PhysicsPlan::of`] is cheap (one pass over the archetypes, no allocation beyond the plan), so
+/// [`PhysicsRunner`](crate::runner::PhysicsRunner) re-plans every step and rebuilds the schedule
+/// only when the plan changes.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct PhysicsPlan {
     stages: Vec<Stage>,
 }
 
+/// What the world holds, as far as planning cares.
+#[derive(Debug, Default, Clone, Copy)]
+struct Contents {
+    dynamic_with_accumulator: bool,
+    dynamic_without_accumulator: bool,
+    fixed_with_accumulator: bool,
+    constant_forces: bool,
+    constant_torques: bool,
+    springs: bool,
+}
+
+impl Contents {
+    /// One pass over the non-empty archetypes.
+    fn of(world: &World) -> Self {
+        let id = |c: Option<ComponentId>| c;
+        let body = id(world.component_id::<RigidBody>());
+        let acc = id(world.component_id::<ForceAccumulator>());
+        let fixed = [
+            world.component_id::<Static>(),
+            world.component_id::<Kinematic>(),
+        ];
+        let force = world.component_id::<ConstantForce>();
+        let torque = world.component_id::<ConstantTorque>();
+        let spring = world.component_id::<Spring>();
+        let mut out = Contents::default();
+        for archetype in world.archetypes().iter().filter(|a| !a.is_empty()) {
+            let has = |c: Option<ComponentId>| c.is_some_and(|c| archetype.contains(c));
+            if has(body) {
+                let is_fixed = fixed.iter().any(|&c| has(c));
+                match (is_fixed, has(acc)) {
+                    (false, true) => out.dynamic_with_accumulator = true,
+                    (false, false) => out.dynamic_without_accumulator = true,
+                    (true, true) => out.fixed_with_accumulator = true,
+                    (true, false) => {}
+                }
+            }
+            out.constant_forces |= has(force);
+            out.constant_torques |= has(torque);
+            out.springs |= has(spring);
+        }
+        out
+    }
+}
+
 impl PhysicsPlan {
-    /// Plans the step for `world`. Inserts default [`PhysicsSettings`] if the world has none.
-    /// Settings outside the integrator's stable region are reported through `tracing` (see
+    /// Plans the step for `world`: [`of`](Self::of) after inserting default
+    /// [`PhysicsSettings`] (if missing) and the bookkeeping resource, with settings outside the
+    /// integrator's stable region reported through `tracing` (see
     /// [`check_stability`](crate::stability::check_stability)).
     pub fn for_world(world: &mut World) -> Self {
-        let settings = *world.get_resource_or_init::<PhysicsSettings>();
+        world.get_resource_or_init::<PhysicsSettings>();
         for warning in crate::stability::check_stability(world) {
             tracing::warn!("{warning}");
         }
         world.init_resource::<HalfDrifted>();
-        let mut stages = Vec::with_capacity(7);
-        if settings.integrator.samples_forces_at_midpoint() && has_any::<ForceAccumulator>(world) {
+        Self::of(world)
+    }
+
+    /// The plan for `world` as it is now, without side effects.
+    pub fn of(world: &World) -> Self {
+        let midpoint = world
+            .get_resource::<PhysicsSettings>()
+            .copied()
+            .unwrap_or_default()
+            .integrator
+            .samples_forces_at_midpoint();
+        let c = Contents::of(world);
+        let mut stages = Vec::with_capacity(8);
+        if midpoint && c.dynamic_with_accumulator {
             stages.push(Stage::BeginStep);
         }
-        if world.contains_resource::<Gravity>() {
+        if world.contains_resource::<Gravity>() && c.dynamic_with_accumulator {
             stages.push(Stage::Gravity);
         }
-        if has_any::<ConstantForce>(world) {
+        if c.constant_forces {
             stages.push(Stage::ConstantForces);
         }
-        if has_any::<ConstantTorque>(world) {
+        if c.constant_torques {
             stages.push(Stage::ConstantTorques);
         }
-        if has_any::<Spring>(world) {
+        if c.springs {
             stages.push(Stage::Springs);
         }
-        stages.push(Stage::IntegrateWithForces);
-        stages.push(Stage::IntegrateWithoutForces);
+        if c.dynamic_with_accumulator {
+            stages.push(Stage::IntegrateWithForces);
+        }
+        if c.dynamic_without_accumulator {
+            stages.push(Stage::IntegrateWithoutForces);
+        }
+        if c.fixed_with_accumulator {
+            stages.push(Stage::DiscardFixedBodyForces);
+        }
         Self { stages }
     }
 
@@ -153,7 +234,9 @@ impl PhysicsPlan {
             let set = match stage {
                 Stage::BeginStep => PhysicsSet::Prepare,
                 Stage::Gravity => PhysicsSet::Gravity,
-                Stage::IntegrateWithForces | Stage::IntegrateWithoutForces => PhysicsSet::Integrate,
+                Stage::IntegrateWithForces
+                | Stage::IntegrateWithoutForces
+                | Stage::DiscardFixedBodyForces => PhysicsSet::Integrate,
                 _ => PhysicsSet::Forces,
             };
             add_stage(&mut schedule, stage, set, previous);
@@ -176,16 +259,13 @@ fn add_stage(schedule: &mut Schedule, stage: Stage, set: PhysicsSet, after: Opti
         Stage::Springs => apply_springs.into_configs(),
         Stage::IntegrateWithForces => integrate_with_forces.into_configs(),
         Stage::IntegrateWithoutForces => integrate_without_forces.into_configs(),
+        Stage::DiscardFixedBodyForces => discard_fixed_body_forces.into_configs(),
     };
     let config = config.in_set(set).in_set(StageSet(stage));
     match after {
         Some(prev) => schedule.add_systems(config.after(StageSet(prev))),
         None => schedule.add_systems(config),
     };
-}
-
-fn has_any<C: Component>(world: &mut World) -> bool {
-    world.query::<&C>().iter(world).next().is_some()
 }
 
 impl fmt::Display for PhysicsPlan {

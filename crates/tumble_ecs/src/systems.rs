@@ -11,8 +11,8 @@ use bevy_ecs::prelude::*;
 use tumble_core::{BodyState, MassProperties, Wrench};
 
 use crate::components::{
-    Damping, ForceAccumulator, Gravity, GravityScale, MassProps, PhysicsSettings, RigidBody,
-    Transform, Velocity, body_state, write_body_state,
+    Damping, ForceAccumulator, Gravity, GravityScale, Kinematic, MassProps, PhysicsSettings,
+    RigidBody, Static, Transform, Velocity, body_state, write_body_state,
 };
 use crate::parallel::Parallelism;
 use crate::validate::{BodyError, BodyErrorKind, Rejected, check_accumulator, check_body, reject};
@@ -262,6 +262,31 @@ fn reject_all(commands: &mut Commands, errors: Vec<BodyError>) {
     }
 }
 
+/// The bodies the integrate systems step: valid rigid bodies that are neither [`Static`] nor
+/// [`Kinematic`].
+pub type Dynamic = (
+    With<RigidBody>,
+    Without<Rejected>,
+    Without<Static>,
+    Without<Kinematic>,
+);
+
+/// Zeroes the accumulators of [`Static`] and [`Kinematic`] bodies (springs may push on them;
+/// they are never integrated, so the forces are discarded rather than left to pile up). In the
+/// schedule only when such a body has an accumulator.
+pub fn discard_fixed_body_forces(
+    mut bodies: Query<
+        &mut ForceAccumulator,
+        (With<RigidBody>, Or<(With<Static>, With<Kinematic>)>),
+    >,
+) {
+    for mut acc in &mut bodies {
+        if *acc != ForceAccumulator::default() {
+            *acc = ForceAccumulator::default();
+        }
+    }
+}
+
 /// Set by [`begin_step`] when it has drifted the bodies with accumulators half a step, so that
 /// [`integrate_with_forces`] finishes the step instead of taking a whole one. Reset every step.
 #[derive(Resource, Debug, Default, Clone, Copy, PartialEq, Eq)]
@@ -284,7 +309,7 @@ pub fn begin_step(
             &MassProps,
             &ForceAccumulator,
         ),
-        (With<RigidBody>, Without<Rejected>),
+        Dynamic,
     >,
 ) {
     if !settings.integrator.samples_forces_at_midpoint() {
@@ -327,7 +352,7 @@ pub fn integrate_with_forces(
             &mut ForceAccumulator,
             Option<&Damping>,
         ),
-        (With<RigidBody>, Without<Rejected>),
+        Dynamic,
     >,
 ) {
     let phase = if drifted.0 {
@@ -377,11 +402,7 @@ pub fn integrate_without_forces(
             Option<&GravityScale>,
             Option<&Damping>,
         ),
-        (
-            With<RigidBody>,
-            Without<Rejected>,
-            Without<ForceAccumulator>,
-        ),
+        (Dynamic, Without<ForceAccumulator>),
     >,
 ) {
     let gravity = gravity.map(|g| g.0);

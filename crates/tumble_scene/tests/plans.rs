@@ -1,0 +1,56 @@
+//! Each bundled scene gets exactly the systems it needs, no more: the expected lists follow from
+//! the rules of `PhysicsPlan` (a gravity system only for bodies with accumulators, one system per
+//! kind of generator, the first half-drift only for drift–kick–drift methods with forces).
+
+use bevy_ecs::prelude::World;
+use tumble_ecs::prelude::PhysicsPlan;
+use tumble_scene::load_scene;
+
+fn plan_of(name: &str) -> (String, usize) {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../scenes")
+        .join(format!("{name}.toml"));
+    let mut built = load_scene(&path).unwrap().build();
+    let world: &mut World = &mut built.world;
+    built.schedule.initialize(world).unwrap();
+    (
+        PhysicsPlan::for_world(world).to_string(),
+        built.schedule.systems_len(),
+    )
+}
+
+#[test]
+fn every_bundled_scene_has_exactly_the_systems_it_needs() {
+    let free = "integrate_without_forces";
+    let expected = [
+        // Torque-free bodies (gravity, where present, is applied inside the integrate pass).
+        ("dzhanibekov", free),
+        ("far_away", free),
+        ("long_run", free),
+        ("principal_spins", free),
+        ("projectile", free),
+        ("thin_rod", free),
+        // A force at a point on the top; springs between bodies.
+        (
+            "spinning_top",
+            "begin_step → apply_constant_forces → integrate_with_forces",
+        ),
+        (
+            "spring_chain",
+            "begin_step → apply_springs → integrate_with_forces",
+        ),
+        (
+            "mass_ratio",
+            "begin_step → apply_springs → integrate_with_forces",
+        ),
+    ];
+    for (scene, systems) in expected {
+        let (plan, count) = plan_of(scene);
+        assert_eq!(plan, systems, "{scene}");
+        assert_eq!(
+            count,
+            systems.split(" → ").count(),
+            "{scene}: schedule size"
+        );
+    }
+}
