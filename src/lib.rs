@@ -28,6 +28,18 @@
 //! The crates: [`core`] (ECS-free math: state, mass properties, integrators, invariants) and
 //! [`ecs`] (components, systems, schedule). `glam`, `bevy_ecs` (and `parry3d` with the `parry`
 //! feature) are re-exported so versions always match.
+//!
+//! Features (a build pays only for what it enables):
+//!
+//! | feature | default | adds |
+//! |---|---|---|
+//! | `parry` | yes | mass properties from parry3d shapes |
+//! | `parallel` | yes | big tables split over bevy's compute pool (bit-identical results) |
+//! | `scene` | no | `tumble::scene`: TOML scene files, CSV trajectories |
+//! | `serde` | no | serde for every component and resource; `ecs::snapshot` save / resume |
+//! | `bevy_app` | no | `ecs::plugin::TumblePlugin`: the step in a Bevy app's `FixedUpdate` |
+//!
+//! `--no-default-features` is the bare integrator layer on `bevy_ecs` and `glam` only.
 
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
@@ -38,6 +50,9 @@ pub use glam;
 pub use parry3d;
 pub use tumble_core as core;
 pub use tumble_ecs as ecs;
+/// Scene files and trajectories (feature `scene`).
+#[cfg(feature = "scene")]
+pub use tumble_scene as scene;
 
 /// Everything a game loop needs, in one import.
 pub mod prelude {

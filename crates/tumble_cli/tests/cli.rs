@@ -151,7 +151,10 @@ fn scenes_lists_the_bundled_scenes_and_plan_prints_the_systems() {
         .output()
         .unwrap();
     let plan = String::from_utf8_lossy(&plan.stdout);
-    assert!(plan.trim_end().ends_with("integrate_without_forces"), "{plan}");
+    assert!(
+        plan.trim_end().ends_with("integrate_without_forces"),
+        "{plan}"
+    );
     assert!(!plan.contains("apply_gravity"), "{plan}");
 }
 

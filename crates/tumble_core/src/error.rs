@@ -44,6 +44,9 @@ pub enum InvalidInput {
     /// The time step must be strictly positive and finite.
     #[error("time step must be > 0 and finite, got {0}")]
     NonPositiveTimeStep(f32),
+    /// Saved data whose parts disagree (e.g. moments and their stored reciprocals).
+    #[error("inconsistent saved data: {0}")]
+    Inconsistent(&'static str),
 }
 
 /// Checks that `value` is finite.

@@ -22,6 +22,8 @@ pub mod invariants;
 pub mod mass;
 pub mod reference;
 pub mod rotation;
+#[cfg(feature = "serde")]
+mod serde_impls;
 #[cfg(feature = "parry")]
 pub mod shapes;
 pub mod state;

@@ -65,6 +65,14 @@ impl Density {
 /// moments, where a zero moment locks that axis (`1/0` is stored as `0`): no torque can spin the
 /// body about it and every integrator holds the angular velocity about it at zero.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(
+        try_from = "crate::serde_impls::MassPropertiesData",
+        into = "crate::serde_impls::MassPropertiesData"
+    )
+)]
 pub struct MassProperties {
     inv_mass: f32,
     principal_inertia: Vec3,
@@ -80,6 +88,24 @@ fn locked_reciprocal(moment: f32) -> f32 {
 }
 
 impl MassProperties {
+    /// Assembles already-validated parts (used by deserialization after its checks).
+    #[cfg(feature = "serde")]
+    pub(crate) fn from_parts(
+        inv_mass: f32,
+        principal_inertia: Vec3,
+        inv_principal_inertia: Vec3,
+        principal_frame: Quat,
+        local_center_of_mass: Vec3,
+    ) -> Self {
+        Self {
+            inv_mass,
+            principal_inertia,
+            inv_principal_inertia,
+            principal_frame,
+            local_center_of_mass,
+        }
+    }
+
     /// Mass properties from a mass and principal moments of inertia (kg·m²) about body axes,
     /// centre of mass at the body origin.
     ///

@@ -9,6 +9,7 @@ use crate::error::{InvalidInput, check_finite_vec3, check_unit_quat};
 /// `position` is the world position of the centre of mass, `rotation` maps body coordinates to
 /// world coordinates, `angular_velocity` is in world coordinates.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct BodyState {
     /// World position of the centre of mass `x` (m).
     pub position: Vec3,
@@ -61,6 +62,7 @@ impl BodyState {
 ///
 /// `torque` is about the centre of mass, in world coordinates.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Wrench {
     /// Net force `F` (N), world frame.
     pub force: Vec3,

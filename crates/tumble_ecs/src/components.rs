@@ -12,18 +12,21 @@ use crate::validate::revalidate_body_hook;
 /// Requires [`Transform`], [`Velocity`] and [`MassProps`] (inserted with their defaults when
 /// missing: identity pose, at rest, 1 kg with unit principal moments).
 #[derive(Component, Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[require(Transform, Velocity, MassProps)]
 pub struct RigidBody;
 
 /// Marks a rigid body that never moves: it is never integrated (forces on it are discarded), but
 /// springs may anchor to it and its mass properties still count where they are read.
 #[derive(Component, Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Static;
 
 /// Marks a rigid body that game code moves (by writing its [`Transform`] and [`Velocity`]): tumble
 /// never integrates it and discards forces on it; springs attached to it see its pose and
 /// velocity as the game sets them.
 #[derive(Component, Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Kinematic;
 
 /// Pose of the body origin in world coordinates.
@@ -31,6 +34,7 @@ pub struct Kinematic;
 /// The centre of mass sits at `translation + rotation * c`, with `c` the local centre of mass of
 /// the body's [`MassProps`].
 #[derive(Component, Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[component(on_insert = revalidate_body_hook)]
 pub struct Transform {
     /// World position of the body origin (m).
@@ -91,6 +95,7 @@ impl Transform {
 
 /// Velocity of the centre of mass and angular velocity, both in world coordinates.
 #[derive(Component, Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[component(on_insert = revalidate_body_hook)]
 pub struct Velocity {
     /// Linear velocity of the centre of mass `v` (m/s).
@@ -128,6 +133,7 @@ impl Velocity {
 ///
 /// Immutable: to change the mass, insert a new `MassProps`.
 #[derive(Component, Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[component(immutable)]
 pub struct MassProps(pub MassProperties);
 
@@ -159,6 +165,7 @@ impl From<MassProperties> for MassProps {
 /// [`PhysicsSet::Forces`](crate::schedule::PhysicsSet::Forces)) is applied in the next step
 /// exactly once, and nothing needs to clear it at the start of a step.
 #[derive(Component, Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[component(on_insert = revalidate_body_hook)]
 pub struct ForceAccumulator {
     /// Accumulated force `ΣF` (N), world frame.
@@ -205,6 +212,7 @@ impl ForceAccumulator {
 
 /// Multiplies the world [`Gravity`] for one body (1 = normal, 0 = none, −1 = reversed).
 #[derive(Component, Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct GravityScale(pub f32);
 
 impl Default for GravityScale {
@@ -216,6 +224,7 @@ impl Default for GravityScale {
 /// Velocity damping, Padé form as rapier and avian use it: `v ← v / (1 + Δt c_lin)`,
 /// `ω ← ω / (1 + Δt c_ang)` after each step. Coefficients in 1/s, `>= 0`.
 #[derive(Component, Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Damping {
     /// Linear coefficient `c_lin` (1/s).
     pub linear: f32,
@@ -225,6 +234,7 @@ pub struct Damping {
 
 /// Uniform gravitational acceleration `g` (m/s²). Absent resource ⇒ no gravity system at all.
 #[derive(Resource, Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Gravity(pub Vec3);
 
 impl Gravity {
@@ -235,6 +245,11 @@ impl Gravity {
 /// The step size and integrator of a world. The time step is validated on construction and the
 /// field is private, so a world never holds `Δt ≤ 0` or a non-finite `Δt`.
 #[derive(Resource, Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(try_from = "PhysicsSettingsData", into = "PhysicsSettingsData")
+)]
 pub struct PhysicsSettings {
     dt: f32,
     /// The integration method for every body of the world.
@@ -259,6 +274,33 @@ impl PhysicsSettings {
         tumble_core::error::check_time_step(dt)?;
         self.dt = dt;
         Ok(())
+    }
+}
+
+/// The saved form of [`PhysicsSettings`], checked on load.
+#[cfg(feature = "serde")]
+#[derive(serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct PhysicsSettingsData {
+    dt: f32,
+    integrator: Integrator,
+}
+
+#[cfg(feature = "serde")]
+impl TryFrom<PhysicsSettingsData> for PhysicsSettings {
+    type Error = InvalidInput;
+    fn try_from(d: PhysicsSettingsData) -> Result<Self, InvalidInput> {
+        PhysicsSettings::new(d.dt, d.integrator)
+    }
+}
+
+#[cfg(feature = "serde")]
+impl From<PhysicsSettings> for PhysicsSettingsData {
+    fn from(s: PhysicsSettings) -> Self {
+        Self {
+            dt: s.dt,
+            integrator: s.integrator,
+        }
     }
 }
 

@@ -15,6 +15,7 @@ use crate::validate::Rejected;
 
 /// A constant world-frame force on `body`, through a body-local point (or the centre of mass).
 #[derive(Component, Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[component(on_insert = ensure_accumulators)]
 pub struct ConstantForce {
     /// The body that receives the force.
@@ -28,6 +29,7 @@ pub struct ConstantForce {
 
 /// A constant world-frame torque on `body`.
 #[derive(Component, Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[component(on_insert = ensure_accumulators)]
 pub struct ConstantTorque {
     /// The body that receives the torque.
@@ -38,6 +40,7 @@ pub struct ConstantTorque {
 
 /// The second end of a [`Spring`].
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum SpringEnd {
     /// A point fixed in the world (m).
     World(Vec3),
@@ -57,6 +60,7 @@ pub enum SpringEnd {
 /// `F_a = −(k (|d| − L₀) + c (u·n)) n` and `b` receives `−F_a`, each at its anchor (so with the
 /// matching torques). At `|d| = 0` the direction is undefined and no force is applied.
 #[derive(Component, Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[component(on_insert = ensure_accumulators)]
 pub struct Spring {
     /// First body.

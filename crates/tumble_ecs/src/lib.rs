@@ -15,8 +15,12 @@
 pub mod components;
 pub mod forces;
 pub mod parallel;
+#[cfg(feature = "bevy_app")]
+pub mod plugin;
 pub mod runner;
 pub mod schedule;
+#[cfg(feature = "serde")]
+pub mod snapshot;
 pub mod stability;
 pub mod stepper;
 pub mod systems;

@@ -10,6 +10,7 @@ use bevy_ecs::prelude::*;
 
 /// Threading policy of the physics systems. Optional resource: without it the defaults apply.
 #[derive(Resource, Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Parallelism {
     /// Use the thread pool at all (only has an effect with the `parallel` feature).
     pub enabled: bool,

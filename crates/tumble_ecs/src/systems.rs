@@ -290,6 +290,7 @@ pub fn discard_fixed_body_forces(
 /// Set by [`begin_step`] when it has drifted the bodies with accumulators half a step, so that
 /// [`integrate_with_forces`] finishes the step instead of taking a whole one. Reset every step.
 #[derive(Resource, Debug, Default, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct HalfDrifted(pub bool);
 
 /// First phase of a drift–kick–drift step for bodies with a [`ForceAccumulator`]: half a drift

@@ -35,6 +35,9 @@ pub enum BodyErrorKind {
     /// The integrator produced a non-finite state; the body keeps its last finite state.
     #[error(transparent)]
     Diverged(#[from] StepError),
+    /// The body was already quarantined in a restored snapshot, for this reason.
+    #[error("quarantined before the snapshot: {0}")]
+    Restored(String),
 }
 
 /// A body-level error, naming the entity.
