@@ -9,10 +9,10 @@
 
 use std::borrow::Borrow;
 
-use super::Integrator;
 use super::lanes::LANES;
 use super::splitting::{kick, translate_dkd};
 use super::symmetric_kernel::{SymmetricInput, rotate_symmetric_lanes, rotate_symmetric_one};
+use super::{Integrator, StepError};
 use crate::mass::MassProperties;
 use crate::rotation::rotate_exact;
 use crate::state::{BodyState, Wrench};
@@ -110,6 +110,52 @@ fn commit(states: &mut [BodyState], diverged: &mut Vec<usize>, index: usize, nex
     }
 }
 
+/// Steps every body alone with `single` (the methods without a batched kernel); returns the
+/// indices of the bodies that diverged.
+fn each_alone<M: Borrow<MassProperties>>(
+    states: &mut [BodyState],
+    masses: &[M],
+    mut single: impl FnMut(usize, &mut BodyState, &MassProperties) -> Result<(), StepError>,
+) -> Vec<usize> {
+    let mut diverged = Vec::new();
+    for (i, state) in states.iter_mut().enumerate() {
+        if single(i, state, masses[i].borrow()).is_err() {
+            diverged.push(i);
+        }
+    }
+    diverged
+}
+
+/// The `splitting` batch: `translate(i, next, mass)` does a body's scalar part on a copy and
+/// returns the time over which it then rotates freely (queued for the SIMD kernel), or `None` if
+/// the body needs the whole scalar step `alone` instead. Returns the diverged indices, sorted.
+fn batched<M: Borrow<MassProperties>>(
+    states: &mut [BodyState],
+    masses: &[M],
+    mut translate: impl FnMut(usize, &mut BodyState, &MassProperties) -> Option<f32>,
+    mut alone: impl FnMut(usize, &mut BodyState, &MassProperties) -> Result<(), StepError>,
+) -> Vec<usize> {
+    let mut diverged = Vec::new();
+    let mut pending = PendingRotations::new();
+    for i in 0..states.len() {
+        let mass = masses[i].borrow();
+        let mut next = states[i];
+        match translate(i, &mut next, mass) {
+            Some(h) => pending.push(i, next, mass, h, &mut |j, s| {
+                commit(states, &mut diverged, j, s)
+            }),
+            None => {
+                if alone(i, &mut states[i], mass).is_err() {
+                    diverged.push(i);
+                }
+            }
+        }
+    }
+    pending.flush(&mut |j, s| commit(states, &mut diverged, j, s));
+    diverged.sort_unstable();
+    diverged
+}
+
 impl Integrator {
     /// [`try_step`](Self::try_step) for every body: `states[i]` advances by `dt` under
     /// `wrenches[i]` with mass `masses[i]`. A body whose result is not finite keeps its state and
@@ -123,35 +169,20 @@ impl Integrator {
         dt: f32,
     ) -> Vec<usize> {
         assert!(states.len() == masses.len() && states.len() == wrenches.len());
-        let mut diverged = Vec::new();
+        let alone =
+            |i: usize, s: &mut BodyState, m: &MassProperties| self.try_step(s, m, &wrenches[i], dt);
         if self != Integrator::Splitting {
-            for (i, state) in states.iter_mut().enumerate() {
-                if self
-                    .try_step(state, masses[i].borrow(), &wrenches[i], dt)
-                    .is_err()
-                {
-                    diverged.push(i);
-                }
-            }
-            return diverged;
+            return each_alone(states, masses, alone);
         }
-        let mut pending = PendingRotations::new();
-        for i in 0..states.len() {
-            let mass = masses[i].borrow();
+        let translate = |i: usize, next: &mut BodyState, m: &MassProperties| {
             let wrench = &wrenches[i];
-            if wrench.torque == glam::Vec3::ZERO {
-                let mut next = states[i];
-                translate_dkd(&mut next, mass, wrench, dt);
-                pending.push(i, next, mass, dt, &mut |j, s| {
-                    commit(states, &mut diverged, j, s)
-                });
-            } else if self.try_step(&mut states[i], mass, wrench, dt).is_err() {
-                diverged.push(i);
-            }
-        }
-        pending.flush(&mut |j, s| commit(states, &mut diverged, j, s));
-        diverged.sort_unstable();
-        diverged
+            // A torque must be kicked between two half rotations: that body steps alone.
+            (wrench.torque == glam::Vec3::ZERO).then(|| {
+                translate_dkd(next, m, wrench, dt);
+                dt
+            })
+        };
+        batched(states, masses, translate, alone)
     }
 
     /// [`try_begin_step`](Self::try_begin_step) for every body (see
@@ -163,28 +194,16 @@ impl Integrator {
         dt: f32,
     ) -> Vec<usize> {
         assert!(states.len() == masses.len());
-        let mut diverged = Vec::new();
+        let alone = |_: usize, s: &mut BodyState, m: &MassProperties| self.try_begin_step(s, m, dt);
         if self != Integrator::Splitting {
-            for (i, state) in states.iter_mut().enumerate() {
-                if self.try_begin_step(state, masses[i].borrow(), dt).is_err() {
-                    diverged.push(i);
-                }
-            }
-            return diverged;
+            return each_alone(states, masses, alone);
         }
-        let mut pending = PendingRotations::new();
         let h = 0.5 * dt;
-        for i in 0..states.len() {
-            let mass = masses[i].borrow();
-            let mut next = states[i];
+        let translate = |_: usize, next: &mut BodyState, _: &MassProperties| {
             next.position += h * next.linear_velocity;
-            pending.push(i, next, mass, h, &mut |j, s| {
-                commit(states, &mut diverged, j, s)
-            });
-        }
-        pending.flush(&mut |j, s| commit(states, &mut diverged, j, s));
-        diverged.sort_unstable();
-        diverged
+            Some(h)
+        };
+        batched(states, masses, translate, alone)
     }
 
     /// [`try_finish_step`](Self::try_finish_step) for every body (see
@@ -197,31 +216,18 @@ impl Integrator {
         dt: f32,
     ) -> Vec<usize> {
         assert!(states.len() == masses.len() && states.len() == wrenches.len());
-        let mut diverged = Vec::new();
+        let alone = |i: usize, s: &mut BodyState, m: &MassProperties| {
+            self.try_finish_step(s, m, &wrenches[i], dt)
+        };
         if self != Integrator::Splitting {
-            for (i, state) in states.iter_mut().enumerate() {
-                if self
-                    .try_finish_step(state, masses[i].borrow(), &wrenches[i], dt)
-                    .is_err()
-                {
-                    diverged.push(i);
-                }
-            }
-            return diverged;
+            return each_alone(states, masses, alone);
         }
-        let mut pending = PendingRotations::new();
         let h = 0.5 * dt;
-        for i in 0..states.len() {
-            let mass = masses[i].borrow();
-            let mut next = states[i];
-            kick(&mut next, mass, &wrenches[i], dt);
+        let translate = |i: usize, next: &mut BodyState, m: &MassProperties| {
+            kick(next, m, &wrenches[i], dt);
             next.position += h * next.linear_velocity;
-            pending.push(i, next, mass, h, &mut |j, s| {
-                commit(states, &mut diverged, j, s)
-            });
-        }
-        pending.flush(&mut |j, s| commit(states, &mut diverged, j, s));
-        diverged.sort_unstable();
-        diverged
+            Some(h)
+        };
+        batched(states, masses, translate, alone)
     }
 }
