@@ -33,6 +33,15 @@ impl Default for BodyState {
 }
 
 impl BodyState {
+    /// Every byte zero (even the rotation, so this is not a valid state): for scratch buffers
+    /// that are overwritten field by field before use.
+    pub const ZEROED: Self = Self {
+        position: Vec3::ZERO,
+        rotation: Quat::from_xyzw(0.0, 0.0, 0.0, 0.0),
+        linear_velocity: Vec3::ZERO,
+        angular_velocity: Vec3::ZERO,
+    };
+
     /// True when every component is finite.
     #[inline]
     pub fn is_finite(&self) -> bool {

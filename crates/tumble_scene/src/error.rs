@@ -4,11 +4,11 @@ use thiserror::Error;
 
 /// A scene file that cannot be used, with where and why.
 #[derive(Debug, Clone, PartialEq, Error)]
-#[error("{file}:{line}: {field}: {message}")]
+#[error("{}", location(self))]
 pub struct SceneError {
     /// The file.
     pub file: String,
-    /// 1-based line.
+    /// 1-based line; 0 when the error concerns the whole file (it could not be read).
     pub line: usize,
     /// The field (dotted path, e.g. `bodies[1].mass`).
     pub field: String,
@@ -35,6 +35,14 @@ impl SceneError {
     /// A file that could not be read.
     pub fn io(file: &str, e: std::io::Error) -> Self {
         Self::at(file, 0, "file", format!("cannot be read: {e}"))
+    }
+}
+
+/// `file:line: field: message`, or `file: field: message` for a whole-file error.
+fn location(e: &SceneError) -> String {
+    match e.line {
+        0 => format!("{}: {}: {}", e.file, e.field, e.message),
+        line => format!("{}:{line}: {}: {}", e.file, e.field, e.message),
     }
 }
 

@@ -78,8 +78,15 @@ fn oversized_and_missing_files_are_rejected_before_reading() {
     f.set_len(100 * 1024 * 1024).unwrap(); // a sparse 100 MB file
     let e = load_scene(&big).unwrap_err();
     assert!(e.message.contains("limited to"), "{e}");
-    let e = load_scene(&dir.join("missing.toml")).unwrap_err();
+    let missing = dir.join("missing.toml");
+    let e = load_scene(&missing).unwrap_err();
     assert!(e.message.contains("cannot be read"), "{e}");
+    // A whole-file error names no line (there is none to name).
+    assert!(
+        e.to_string()
+            .starts_with(&format!("{}: file: cannot be read", missing.display())),
+        "{e}"
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
