@@ -5,14 +5,15 @@
 //! would measure nothing.
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
-use tumble::glam::{Quat, Vec3};
+use tumble::math::{Quat, Real, Vec3};
+
 use tumble::prelude::*;
 
 fn bodies(n: usize) -> (Vec<BodyState>, Vec<MassProperties>) {
     let mut states = Vec::with_capacity(n);
     let mut masses = Vec::with_capacity(n);
     for i in 0..n {
-        let f = i as f32 / n as f32;
+        let f = i as Real / n as Real;
         states.push(BodyState {
             position: Vec3::new(f, 2.0 * f, 0.0),
             rotation: Quat::from_rotation_y(f * 3.0),

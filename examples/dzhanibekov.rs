@@ -3,10 +3,11 @@
 //! middle axis) and reports the relative drift of energy and |L|. The exact solution flips 67
 //! times for ω₀ = (1, 5, 1) and 44 times for ω₀ = (0.01, 10, 0.01).
 use tumble::core::invariants::{angular_momentum, kinetic_energy};
-use tumble::glam::Vec3;
+use tumble::math::{Real, Vec3};
+
 use tumble::prelude::*;
 
-fn run(integrator: Integrator, omega0: Vec3, dt: f32, seconds: f32) -> (u32, f32, f32, Vec3) {
+fn run(integrator: Integrator, omega0: Vec3, dt: Real, seconds: Real) -> (u32, Real, Real, Vec3) {
     let mass = MassProperties::new(Mass::new(1.0).unwrap(), Vec3::new(1.0, 2.0, 3.0)).unwrap();
     let mut state = BodyState {
         angular_velocity: omega0,
@@ -25,7 +26,7 @@ fn run(integrator: Integrator, omega0: Vec3, dt: f32, seconds: f32) -> (u32, f32
             .try_step(&mut state, &mass, &Wrench::ZERO, dt)
             .is_err()
         {
-            return (flips, f32::NAN, f32::NAN, Vec3::NAN);
+            return (flips, Real::NAN, Real::NAN, Vec3::NAN);
         }
         let sign = (state.rotation.inverse() * state.angular_velocity)
             .y

@@ -1,6 +1,7 @@
 //! A headless game loop: a plain `World`, one tumbling box under gravity, 2 s at 60 Hz.
 use tumble::bevy_ecs::prelude::World;
-use tumble::glam::Vec3;
+use tumble::math::{Real, Vec3};
+
 use tumble::prelude::*;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -23,7 +24,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let t = world.get::<Transform>(body).ok_or("body vanished")?;
             println!(
                 "t = {:.2} s  x = {:.3}  q = {:.3}",
-                step as f32 / 60.0,
+                step as Real / 60.0,
                 t.translation,
                 t.rotation
             );

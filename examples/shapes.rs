@@ -1,10 +1,20 @@
 //! Bodies made from parry3d shapes and a density: mass properties are computed by parry,
 //! then each body is spun about its middle principal axis and stepped for 1 s.
+// Only `main` differs in an `f64` build with parry3d's `f32` shapes, which leaves these unused.
+#![cfg_attr(all(feature = "f64", not(feature = "parry-f64")), allow(unused_imports))]
+
 use tumble::bevy_ecs::prelude::World;
-use tumble::glam::{Quat, Vec3};
-use tumble::parry3d::shape::{Ball, Capsule, Cone, ConvexPolyhedron, Cuboid, Cylinder, Shape};
+use tumble::math::{Quat, Real, Vec3};
+
+use tumble::parry::shape::{Ball, Capsule, Cone, ConvexPolyhedron, Cuboid, Cylinder, Shape};
 use tumble::prelude::*;
 
+#[cfg(all(feature = "f64", not(feature = "parry-f64")))]
+fn main() {
+    eprintln!("this example builds shapes from tumble's vectors: run it in f32 or with parry-f64");
+}
+
+#[cfg(any(not(feature = "f64"), feature = "parry-f64"))]
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let steel = Density::new(7850.0)?;
     let hull = ConvexPolyhedron::from_convex_hull(&[
@@ -41,7 +51,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let axis = mass.principal_frame() * Vec3::Y;
         let entity = world
             .spawn((RigidBody, MassProps(mass)))
-            .insert(Transform::from_translation(Vec3::new(i as f32, 0.0, 0.0)))
+            .insert(Transform::from_translation(Vec3::new(i as Real, 0.0, 0.0)))
             .insert(Velocity::angular(axis * 6.0 + Vec3::splat(0.01)))
             .id();
         bodies.push((name, entity));

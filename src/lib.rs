@@ -7,7 +7,7 @@
 //!
 //! ```
 //! use tumble::prelude::*;
-//! use tumble::{bevy_ecs::prelude::World, glam::Vec3};
+//! use tumble::{bevy_ecs::prelude::World, math::Vec3};
 //!
 //! let mut world = World::new();
 //! world.insert_resource(PhysicsSettings::new(1.0 / 60.0, Integrator::SymplecticEuler).unwrap());
@@ -38,6 +38,8 @@
 //! | `scene` | no | `tumble::scene`: TOML scene files, CSV trajectories |
 //! | `serde` | no | serde for every component and resource; `ecs::snapshot` save / resume |
 //! | `bevy_app` | no | `ecs::plugin::TumblePlugin`: the step in a Bevy app's `FixedUpdate` |
+//! | `f64` | no | double precision throughout: [`math::Real`] = `f64`, `Vec3` = `DVec3`, … |
+//! | `parry-f64` | no | shapes from parry3d-f64 (implies `f64`) |
 //!
 //! `--no-default-features` is the bare integrator layer on `bevy_ecs` and `glam` only.
 
@@ -46,9 +48,11 @@
 
 pub use bevy_ecs;
 pub use glam;
-#[cfg(feature = "parry")]
-pub use parry3d;
 pub use tumble_core as core;
+pub use tumble_core::math;
+/// The parry crate of the shapes: `parry3d`, or `parry3d-f64` with the feature `parry-f64`.
+#[cfg(any(feature = "parry", feature = "parry-f64"))]
+pub use tumble_core::shapes::parry;
 pub use tumble_ecs as ecs;
 /// Scene files and trajectories (feature `scene`).
 #[cfg(feature = "scene")]
@@ -56,7 +60,7 @@ pub use tumble_scene as scene;
 
 /// Everything a game loop needs, in one import.
 pub mod prelude {
-    #[cfg(feature = "parry")]
+    #[cfg(any(feature = "parry", feature = "parry-f64"))]
     pub use tumble_core::shapes::mass_properties_of;
     pub use tumble_core::{BodyState, Integrator, Wrench};
     pub use tumble_ecs::prelude::*;

@@ -5,8 +5,13 @@ mod core_layer {
     pub mod bad_input;
     pub mod determinism;
     pub mod forces;
+    // Shapes are built with parry's own vectors, which are tumble's except in an `f64` build
+    // that keeps parry3d's `f32` shapes (`f64` without `parry-f64`): that case is tested in
+    // `tumble_core::shapes`.
+    #[cfg(any(not(feature = "f64"), feature = "parry-f64"))]
     pub mod mass_properties;
     pub mod momentum;
+    pub mod precision;
     pub mod projectile;
     pub mod schedule;
     pub mod spin;

@@ -1,7 +1,8 @@
 //! Bad data is rejected with a typed error naming the entity, and never harms another body.
 
 use tumble::bevy_ecs::prelude::*;
-use tumble::glam::{Quat, Vec3};
+use tumble::math::{Quat, Real, Vec3};
+
 use tumble::prelude::*;
 
 use super::util::{mass_props, run_schedule, world_with};
@@ -128,7 +129,7 @@ fn nan_translation_on_insert() {
         |w| {
             spawn_bad(
                 w,
-                Transform::from_translation(Vec3::new(f32::NAN, 0.0, 0.0)),
+                Transform::from_translation(Vec3::new(Real::NAN, 0.0, 0.0)),
                 Velocity::ZERO,
                 None,
             )
@@ -146,7 +147,7 @@ fn infinite_velocity_on_insert() {
             spawn_bad(
                 w,
                 Transform::IDENTITY,
-                Velocity::angular(Vec3::new(0.0, f32::INFINITY, 0.0)),
+                Velocity::angular(Vec3::new(0.0, Real::INFINITY, 0.0)),
                 Some(ForceAccumulator::default()),
             )
         },
@@ -184,7 +185,7 @@ fn nan_force_on_insert() {
         "nan force",
         |w| {
             let acc = ForceAccumulator {
-                force: Vec3::new(0.0, f32::NAN, 0.0),
+                force: Vec3::new(0.0, Real::NAN, 0.0),
                 torque: Vec3::ZERO,
             };
             spawn_bad(w, Transform::IDENTITY, Velocity::ZERO, Some(acc))
@@ -199,7 +200,7 @@ fn nan_written_by_game_code_after_spawn() {
     check_case(
         "nan written through &mut Transform",
         |w| spawn_bad(w, Transform::IDENTITY, Velocity::linear(Vec3::Y), None),
-        |w, bad| w.get_mut::<Transform>(bad).unwrap().translation.x = f32::NAN,
+        |w, bad| w.get_mut::<Transform>(bad).unwrap().translation.x = Real::NAN,
         invalid("Transform"),
     );
 }
@@ -219,7 +220,7 @@ fn nan_torque_added_by_game_code() {
         |w, bad| {
             w.get_mut::<ForceAccumulator>(bad)
                 .unwrap()
-                .add_torque(Vec3::splat(f32::NAN))
+                .add_torque(Vec3::splat(Real::NAN))
         },
         invalid("ForceAccumulator"),
     );
@@ -278,7 +279,7 @@ fn quarantined_body_keeps_finite_state_and_can_be_revived() {
 
 #[test]
 fn bad_time_steps_are_rejected() {
-    for dt in [0.0, -0.01, f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
+    for dt in [0.0, -0.01, Real::NAN, Real::INFINITY, Real::NEG_INFINITY] {
         let err = PhysicsSettings::new(dt, Integrator::SymplecticEuler).unwrap_err();
         assert!(
             matches!(err, tumble::core::InvalidInput::NonPositiveTimeStep(_)),
@@ -308,7 +309,7 @@ fn bad_mass_data_cannot_be_constructed() {
         Err(InvalidInput::NegativeInertia(_))
     ));
     assert!(matches!(
-        MassProperties::new(one, Vec3::new(1.0, f32::INFINITY, 1.0)),
+        MassProperties::new(one, Vec3::new(1.0, Real::INFINITY, 1.0)),
         Err(InvalidInput::NonFinite { .. })
     ));
     assert_eq!(

@@ -1,16 +1,16 @@
 //! The same inputs give bit-identical results, run after run.
 
-use tumble::glam::{Quat, Vec3};
+use tumble::math::{Quat, Real, Vec3, Widen};
 use tumble::prelude::*;
 
 use super::util::{mass_props, run, world_with};
 
-fn scene_bits() -> Vec<u32> {
+fn scene_bits() -> Vec<u64> {
     let mut world = world_with(1.0 / 90.0, Integrator::SymplecticEuler);
     world.insert_resource(Gravity(Vec3::new(0.0, -9.81, 0.0)));
     let mut bodies = Vec::new();
     for i in 0..64u32 {
-        let f = i as f32;
+        let f = i as Real;
         let e = world
             .spawn((
                 RigidBody,
@@ -59,7 +59,7 @@ fn scene_bits() -> Vec<u32> {
             .chain(v.linear.to_array())
             .chain(v.angular.to_array())
         {
-            bits.push(x.to_bits());
+            bits.push(x.widen().to_bits());
         }
     }
     bits
@@ -70,7 +70,7 @@ fn two_runs_are_bit_identical() {
     let a = scene_bits();
     let b = scene_bits();
     assert_eq!(a, b);
-    assert!(a.iter().all(|&x| f32::from_bits(x).is_finite()));
+    assert!(a.iter().all(|&x| f64::from_bits(x).is_finite()));
 }
 
 #[test]
@@ -122,13 +122,13 @@ fn ecs_matches_the_raw_loop_bit_for_bit() {
 
 /// A large mixed world (free bodies under gravity, bodies with accumulators, springs, spheres,
 /// asymmetric and locked-axis bodies) stepped with the given threading policy.
-fn big_world_bits(parallelism: Parallelism, integrator: Integrator) -> Vec<u32> {
+fn big_world_bits(parallelism: Parallelism, integrator: Integrator) -> Vec<u64> {
     let mut world = world_with(1.0 / 60.0, integrator);
     world.insert_resource(Gravity(Vec3::new(0.0, -9.81, 0.0)));
     world.insert_resource(parallelism);
     let mut bodies = Vec::new();
     for i in 0..6000u32 {
-        let f = i as f32 / 6000.0;
+        let f = i as Real / 6000.0;
         let inertia = match i % 4 {
             0 => [1.0, 2.0 + f, 3.0],
             1 => [0.5, 0.5, 0.5],
@@ -139,7 +139,7 @@ fn big_world_bits(parallelism: Parallelism, integrator: Integrator) -> Vec<u32> 
             RigidBody,
             mass_props(1.0 + f, inertia),
             Transform {
-                translation: Vec3::new(f * 100.0, 0.0, (i % 7) as f32),
+                translation: Vec3::new(f * 100.0, 0.0, (i % 7) as Real),
                 rotation: Quat::from_rotation_y(f * 9.0),
             },
             Velocity {
@@ -177,7 +177,7 @@ fn big_world_bits(parallelism: Parallelism, integrator: Integrator) -> Vec<u32> 
             .chain(t.rotation.to_array())
             .chain(v.linear.to_array())
             .chain(v.angular.to_array());
-        bits.extend(values.map(f32::to_bits));
+        bits.extend(values.map(|x| x.widen().to_bits()));
     }
     bits
 }
@@ -201,6 +201,6 @@ fn one_and_several_threads_give_identical_bits() {
             single == parallel,
             "{integrator}: thread count changed the result"
         );
-        assert!(single.iter().all(|&x| f32::from_bits(x).is_finite()));
+        assert!(single.iter().all(|&x| f64::from_bits(x).is_finite()));
     }
 }

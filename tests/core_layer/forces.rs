@@ -1,7 +1,8 @@
 //! Forces at points produce the torque `(p − x) × F` about the centre of mass, and generators
 //! deliver their load in the step they run, exactly once.
 
-use tumble::glam::{DMat3, Quat, Vec3};
+use tumble::glam::DMat3;
+use tumble::math::{Quat, Real, Vec3, Widen, to_f64};
 use tumble::prelude::*;
 
 use super::util::{run, world_with};
@@ -33,8 +34,8 @@ fn accumulator_force_at_point_torque() {
 
 #[test]
 fn constant_force_at_body_point_gives_right_linear_and_angular_kick() {
-    let dt = 1e-3_f32;
-    let m = 2.0_f32;
+    let dt = 1e-3 as Real;
+    let m = 2.0 as Real;
     let inertia = Vec3::new(0.5, 1.5, 2.0);
     let frame = Quat::from_rotation_x(0.4) * Quat::from_rotation_z(0.3);
     let com = Vec3::new(0.1, -0.2, 0.05);
@@ -67,16 +68,16 @@ fn constant_force_at_body_point_gives_right_linear_and_angular_kick() {
     run(&mut world, 1);
 
     // Expected, in f64: τ = R (p − c) × F; Δω = Δt I_w⁻¹ τ with I_w = (RP) diag(I) (RP)ᵀ.
-    let r = q.as_dquat();
-    let tau = (r * (point - com).as_dvec3()).cross(force.as_dvec3());
-    let rp = DMat3::from_quat(r * frame.as_dquat());
-    let i_world = rp * DMat3::from_diagonal(inertia.as_dvec3()) * rp.transpose();
-    let domega = i_world.inverse() * tau * f64::from(dt);
+    let r = q.widen();
+    let tau = (r * (point - com).widen()).cross(force.widen());
+    let rp = DMat3::from_quat(r * frame.widen());
+    let i_world = rp * DMat3::from_diagonal(inertia.widen()) * rp.transpose();
+    let domega = i_world.inverse() * tau * to_f64(dt);
     let v = world.get::<Velocity>(body).unwrap();
-    let dv = force.as_dvec3() * f64::from(dt / m);
-    assert!((v.linear.as_dvec3() - dv).length() < 1e-6 * dv.length());
+    let dv = force.widen() * to_f64(dt / m);
+    assert!((v.linear.widen() - dv).length() < 1e-6 * dv.length());
     assert!(
-        (v.angular.as_dvec3() - domega).length() < 1e-5 * domega.length(),
+        (v.angular.widen() - domega).length() < 1e-5 * domega.length(),
         "Δω = {} expected {domega}",
         v.angular
     );
@@ -84,8 +85,8 @@ fn constant_force_at_body_point_gives_right_linear_and_angular_kick() {
     let t = world.get::<Transform>(body).unwrap();
     let com_world = t
         .center_of_mass(world.get::<MassProps>(body).unwrap())
-        .as_dvec3();
-    let com_expected = (t0 + q * com).as_dvec3() + dv * f64::from(dt);
+        .widen();
+    let com_expected = (t0 + q * com).widen() + dv * to_f64(dt);
     assert!((com_world - com_expected).length() < 1e-5);
 }
 
@@ -107,7 +108,7 @@ fn game_force_is_applied_exactly_once() {
     schedule.run(&mut world);
     let v = world.get::<Velocity>(body).unwrap();
     assert_eq!(v.linear, Vec3::X * (10.0 * dt)); // one kick of F Δt / m, not two
-    assert!((v.angular - Vec3::Y * (2.0 * dt)).length() < 4.0 * f32::EPSILON); // unit inertia
+    assert!((v.angular - Vec3::Y * (2.0 * dt)).length() < 4.0 * Real::EPSILON); // unit inertia
     assert_eq!(
         *world.get::<ForceAccumulator>(body).unwrap(),
         ForceAccumulator::default()

@@ -1,8 +1,8 @@
 //! Mass properties from parry3d shapes against closed forms, and the Mass/Density split.
 
-use tumble::glam::{Quat, Vec3};
-use tumble::parry3d::math::Pose;
-use tumble::parry3d::shape::{
+use tumble::math::{Quat, Real, Vec3, to_f64};
+use tumble::parry::math::Pose;
+use tumble::parry::shape::{
     Ball, Capsule, Compound, Cone, ConvexPolyhedron, Cuboid, Cylinder, SharedShape,
 };
 use tumble::prelude::*;
@@ -15,22 +15,22 @@ fn rho() -> Density {
     Density::new(750.0).unwrap()
 }
 
-fn close(a: f32, b: f64, tol: f64, what: &str) {
-    let r = (f64::from(a) - b).abs() / b.abs();
+fn close(a: Real, b: f64, tol: f64, what: &str) {
+    let r = (to_f64(a) - b).abs() / b.abs();
     assert!(r < tol, "{what}: {a} vs {b} (rel {r:e})");
 }
 
 /// Sorted principal moments (parry may order axes its own way for hulls and compounds).
-fn sorted(v: Vec3) -> [f32; 3] {
+fn sorted(v: Vec3) -> [Real; 3] {
     let mut a = v.to_array();
-    a.sort_by(f32::total_cmp);
+    a.sort_by(Real::total_cmp);
     a
 }
 
 #[test]
 fn ball_is_two_fifths_m_r_squared() {
     let r = 0.3_f64;
-    let props = mass_properties_of(&Ball::new(r as f32), rho()).unwrap();
+    let props = mass_properties_of(&Ball::new(r as Real), rho()).unwrap();
     let m = 750.0 * 4.0 / 3.0 * PI * r.powi(3);
     close(props.mass(), m, TOL, "ball mass");
     for i in props.principal_inertia().to_array() {
@@ -42,7 +42,7 @@ fn ball_is_two_fifths_m_r_squared() {
 #[test]
 fn cuboid_is_m_b2_c2_over_12() {
     let (a, b, c) = (0.8_f64, 0.3, 0.1); // full edges
-    let shape = Cuboid::new(Vec3::new(a as f32, b as f32, c as f32) * 0.5);
+    let shape = Cuboid::new(Vec3::new(a as Real, b as Real, c as Real) * 0.5);
     let props = mass_properties_of(&shape, rho()).unwrap();
     let m = 750.0 * a * b * c;
     close(props.mass(), m, TOL, "box mass");
@@ -52,7 +52,7 @@ fn cuboid_is_m_b2_c2_over_12() {
     close(i.z, m * (a * a + b * b) / 12.0, TOL, "box Izz");
     // The closed-form constructor agrees.
     let direct =
-        MassProperties::solid_cuboid(Mass::new(m as f32).unwrap(), shape.half_extents).unwrap();
+        MassProperties::solid_cuboid(Mass::new(m as Real).unwrap(), shape.half_extents).unwrap();
     close(
         direct.principal_inertia().y,
         m * (a * a + c * c) / 12.0,
@@ -65,7 +65,7 @@ fn cuboid_is_m_b2_c2_over_12() {
 fn cylinder_axial_half_m_r2_transverse_m_3r2_h2_over_12() {
     let (hh, r) = (0.4_f64, 0.15);
     let h = 2.0 * hh;
-    let props = mass_properties_of(&Cylinder::new(hh as f32, r as f32), rho()).unwrap();
+    let props = mass_properties_of(&Cylinder::new(hh as Real, r as Real), rho()).unwrap();
     let m = 750.0 * PI * r * r * h;
     close(props.mass(), m, TOL, "cylinder mass");
     let i = props.principal_inertia();
@@ -88,7 +88,7 @@ fn cylinder_axial_half_m_r2_transverse_m_3r2_h2_over_12() {
 fn cone_moments_and_centre_of_mass() {
     let (hh, r) = (0.5_f64, 0.2);
     let h = 2.0 * hh;
-    let props = mass_properties_of(&Cone::new(hh as f32, r as f32), rho()).unwrap();
+    let props = mass_properties_of(&Cone::new(hh as Real, r as Real), rho()).unwrap();
     let m = 750.0 * PI * r * r * h / 3.0;
     close(props.mass(), m, TOL, "cone mass");
     let i = props.principal_inertia();
@@ -113,7 +113,7 @@ fn cone_moments_and_centre_of_mass() {
 fn capsule_is_cylinder_plus_two_hemispheres() {
     let (hh, r) = (0.3_f64, 0.1);
     let h = 2.0 * hh;
-    let props = mass_properties_of(&Capsule::new_y(hh as f32, r as f32), rho()).unwrap();
+    let props = mass_properties_of(&Capsule::new_y(hh as Real, r as Real), rho()).unwrap();
     let m_cyl = 750.0 * PI * r * r * h;
     let m_sph = 750.0 * 4.0 / 3.0 * PI * r.powi(3);
     close(props.mass(), m_cyl + m_sph, TOL, "capsule mass");
@@ -159,13 +159,16 @@ fn convex_hull_of_box_corners_is_the_box() {
 fn compound_of_two_balls_obeys_parallel_axes() {
     let r = 0.1_f64;
     let d = 0.5_f64; // each ball at ±d on x
-    let ball = SharedShape::ball(r as f32);
+    let ball = SharedShape::ball(r as Real);
     let compound = Compound::new(vec![
         (
-            Pose::from_translation(Vec3::new(d as f32, 0.0, 0.0)),
+            Pose::from_translation(Vec3::new(d as Real, 0.0, 0.0)),
             ball.clone(),
         ),
-        (Pose::from_translation(Vec3::new(-d as f32, 0.0, 0.0)), ball),
+        (
+            Pose::from_translation(Vec3::new(-d as Real, 0.0, 0.0)),
+            ball,
+        ),
     ]);
     let props = mass_properties_of(&compound, rho()).unwrap();
     let m1 = 750.0 * 4.0 / 3.0 * PI * r.powi(3);
@@ -200,14 +203,14 @@ fn compound_of_two_balls_obeys_parallel_axes() {
 
 #[test]
 fn mass_and_density_reject_bad_values() {
-    for bad in [0.0, -1.0, f32::NAN, f32::INFINITY] {
+    for bad in [0.0, -1.0, Real::NAN, Real::INFINITY] {
         assert!(Mass::new(bad).is_err(), "mass {bad}");
         assert!(Density::new(bad).is_err(), "density {bad}");
     }
     let one = Mass::new(1.0).unwrap();
     assert!(MassProperties::new(one, Vec3::new(1.0, -1.0, 1.0)).is_err());
     assert!(MassProperties::new(one, Vec3::ZERO).is_err());
-    assert!(MassProperties::new(one, Vec3::new(1.0, f32::NAN, 1.0)).is_err());
+    assert!(MassProperties::new(one, Vec3::new(1.0, Real::NAN, 1.0)).is_err());
     assert!(
         MassProperties::new(one, Vec3::ONE)
             .unwrap()

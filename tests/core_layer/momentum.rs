@@ -6,12 +6,12 @@
 //! and over `n` steps by at most `n ½ (Δt |ω|)²` (first order). Energy and `|L|` drift must
 //! therefore shrink about 2× per halving of Δt.
 
-use tumble::glam::Vec3;
+use tumble::math::{Real, Vec3, to_f64};
 use tumble::prelude::*;
 
 use super::util::{mass_props, run, world_with};
 
-fn angular_momentum_drift(dt: f32, seconds: f32) -> (f64, f64) {
+fn angular_momentum_drift(dt: Real, seconds: Real) -> (f64, f64) {
     let omega0 = Vec3::new(1.0, 2.0, 3.0);
     let mass = mass_props(2.0, [1.0, 2.0, 3.0]);
     let state = |t: &Transform, v: &Velocity| BodyState {
@@ -47,8 +47,8 @@ fn angular_momentum_drift(dt: f32, seconds: f32) -> (f64, f64) {
         &state(world.get::<Transform>(id).unwrap(), v),
         &mass,
     );
-    let bound = steps as f64 * 0.5 * f64::from(dt * omega0.length()).powi(2);
-    let drift = f64::from((l.length() - l0.length()) / l0.length());
+    let bound = steps as f64 * 0.5 * to_f64(dt * omega0.length()).powi(2);
+    let drift = to_f64((l.length() - l0.length()) / l0.length());
     (drift, bound)
 }
 

@@ -2,7 +2,8 @@
 //! `x_n = x₀ + v₀ nΔt + g Δt² n(n+1)/2` (kick before drift), to f32 round-off.
 
 use tumble::bevy_ecs::prelude::*;
-use tumble::glam::{DVec3, Vec3};
+use tumble::glam::DVec3;
+use tumble::math::{Real, Vec3, Widen, to_f64};
 use tumble::prelude::*;
 
 use super::util::{mass_props, rel, run, world_with};
@@ -12,7 +13,7 @@ fn discrete_position(x0: DVec3, v0: DVec3, g: DVec3, dt: f64, n: f64) -> DVec3 {
 }
 
 fn check_projectile(with_accumulator: bool) {
-    let dt = 1.0 / 60.0_f32;
+    let dt = 1.0 / 60.0 as Real;
     let g = Vec3::new(0.3, -9.81, 0.1);
     let x0 = Vec3::new(1.0, 100.0, -2.0);
     let v0 = Vec3::new(3.0, 20.0, -1.5);
@@ -33,19 +34,13 @@ fn check_projectile(with_accumulator: bool) {
         schedule.run(&mut world);
         world.clear_trackers();
         if n % 50 == 0 {
-            let x = world.get::<Transform>(id).unwrap().translation.as_dvec3();
-            let exact = discrete_position(
-                x0.as_dvec3(),
-                v0.as_dvec3(),
-                g.as_dvec3(),
-                f64::from(dt),
-                f64::from(n),
-            );
+            let x = world.get::<Transform>(id).unwrap().translation.widen();
+            let exact = discrete_position(x0.widen(), v0.widen(), g.widen(), to_f64(dt), to_f64(n));
             // f32 round-off: ~n ε per coordinate in the worst case, far below 1e-5.
             let err = (x - exact).length() / exact.length();
             assert!(err < 1e-5, "step {n}: |x − x_exact|/|x_exact| = {err:e}");
-            let v = world.get::<Velocity>(id).unwrap().linear.as_dvec3();
-            let v_exact = v0.as_dvec3() + g.as_dvec3() * (f64::from(dt) * f64::from(n));
+            let v = world.get::<Velocity>(id).unwrap().linear.widen();
+            let v_exact = v0.widen() + g.widen() * (to_f64(dt) * to_f64(n));
             assert!(rel(v.y, v_exact.y) < 1e-5, "vy {} vs {}", v.y, v_exact.y);
         }
     }
@@ -72,7 +67,7 @@ fn gravity_scale_scales_the_fall() {
     let none = world.spawn((RigidBody, GravityScale(0.0))).id();
     let full = world.spawn(RigidBody).id();
     run(&mut world, 100);
-    let y = |e: Entity| f64::from(world.get::<Transform>(e).unwrap().translation.y);
+    let y = |e: Entity| to_f64(world.get::<Transform>(e).unwrap().translation.y);
     let full_y = -10.0 * 0.01 * 0.01 * 100.0 * 101.0 / 2.0;
     assert!(rel(y(full), full_y) < 1e-5);
     assert!(rel(y(half), 0.5 * full_y) < 1e-5);
@@ -83,7 +78,7 @@ fn gravity_scale_scales_the_fall() {
 fn drift_kick_drift_is_exact_for_constant_gravity() {
     // splitting samples forces at the midpoint: x_n = x₀ + v₀ t + ½ g t² with no Δt bias.
     for integrator in [Integrator::Splitting, Integrator::Yoshida4, Integrator::Rk4] {
-        let dt = 1.0 / 60.0_f32;
+        let dt = 1.0 / 60.0 as Real;
         let g = Vec3::new(0.0, -9.81, 0.0);
         let (x0, v0) = (Vec3::new(0.0, 50.0, 0.0), Vec3::new(4.0, 10.0, 0.0));
         let mut world = world_with(dt, integrator);
@@ -110,10 +105,10 @@ fn drift_kick_drift_is_exact_for_constant_gravity() {
         for _ in 0..n {
             schedule.run(&mut world);
         }
-        let t = f64::from(dt) * f64::from(n);
-        let exact = x0.as_dvec3() + v0.as_dvec3() * t + 0.5 * g.as_dvec3() * t * t;
+        let t = to_f64(dt) * to_f64(n);
+        let exact = x0.widen() + v0.widen() * t + 0.5 * g.widen() * t * t;
         for id in [with_acc, without_acc] {
-            let x = world.get::<Transform>(id).unwrap().translation.as_dvec3();
+            let x = world.get::<Transform>(id).unwrap().translation.widen();
             let err = (x - exact).length() / exact.length();
             assert!(
                 err < 1e-5,

@@ -1,7 +1,8 @@
 //! The schedule holds only the systems a world needs.
 
 use tumble::bevy_ecs::prelude::*;
-use tumble::glam::Vec3;
+use tumble::math::Vec3;
+
 use tumble::prelude::*;
 
 use super::util::world_with;

@@ -1,14 +1,15 @@
 //! A spin about a principal axis stays a spin about that axis, at constant rate, and the pose
 //! follows the exact rotation `q(t) = exp(½ t ω) q₀`.
 
-use tumble::glam::{DQuat, Quat, Vec3};
+use tumble::glam::{DQuat, DVec3};
+use tumble::math::{Quat, Real, Vec3, Widen, to_f64};
 use tumble::prelude::*;
 
 use super::util::{run, world_with};
 
 /// Spins a body (rotated, with a rotated principal frame) about principal axis `axis` and checks
 /// rate and pose after `steps` steps.
-fn check_principal_spin(integrator: Integrator, axis: Vec3, rate: f32, dt: f32, steps: usize) {
+fn check_principal_spin(integrator: Integrator, axis: Vec3, rate: Real, dt: Real, steps: usize) {
     let principal_frame = Quat::from_euler(tumble::glam::EulerRot::XYZ, 0.3, -0.7, 1.1);
     let q0 = Quat::from_euler(tumble::glam::EulerRot::ZYX, -0.4, 0.2, 0.9);
     let mass = MassProperties::new(Mass::new(3.0).unwrap(), Vec3::new(1.0, 2.0, 3.0))
@@ -27,10 +28,10 @@ fn check_principal_spin(integrator: Integrator, axis: Vec3, rate: f32, dt: f32, 
         .id();
     run(&mut world, steps);
     let w = world.get::<Velocity>(id).unwrap().angular;
-    let t = f64::from(dt) * steps as f64;
+    let t = to_f64(dt) * steps as f64;
     // Round-off of one step is a few f32 ulps of |ω|; the explicit gyroscopic term amplifies
     // a perturbation at most by (1 + (c Δt)²)^(n/2) with c ≤ |ω|·max ratio, ≤ 1.05 here.
-    let tol = 16.0 * f32::EPSILON * steps as f32 * rate;
+    let tol = 16.0 * Real::EPSILON * steps as Real * rate;
     assert!(
         (w - omega).length() < tol,
         "{integrator}: ω drifted by {} (tol {tol})",
@@ -40,11 +41,14 @@ fn check_principal_spin(integrator: Integrator, axis: Vec3, rate: f32, dt: f32, 
         .get::<tumble::ecs::components::Transform>(id)
         .unwrap()
         .rotation;
-    let omega64 = omega.as_dvec3();
-    let q_exact = DQuat::from_scaled_axis(omega64 * t) * q0.as_dquat();
-    let angle = 2.0 * q.as_dquat().dot(q_exact).abs().min(1.0).acos();
+    let omega64 = omega.widen();
+    let q_exact = DQuat::from_scaled_axis(omega64 * t) * q0.widen();
+    // 2 atan2(|v|, |w|) of q* q_exact: exact for tiny angles, where 2 acos |⟨q, q_exact⟩| has an
+    // error floor of √(2ε₆₄) ≈ 2e-8 rad that would hide the f64 engine's own accuracy.
+    let r = q.widen().normalize().conjugate() * q_exact;
+    let angle = 2.0 * DVec3::new(r.x, r.y, r.z).length().atan2(r.w.abs());
     // Each exact-exponential step is accurate to a few ulps; allow 16 ε per step.
-    let angle_tol = 16.0 * f64::from(f32::EPSILON) * steps as f64 * (1.0 + omega64.length());
+    let angle_tol = 16.0 * to_f64(Real::EPSILON) * steps as f64 * (1.0 + omega64.length());
     assert!(
         angle < angle_tol,
         "{integrator}: pose off by {angle} rad (tol {angle_tol})"
@@ -80,8 +84,8 @@ fn identity_frame_spin_is_bit_exact_in_rate() {
 fn linearized_rotation_update_has_first_order_error() {
     // q += ½Δt ω q then normalize rotates by 2 atan(|ω|Δt/2) instead of |ω|Δt per step: the
     // angle per step is short by about (|ω|Δt)³/12, so the error of a spin grows like Δt².
-    let rate = 5.0_f32;
-    let err = |dt: f32| {
+    let rate = 5.0 as Real;
+    let err = |dt: Real| {
         let steps = (1.0 / dt).round() as usize;
         let mut world = world_with(dt, Integrator::SymplecticEulerLinear);
         let id = world
@@ -89,9 +93,9 @@ fn linearized_rotation_update_has_first_order_error() {
             .id();
         run(&mut world, steps);
         let q = world.get::<Transform>(id).unwrap().rotation;
-        let exact = f64::from(rate); // angle after 1 s
-        let angle = 2.0 * f64::from(q.z).atan2(f64::from(q.w));
-        let per_step = 2.0 * (f64::from(rate * dt) / 2.0).atan();
+        let exact = to_f64(rate); // angle after 1 s
+        let angle = 2.0 * to_f64(q.z).atan2(to_f64(q.w));
+        let per_step = 2.0 * (to_f64(rate * dt) / 2.0).atan();
         let predicted = exact - per_step * steps as f64;
         ((angle - exact).abs(), predicted.abs())
     };

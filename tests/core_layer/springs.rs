@@ -2,15 +2,15 @@
 //! `v' = v + Δt (−k x − c v)/m`, `x' = x + Δt v'` — iterated here in f64.
 //! Two bodies on one spring exchange equal and opposite forces.
 
-use tumble::glam::Vec3;
+use tumble::math::{Real, Vec3, to_f64};
 use tumble::prelude::*;
 
 use super::util::{mass_props, run, world_with};
 
 #[test]
 fn anchored_spring_follows_the_discrete_map() {
-    for (k, c) in [(40.0_f32, 0.0_f32), (40.0, 0.8)] {
-        let (m, dt, x0) = (2.0_f32, 1.0 / 60.0_f32, 0.7_f32);
+    for (k, c) in [(40.0 as Real, 0.0 as Real), (40.0, 0.8)] {
+        let (m, dt, x0) = (2.0 as Real, 1.0 / 60.0 as Real, 0.7 as Real);
         let mut world = world_with(dt, Integrator::SymplecticEuler);
         let body = world
             .spawn((
@@ -29,8 +29,8 @@ fn anchored_spring_follows_the_discrete_map() {
         });
         let steps = 300;
         run(&mut world, steps);
-        let (mut x, mut v) = (f64::from(x0), 0.0_f64);
-        let (k, c, m, h) = (f64::from(k), f64::from(c), f64::from(m), f64::from(dt));
+        let (mut x, mut v) = (to_f64(x0), 0.0_f64);
+        let (k, c, m, h) = (to_f64(k), to_f64(c), to_f64(m), to_f64(dt));
         let mut amplitude = x.abs();
         for _ in 0..steps {
             v += h * (-k * x - c * v) / m;
@@ -39,9 +39,9 @@ fn anchored_spring_follows_the_discrete_map() {
         }
         let got = world.get::<Transform>(body).unwrap().translation;
         // f32 round-off accumulates about n ε of the amplitude.
-        let tol = 300.0 * 4.0 * f64::from(f32::EPSILON) * amplitude;
+        let tol = 300.0 * 4.0 * to_f64(Real::EPSILON) * amplitude;
         assert!(
-            (f64::from(got.x) - x).abs() < tol,
+            (to_f64(got.x) - x).abs() < tol,
             "k={k} c={c}: x {} vs {x}",
             got.x
         );
@@ -53,7 +53,7 @@ fn anchored_spring_follows_the_discrete_map() {
 fn two_body_spring_conserves_linear_momentum() {
     let dt = 1.0 / 120.0;
     let mut world = world_with(dt, Integrator::SymplecticEuler);
-    let (ma, mb) = (1.0_f32, 3.0_f32);
+    let (ma, mb) = (1.0 as Real, 3.0 as Real);
     let a = world
         .spawn((
             RigidBody,
@@ -99,7 +99,7 @@ fn two_body_spring_conserves_linear_momentum() {
 fn default_integrator_spring_is_position_verlet() {
     // Forces sampled at the midpoint: x_{½} = x + ½h v; v' = v + h a(x_{½}); x' = x_{½} + ½h v'.
     // Symplectic and second order: stable for ω h < 2, here ω h = 1.5.
-    let (m, k, dt) = (0.5_f32, 4050.0_f32, 1.0 / 60.0_f32);
+    let (m, k, dt) = (0.5 as Real, 4050.0 as Real, 1.0 / 60.0 as Real);
     let mut world = world_with(dt, Integrator::Splitting);
     let body = world
         .spawn((
@@ -119,7 +119,7 @@ fn default_integrator_spring_is_position_verlet() {
     });
     let steps = 2000;
     run(&mut world, steps);
-    let (w2, h) = (f64::from(k / m), f64::from(dt));
+    let (w2, h) = (to_f64(k / m), to_f64(dt));
     let (mut x, mut v) = (0.3_f64, -1.0_f64);
     for _ in 0..steps {
         let half = x + 0.5 * h * v;
@@ -129,7 +129,7 @@ fn default_integrator_spring_is_position_verlet() {
     let got = world.get::<Transform>(body).unwrap().translation.x;
     // Bounded orbit of amplitude ≤ 0.4 m; f32 round-off grows like n ε relative at worst.
     assert!(
-        (f64::from(got) - x).abs() < 2000.0 * 4.0 * f64::from(f32::EPSILON),
+        (to_f64(got) - x).abs() < 2000.0 * 4.0 * to_f64(Real::EPSILON),
         "{got} vs {x}"
     );
 }

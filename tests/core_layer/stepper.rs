@@ -1,6 +1,6 @@
 //! Fixed step for variable frame times: accumulator, step cap, interpolation factor.
 
-use tumble::glam::{Quat, Vec3};
+use tumble::math::{Quat, Real, Vec3, to_f64};
 use tumble::prelude::*;
 
 #[test]
@@ -20,8 +20,8 @@ fn accumulates_partial_frames() {
         time += frame;
         total_steps += u64::from(s.advance(frame).unwrap().steps);
     }
-    let simulated = total_steps as f64 * f64::from(s.dt());
-    assert!((time - simulated).abs() <= f64::from(s.dt()) + 1e-9);
+    let simulated = total_steps as f64 * to_f64(s.dt());
+    assert!((time - simulated).abs() <= to_f64(s.dt()) + 1e-9);
 }
 
 #[test]
@@ -38,7 +38,7 @@ fn caps_steps_and_drops_the_backlog() {
 #[test]
 fn rejects_bad_input() {
     assert!(FixedStepper::new(0.0, 4).is_err());
-    assert!(FixedStepper::new(f32::NAN, 4).is_err());
+    assert!(FixedStepper::new(Real::NAN, 4).is_err());
     assert!(FixedStepper::new(0.01, 0).is_err());
     let mut s = FixedStepper::new(0.01, 4).unwrap();
     assert!(s.advance(-1.0).is_err());

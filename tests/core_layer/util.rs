@@ -2,10 +2,11 @@
 
 use tumble::bevy_ecs::prelude::*;
 use tumble::bevy_ecs::schedule::Schedule;
+use tumble::math::Real;
 use tumble::prelude::*;
 
 /// A world with the given step and integrator.
-pub fn world_with(dt: f32, integrator: Integrator) -> World {
+pub fn world_with(dt: Real, integrator: Integrator) -> World {
     let mut world = World::new();
     world.insert_resource(PhysicsSettings::new(dt, integrator).expect("valid dt"));
     world
@@ -27,7 +28,7 @@ pub fn run_schedule(world: &mut World, schedule: &mut Schedule, steps: usize) {
 }
 
 /// Mass properties from a mass and principal moments.
-pub fn mass_props(m: f32, inertia: [f32; 3]) -> MassProps {
+pub fn mass_props(m: Real, inertia: [Real; 3]) -> MassProps {
     MassProps(MassProperties::new(Mass::new(m).unwrap(), inertia.into()).unwrap())
 }
 

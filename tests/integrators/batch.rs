@@ -1,7 +1,7 @@
 //! The batched entry points (`try_*_many`, SIMD lanes for `splitting`) give every body exactly
 //! the bits it gets when stepped alone, whatever its neighbours, their order or the batch size.
 
-use tumble::glam::{Quat, Vec3};
+use tumble::math::{Quat, Real, Vec3};
 use tumble::prelude::*;
 
 /// A mixed population: every odd-axis choice, spherical bodies, locked axes, a rotated
@@ -11,7 +11,7 @@ fn population(n: usize) -> (Vec<BodyState>, Vec<MassProperties>, Vec<Wrench>) {
     let mut masses = Vec::new();
     let mut wrenches = Vec::new();
     for i in 0..n {
-        let f = i as f32 / n as f32;
+        let f = i as Real / n as Real;
         let inertia = match i % 6 {
             0 => Vec3::new(1.0, 2.0 + f, 3.0),
             1 => Vec3::new(2.0, 1.0, 2.05),
@@ -31,7 +31,7 @@ fn population(n: usize) -> (Vec<BodyState>, Vec<MassProperties>, Vec<Wrench>) {
             position: Vec3::new(f, -f, 2.0 * f),
             rotation: Quat::from_rotation_y(7.0 * f) * Quat::from_rotation_x(f),
             linear_velocity: Vec3::new(1.0, f, 0.0),
-            angular_velocity: Vec3::new(0.3 + 40.0 * f * f, 1.0 - f, 0.3) * (1 + i % 3) as f32,
+            angular_velocity: Vec3::new(0.3 + 40.0 * f * f, 1.0 - f, 0.3) * (1 + i % 3) as Real,
         });
         let torque = if i % 4 == 1 {
             Vec3::new(0.0, 0.1, -0.2)
@@ -49,10 +49,10 @@ fn population(n: usize) -> (Vec<BodyState>, Vec<MassProperties>, Vec<Wrench>) {
 fn same_bits(a: &BodyState, b: &BodyState) -> bool {
     let bits = |s: &BodyState| {
         let mut v = Vec::new();
-        v.extend(s.position.to_array().map(f32::to_bits));
-        v.extend(s.rotation.to_array().map(f32::to_bits));
-        v.extend(s.linear_velocity.to_array().map(f32::to_bits));
-        v.extend(s.angular_velocity.to_array().map(f32::to_bits));
+        v.extend(s.position.to_array().map(Real::to_bits));
+        v.extend(s.rotation.to_array().map(Real::to_bits));
+        v.extend(s.linear_velocity.to_array().map(Real::to_bits));
+        v.extend(s.angular_velocity.to_array().map(Real::to_bits));
         v
     };
     bits(a) == bits(b)
@@ -136,8 +136,8 @@ fn a_diverging_body_in_a_batch_is_reported_and_harms_no_neighbour() {
         s
     };
     // Body 5 gets an overflowing kick: its step is not finite.
-    wrenches[5].force = Vec3::splat(f32::MAX);
-    states[5].linear_velocity = Vec3::splat(f32::MAX);
+    wrenches[5].force = Vec3::splat(Real::MAX);
+    states[5].linear_velocity = Vec3::splat(Real::MAX);
     let before = states[5];
     let diverged = integrator.try_step_many(&mut states, &masses, &wrenches, dt);
     assert_eq!(diverged, vec![5]);

@@ -8,7 +8,8 @@
 
 use tumble::core::reference::free_body;
 use tumble::core::rotation::angle_between;
-use tumble::glam::{Quat, Vec3};
+use tumble::math::{Quat, Real, Vec3, Widen, to_f64};
+
 use tumble::prelude::*;
 
 const I: Vec3 = Vec3::new(1.0, 2.0, 3.0);
@@ -16,7 +17,7 @@ const HORIZON: f64 = 4.0;
 
 fn orientation_error(integrator: Integrator, omega0: Vec3, steps_per_second: u32) -> f64 {
     let mass = MassProperties::new(Mass::new(1.0).unwrap(), I).unwrap();
-    let dt = 1.0 / steps_per_second as f32;
+    let dt = 1.0 / steps_per_second as Real;
     let mut state = BodyState {
         angular_velocity: omega0,
         ..Default::default()
@@ -24,11 +25,11 @@ fn orientation_error(integrator: Integrator, omega0: Vec3, steps_per_second: u32
     for _ in 0..(HORIZON as u32 * steps_per_second) {
         integrator.step(&mut state, &mass, &Wrench::ZERO, dt);
     }
-    let (e, _) = free_body(I.as_dvec3(), omega0.as_dvec3(), &[HORIZON])[0];
+    let (e, _) = free_body(I.widen(), omega0.widen(), &[HORIZON])[0];
     // Rounding the reference to f32 costs ≈ 6e-8 rad, far below the errors measured here.
     angle_between(
         state.rotation,
-        Quat::from_xyzw(e.x as f32, e.y as f32, e.z as f32, e.w as f32),
+        Quat::from_xyzw(e.x as Real, e.y as Real, e.z as Real, e.w as Real),
     )
 }
 
@@ -36,7 +37,7 @@ fn orientation_error(integrator: Integrator, omega0: Vec3, steps_per_second: u32
 fn observed_order(errors: &[(u32, f64)]) -> f64 {
     let pts: Vec<(f64, f64)> = errors
         .iter()
-        .map(|&(n, e)| ((1.0 / f64::from(n)).ln(), e.ln()))
+        .map(|&(n, e)| ((1.0 / to_f64(n)).ln(), e.ln()))
         .collect();
     let k = pts.len() as f64;
     let (sx, sy) = pts
@@ -69,7 +70,7 @@ fn every_integrator_converges_at_its_nominal_order() {
         let order = observed_order(&errors);
         eprintln!("{integrator}: observed order {order:.2} from {errors:?}");
         assert!(
-            (order - f64::from(integrator.order())).abs() <= 0.3,
+            (order - to_f64(integrator.order())).abs() <= 0.3,
             "{integrator}: observed order {order:.2} (nominal {}), errors {errors:?}",
             integrator.order()
         );

@@ -1,7 +1,8 @@
 //! Plain-data runs of one body (no ECS), the way the report and the raw benchmark loop do.
 
 use tumble::core::invariants::{angular_momentum, kinetic_energy};
-use tumble::glam::Vec3;
+use tumble::math::{Real, Vec3, to_f64};
+
 use tumble::prelude::*;
 
 /// Summary of a torque-free run.
@@ -32,7 +33,7 @@ pub fn torque_free(
     integrator: Integrator,
     inertia: Vec3,
     omega0: Vec3,
-    dt: f32,
+    dt: Real,
     steps: usize,
 ) -> Run {
     let mass = MassProperties::new(Mass::new(1.0).unwrap(), inertia).unwrap();
@@ -40,8 +41,8 @@ pub fn torque_free(
         angular_velocity: omega0,
         ..Default::default()
     };
-    let e0 = f64::from(kinetic_energy(&state, &mass));
-    let l0 = f64::from(angular_momentum(&state, &mass).length());
+    let e0 = to_f64(kinetic_energy(&state, &mass));
+    let l0 = to_f64(angular_momentum(&state, &mass).length());
     let axis0 = omega0.normalize();
     let mut flips = 0;
     let mut positive = omega0.y > 0.0;
@@ -61,16 +62,16 @@ pub fn torque_free(
             flips += 1;
             positive = w.y > 0.0;
         }
-        let e = f64::from(kinetic_energy(&state, &mass));
+        let e = to_f64(kinetic_energy(&state, &mass));
         max_energy_drift = max_energy_drift.max((e / e0 - 1.0).abs());
-        let cos = f64::from(w.normalize().dot(axis0)).clamp(-1.0, 1.0);
+        let cos = to_f64(w.normalize().dot(axis0)).clamp(-1.0, 1.0);
         max_axis_deviation_deg = max_axis_deviation_deg.max(cos.acos().to_degrees());
     }
     Run {
         flips,
-        energy_drift: f64::from(kinetic_energy(&state, &mass)) / e0 - 1.0,
+        energy_drift: to_f64(kinetic_energy(&state, &mass)) / e0 - 1.0,
         max_energy_drift,
-        momentum_drift: f64::from(angular_momentum(&state, &mass).length()) / l0 - 1.0,
+        momentum_drift: to_f64(angular_momentum(&state, &mass).length()) / l0 - 1.0,
         max_axis_deviation_deg,
         state,
         finite,

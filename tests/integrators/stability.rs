@@ -2,11 +2,12 @@
 //! diverges, none where it stays bounded.
 
 use tumble::bevy_ecs::prelude::*;
-use tumble::glam::Vec3;
+use tumble::math::{Real, Vec3};
+
 use tumble::prelude::*;
 
-fn spring_world(omega_dt: f32, integrator: Integrator) -> (World, Entity) {
-    let (dt, m) = (1.0 / 60.0_f32, 2.0_f32);
+fn spring_world(omega_dt: Real, integrator: Integrator) -> (World, Entity) {
+    let (dt, m) = (1.0 / 60.0 as Real, 2.0 as Real);
     let k = m * (omega_dt / dt).powi(2);
     let mut world = World::new();
     world.insert_resource(PhysicsSettings::new(dt, integrator).unwrap());
@@ -47,7 +48,7 @@ fn spring_warning_matches_divergence() {
         Integrator::Splitting,
         Integrator::Lclamp,
     ] {
-        for omega_dt in [0.5_f32, 1.5, 1.95, 2.05, 2.5] {
+        for omega_dt in [0.5 as Real, 1.5, 1.95, 2.05, 2.5] {
             let (mut world, body) = spring_world(omega_dt, integrator);
             let warned = check_stability(&mut world)
                 .iter()

@@ -3,6 +3,7 @@
 //! rapier 0.36.
 
 use std::sync::Mutex;
+use tumble_core::math::{Real, Vec3};
 
 use tumble_core::{BodyState, Integrator, MassProperties, Wrench};
 use tumble_ecs::parallel::{Parallelism, scope};
@@ -23,14 +24,14 @@ pub struct RawLoop {
     masses: Vec<MassProperties>,
     wrenches: Vec<Wrench>,
     integrator: Integrator,
-    dt: f32,
+    dt: Real,
     parallelism: Parallelism,
 }
 
 impl RawLoop {
     /// The bodies of `scene` in plain arrays (gravity as a constant force per body).
     pub fn new(scene: &ComparisonScene, integrator: Integrator, parallelism: Parallelism) -> Self {
-        let g = scene.gravity.unwrap_or(glam::Vec3::ZERO);
+        let g = scene.gravity.unwrap_or(Vec3::ZERO);
         // Zeroed and written field by field, as the ECS does: `BodyState`'s padding lanes are
         // read by vectorized code, and stale bytes there can be subnormal patterns that cost a
         // microcode assist per operation (which made this loop 2–4× slower in some builds).
@@ -49,7 +50,7 @@ impl RawLoop {
                 .iter()
                 .map(|b| Wrench {
                     force: (b.mass.mass() * b.gravity_scale) * g,
-                    torque: glam::Vec3::ZERO,
+                    torque: Vec3::ZERO,
                 })
                 .collect(),
             integrator,

@@ -16,6 +16,7 @@ pub mod output;
 pub mod population;
 
 use std::path::PathBuf;
+use tumble_core::math::Vec3;
 
 use serde::Serialize;
 use tumble_core::Integrator;
@@ -235,7 +236,7 @@ fn unused_gravity(n: usize, effort: &Effort) -> UnusedFeature {
     let mut scene = population::scene(n);
     scene.gravity = None;
     let mut without = Ecs::new(&scene, Integrator::default(), Parallelism::SINGLE_THREAD);
-    scene.gravity = Some(glam::Vec3::ZERO);
+    scene.gravity = Some(Vec3::ZERO);
     let mut with_zero = Ecs::new(&scene, Integrator::default(), Parallelism::SINGLE_THREAD);
     let ns = compare(&mut [&mut without, &mut with_zero], n, effort);
     UnusedFeature {

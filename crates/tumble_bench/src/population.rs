@@ -6,7 +6,7 @@
 //! would measure nothing. Every body has distinct principal moments, so the default integrator does
 //! its full gyroscopic work (spherical bodies would take a cheaper path).
 
-use glam::{Quat, Vec3};
+use tumble_core::math::{Quat, Real, Vec3};
 use tumble_core::{BodyState, Mass, MassProperties};
 use tumble_rapier::{ComparisonBody, ComparisonScene};
 
@@ -14,22 +14,22 @@ use tumble_rapier::{ComparisonBody, ComparisonScene};
 pub const GRAVITY: Vec3 = Vec3::new(0.0, -9.81, 0.0);
 
 /// Time step (s).
-pub const DT: f32 = 1.0 / 60.0;
+pub const DT: Real = 1.0 / 60.0;
 
 /// The scene with `n` bodies, deterministic.
 pub fn scene(n: usize) -> ComparisonScene {
     let bodies = (0..n)
         .map(|i| {
-            let f = (i as f32 + 0.5) / n as f32;
-            let g = ((i as f32) * 0.618_034).fract();
+            let f = (i as Real + 0.5) / n as Real;
+            let g = ((i as Real) * 0.618_034).fract();
             let mass = Mass::new(0.5 + f).expect("positive mass");
             let inertia = Vec3::new(1.0, 2.0 + f, 3.0 + 2.0 * g) * mass.get();
             let properties = MassProperties::new(mass, inertia).expect("valid inertia");
-            let side = (n as f32).cbrt().ceil().max(1.0) as usize;
+            let side = (n as Real).cbrt().ceil().max(1.0) as usize;
             let cell = Vec3::new(
-                (i % side) as f32,
-                ((i / side) % side) as f32,
-                (i / (side * side)) as f32,
+                (i % side) as Real,
+                ((i / side) % side) as Real,
+                (i / (side * side)) as Real,
             );
             let state = BodyState {
                 position: cell * 2.0,

@@ -1,7 +1,8 @@
 //! `tumble compare`: the scene in tumble and in rapier 0.36, side by side.
 
-use glam::{DQuat, Quat};
+use glam::DQuat;
 use tumble_core::exact::TorqueFreeTop;
+use tumble_core::math::{Narrow, Quat, Real, Vec3, Widen, to_f64};
 use tumble_core::{BodyState, Integrator};
 use tumble_rapier::{ComparisonBody, ComparisonOptions, ComparisonScene, Load, compare};
 use tumble_scene::{ForceDef, Scene};
@@ -25,8 +26,8 @@ pub fn run(scene: &Scene, integrator: Integrator, gyroscopic: bool) -> Result<()
         match force {
             ForceDef::Constant { body, force, point } => {
                 let i = index(body).ok_or("unknown body")?;
-                let f = glam::DVec3::from_array(*force).as_vec3();
-                let p = point.map(|p| glam::DVec3::from_array(p).as_vec3());
+                let f = glam::DVec3::from_array(*force).narrow();
+                let p = point.map(|p| glam::DVec3::from_array(p).narrow());
                 bodies[i].loads.push(Load::Force {
                     force: f,
                     local_point: p,
@@ -36,7 +37,7 @@ pub fn run(scene: &Scene, integrator: Integrator, gyroscopic: bool) -> Result<()
                 let i = index(body).ok_or("unknown body")?;
                 bodies[i]
                     .loads
-                    .push(Load::Torque(glam::DVec3::from_array(*torque).as_vec3()));
+                    .push(Load::Torque(glam::DVec3::from_array(*torque).narrow()));
             }
             ForceDef::Spring { .. } => {
                 return Err(format!(
@@ -56,7 +57,7 @@ pub fn run(scene: &Scene, integrator: Integrator, gyroscopic: bool) -> Result<()
     // Exact solutions for bodies without loads or damping: the position is the parabola
     // x₀ + v₀t + ½ g s t²; the orientation is a steady rotation for a spherical body, or the
     // elliptic torque-free top for distinct moments (identity principal frame).
-    let gravity = scene.gravity.unwrap_or(glam::Vec3::ZERO).as_dvec3();
+    let gravity = scene.gravity.unwrap_or(Vec3::ZERO).widen();
     let exact_for: Vec<Option<(Option<TorqueFreeTop>, bool)>> = comparison
         .bodies
         .iter()
@@ -73,9 +74,9 @@ pub fn run(scene: &Scene, integrator: Integrator, gyroscopic: bool) -> Result<()
             }
             let w_body = b.state.rotation.inverse() * b.state.angular_velocity;
             TorqueFreeTop::new(
-                b.mass.principal_inertia().as_dvec3(),
-                w_body.as_dvec3(),
-                b.state.rotation.as_dquat(),
+                b.mass.principal_inertia().widen(),
+                w_body.widen(),
+                b.state.rotation.widen(),
             )
             .ok()
             .map(|top| (Some(top), false))
@@ -87,17 +88,17 @@ pub fn run(scene: &Scene, integrator: Integrator, gyroscopic: bool) -> Result<()
         let q: DQuat = match top {
             Some(top) => top.orientation(t),
             None if *spherical => {
-                DQuat::from_scaled_axis(b.state.angular_velocity.as_dvec3() * t)
-                    * b.state.rotation.as_dquat()
+                DQuat::from_scaled_axis(b.state.angular_velocity.widen() * t)
+                    * b.state.rotation.widen()
             }
             None => return None,
         };
-        let x = b.state.position.as_dvec3()
-            + b.state.linear_velocity.as_dvec3() * t
-            + 0.5 * gravity * f64::from(b.gravity_scale) * t * t;
+        let x = b.state.position.widen()
+            + b.state.linear_velocity.widen() * t
+            + 0.5 * gravity * to_f64(b.gravity_scale) * t * t;
         Some(BodyState {
-            position: x.as_vec3(),
-            rotation: Quat::from_xyzw(q.x as f32, q.y as f32, q.z as f32, q.w as f32),
+            position: x.narrow(),
+            rotation: Quat::from_xyzw(q.x as Real, q.y as Real, q.z as Real, q.w as Real),
             ..Default::default()
         })
     };

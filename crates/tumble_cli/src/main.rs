@@ -5,6 +5,7 @@ mod compare;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
+use tumble_core::math::{Vec3, Widen, to_f64};
 
 use bevy_ecs::prelude::*;
 use clap::{Parser, Subcommand};
@@ -282,11 +283,11 @@ fn drift(before: f64, after: f64) -> String {
 /// Total kinetic energy and |ΣL| of the bodies.
 fn totals(world: &mut World) -> (f64, f64) {
     let mut q = world.query_filtered::<(&Transform, &Velocity, &MassProps), With<RigidBody>>();
-    let (mut e, mut l) = (0.0, glam::Vec3::ZERO.as_dvec3());
+    let (mut e, mut l) = (0.0, Vec3::ZERO.widen());
     for (t, v, m) in q.iter(world) {
         let s = body_state(t, v, m);
-        e += f64::from(kinetic_energy(&s, m));
-        l += angular_momentum(&s, m).as_dvec3();
+        e += to_f64(kinetic_energy(&s, m));
+        l += angular_momentum(&s, m).widen();
     }
     (e, l.length())
 }

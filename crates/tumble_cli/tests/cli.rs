@@ -1,6 +1,7 @@
 //! The `tumble` binary: CSV exactly as specified, bit-identical to the library, clean failures.
 
 use std::process::Command;
+use tumble_core::math::Real;
 
 use tumble_ecs::prelude::*;
 use tumble_scene::{CSV_HEADER, load_scene};
@@ -55,7 +56,7 @@ fn run_writes_the_specified_csv_bit_identical_to_the_library() {
         assert_eq!((row[0], row[2]), ("50", name.as_str()));
         let t = built.world.get::<Transform>(*e).unwrap();
         let v = built.world.get::<Velocity>(*e).unwrap();
-        let values: Vec<f32> = row[3..].iter().map(|x| x.parse().unwrap()).collect();
+        let values: Vec<Real> = row[3..].iter().map(|x| x.parse().unwrap()).collect();
         let expected = [
             t.translation.x,
             t.translation.y,

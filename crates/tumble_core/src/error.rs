@@ -1,12 +1,13 @@
 //! Typed errors for invalid physical input.
 
+use crate::math::{Quat, Real, Vec3};
 use thiserror::Error;
 
 /// Largest accepted deviation `||q| − 1|` of a rotation quaternion.
 ///
 /// Quaternions built with glam's constructors are unit to about 1e-7; the integrators renormalize
 /// every step. Anything beyond this tolerance is a bug in the caller, not round-off.
-pub const UNIT_QUATERNION_TOLERANCE: f32 = 1e-4;
+pub const UNIT_QUATERNION_TOLERANCE: Real = 1e-4;
 
 /// Why a piece of physical input was rejected.
 #[derive(Debug, Clone, PartialEq, Error)]
@@ -21,13 +22,13 @@ pub enum InvalidInput {
     },
     /// Mass must be strictly positive and finite.
     #[error("mass must be > 0 and finite, got {0}")]
-    NonPositiveMass(f32),
+    NonPositiveMass(Real),
     /// Density must be strictly positive and finite.
     #[error("density must be > 0 and finite, got {0}")]
-    NonPositiveDensity(f32),
+    NonPositiveDensity(Real),
     /// A principal moment of inertia is negative (or NaN).
     #[error("principal inertia must be >= 0 on every axis, got [{}, {}, {}]", .0[0], .0[1], .0[2])]
-    NegativeInertia([f32; 3]),
+    NegativeInertia([Real; 3]),
     /// All principal moments are zero: the body could not rotate at all and has no inertia tensor.
     #[error("principal inertia is zero on every axis; give at least one axis a positive moment")]
     ZeroInertia,
@@ -39,18 +40,18 @@ pub enum InvalidInput {
         /// Which quaternion, e.g. `"rotation"`.
         field: &'static str,
         /// Its length.
-        norm: f32,
+        norm: Real,
     },
     /// The time step must be strictly positive and finite.
     #[error("time step must be > 0 and finite, got {0}")]
-    NonPositiveTimeStep(f32),
+    NonPositiveTimeStep(Real),
     /// Saved data whose parts disagree (e.g. moments and their stored reciprocals).
     #[error("inconsistent saved data: {0}")]
     Inconsistent(&'static str),
 }
 
 /// Checks that `value` is finite.
-pub fn check_finite_vec3(field: &'static str, value: glam::Vec3) -> Result<(), InvalidInput> {
+pub fn check_finite_vec3(field: &'static str, value: Vec3) -> Result<(), InvalidInput> {
     if value.is_finite() {
         Ok(())
     } else {
@@ -62,7 +63,7 @@ pub fn check_finite_vec3(field: &'static str, value: glam::Vec3) -> Result<(), I
 }
 
 /// Checks that `q` is finite and of unit length within [`UNIT_QUATERNION_TOLERANCE`].
-pub fn check_unit_quat(field: &'static str, q: glam::Quat) -> Result<(), InvalidInput> {
+pub fn check_unit_quat(field: &'static str, q: Quat) -> Result<(), InvalidInput> {
     if !q.is_finite() {
         return Err(InvalidInput::NonFinite {
             field,
@@ -77,7 +78,7 @@ pub fn check_unit_quat(field: &'static str, q: glam::Quat) -> Result<(), Invalid
 }
 
 /// Checks that a time step is strictly positive and finite.
-pub fn check_time_step(dt: f32) -> Result<(), InvalidInput> {
+pub fn check_time_step(dt: Real) -> Result<(), InvalidInput> {
     if dt.is_finite() && dt > 0.0 {
         Ok(())
     } else {

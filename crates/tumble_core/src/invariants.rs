@@ -1,20 +1,19 @@
 //! Invariants of free motion: kinetic energy, linear momentum, world angular momentum.
 
-use glam::Vec3;
-
 use crate::mass::MassProperties;
+use crate::math::{Real, Vec3};
 use crate::state::BodyState;
 
 /// Kinetic energy `T = ½ m |v|² + ½ ωᵀ I ω` (J), with `I` the world inertia tensor.
 #[inline]
-pub fn kinetic_energy(state: &BodyState, mass: &MassProperties) -> f32 {
+pub fn kinetic_energy(state: &BodyState, mass: &MassProperties) -> Real {
     let linear = 0.5 * mass.mass() * state.linear_velocity.length_squared();
     linear + rotational_energy(state, mass)
 }
 
 /// Rotational kinetic energy `½ ωᵀ I ω` (J).
 #[inline]
-pub fn rotational_energy(state: &BodyState, mass: &MassProperties) -> f32 {
+pub fn rotational_energy(state: &BodyState, mass: &MassProperties) -> Real {
     0.5 * state
         .angular_velocity
         .dot(mass.world_inertia_mul(state.rotation, state.angular_velocity))

@@ -20,11 +20,12 @@ pub mod exact;
 pub mod integrate;
 pub mod invariants;
 pub mod mass;
+pub mod math;
 pub mod reference;
 pub mod rotation;
 #[cfg(feature = "serde")]
 mod serde_impls;
-#[cfg(feature = "parry")]
+#[cfg(any(feature = "parry", feature = "parry-f64"))]
 pub mod shapes;
 pub mod state;
 

@@ -3,17 +3,16 @@
 //! [`Mass`] and [`Density`] are distinct types, so a density can never be passed where a mass is
 //! expected (or the reverse).
 
-use glam::{Quat, Vec3};
-
 use crate::error::{InvalidInput, check_finite_vec3, check_unit_quat};
+use crate::math::{Quat, Real, Vec3};
 
 /// A mass in kilograms, strictly positive and finite.
 #[derive(Debug, Clone, Copy, PartialEq, PartialOrd)]
-pub struct Mass(f32);
+pub struct Mass(Real);
 
 impl Mass {
     /// Creates a mass; rejects values that are not finite or not `> 0`.
-    pub fn new(kilograms: f32) -> Result<Self, InvalidInput> {
+    pub fn new(kilograms: Real) -> Result<Self, InvalidInput> {
         if kilograms.is_finite() && kilograms > 0.0 {
             Ok(Self(kilograms))
         } else {
@@ -23,7 +22,7 @@ impl Mass {
 
     /// The mass in kilograms.
     #[inline]
-    pub fn get(self) -> f32 {
+    pub fn get(self) -> Real {
         self.0
     }
 }
@@ -35,14 +34,14 @@ impl Mass {
 /// ```compile_fail
 /// use tumble_core::{Density, MassProperties};
 /// let rho = Density::new(1000.0).unwrap();
-/// let props = MassProperties::new(rho, glam::Vec3::ONE); // error: expected `Mass`
+/// let props = MassProperties::new(rho, tumble_core::math::Vec3::ONE); // error: expected `Mass`
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq, PartialOrd)]
-pub struct Density(f32);
+pub struct Density(Real);
 
 impl Density {
     /// Creates a density; rejects values that are not finite or not `> 0`.
-    pub fn new(kg_per_m3: f32) -> Result<Self, InvalidInput> {
+    pub fn new(kg_per_m3: Real) -> Result<Self, InvalidInput> {
         if kg_per_m3.is_finite() && kg_per_m3 > 0.0 {
             Ok(Self(kg_per_m3))
         } else {
@@ -52,7 +51,7 @@ impl Density {
 
     /// The density in kg/m³.
     #[inline]
-    pub fn get(self) -> f32 {
+    pub fn get(self) -> Real {
         self.0
     }
 }
@@ -74,7 +73,7 @@ impl Density {
     )
 )]
 pub struct MassProperties {
-    inv_mass: f32,
+    inv_mass: Real,
     principal_inertia: Vec3,
     inv_principal_inertia: Vec3,
     principal_frame: Quat,
@@ -83,7 +82,7 @@ pub struct MassProperties {
 
 /// Reciprocal of a principal moment, with `0` for a locked (zero-moment) axis.
 #[inline]
-fn locked_reciprocal(moment: f32) -> f32 {
+fn locked_reciprocal(moment: Real) -> Real {
     if moment > 0.0 { 1.0 / moment } else { 0.0 }
 }
 
@@ -91,7 +90,7 @@ impl MassProperties {
     /// Assembles already-validated parts (used by deserialization after its checks).
     #[cfg(feature = "serde")]
     pub(crate) fn from_parts(
-        inv_mass: f32,
+        inv_mass: Real,
         principal_inertia: Vec3,
         inv_principal_inertia: Vec3,
         principal_frame: Quat,
@@ -133,7 +132,7 @@ impl MassProperties {
     }
 
     /// A solid sphere of the given mass and radius: `I = 2/5 m r²` on every axis.
-    pub fn solid_sphere(mass: Mass, radius: f32) -> Result<Self, InvalidInput> {
+    pub fn solid_sphere(mass: Mass, radius: Real) -> Result<Self, InvalidInput> {
         let moment = 0.4 * mass.get() * radius * radius;
         Self::new(mass, Vec3::splat(moment))
     }
@@ -165,13 +164,13 @@ impl MassProperties {
 
     /// Mass `m` (kg).
     #[inline]
-    pub fn mass(&self) -> f32 {
+    pub fn mass(&self) -> Real {
         1.0 / self.inv_mass
     }
 
     /// Inverse mass `1/m` (1/kg).
     #[inline]
-    pub fn inv_mass(&self) -> f32 {
+    pub fn inv_mass(&self) -> Real {
         self.inv_mass
     }
 

@@ -1,7 +1,6 @@
 //! Quaternion helpers: the exponential map and its linearization.
 
-use glam::{Quat, Vec3};
-
+use crate::math::{Quat, Real, Vec3, Widen};
 /// The unit quaternion of a rotation by the vector `θ` (axis `θ/|θ|`, angle `|θ|`):
 /// `exp(½ θ) = (sin(|θ|/2) θ/|θ|, cos(|θ|/2))`, exact for every angle.
 ///
@@ -24,14 +23,14 @@ pub fn exp_rotation(theta: Vec3) -> Quat {
 /// Rotates `q` by the world angular velocity `ω` over `dt` with the exact exponential map:
 /// `q ← exp(½ Δt ω) q`, then renormalizes to remove round-off.
 #[inline]
-pub fn rotate_exact(q: Quat, omega: Vec3, dt: f32) -> Quat {
+pub fn rotate_exact(q: Quat, omega: Vec3, dt: Real) -> Quat {
     (exp_rotation(omega * dt) * q).normalize()
 }
 
 /// The linearized update `q ← normalize(q + ½ Δt (ω, 0) q)`: first-order, its error grows with
 /// `|ω|Δt` (kept to show that error, see the `symplectic-euler-linear` integrator).
 #[inline]
-pub fn rotate_linearized(q: Quat, omega: Vec3, dt: f32) -> Quat {
+pub fn rotate_linearized(q: Quat, omega: Vec3, dt: Real) -> Quat {
     let w = Quat::from_xyzw(omega.x, omega.y, omega.z, 0.0);
     (q + (w * q) * (0.5 * dt)).normalize()
 }
@@ -41,6 +40,6 @@ pub fn rotate_linearized(q: Quat, omega: Vec3, dt: f32) -> Quat {
 /// every digit (and returns 0 once round-off pushes the dot product past 1).
 #[inline]
 pub fn angle_between(a: Quat, b: Quat) -> f64 {
-    let r = a.as_dquat().normalize().conjugate() * b.as_dquat().normalize();
+    let r = a.widen().normalize().conjugate() * b.widen().normalize();
     2.0 * glam::DVec3::new(r.x, r.y, r.z).length().atan2(r.w.abs())
 }

@@ -2,6 +2,7 @@
 //! construction go through a checked mirror, so a deserialized value is exactly the saved one
 //! (bit for bit, for an exact resume) and never an invalid one.
 
+use crate::math::{Quat, Real, Vec3};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{InvalidInput, check_finite_vec3, check_unit_quat};
@@ -12,11 +13,11 @@ use crate::mass::MassProperties;
 #[derive(Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(crate) struct MassPropertiesData {
-    pub inv_mass: f32,
-    pub principal_inertia: glam::Vec3,
-    pub inv_principal_inertia: glam::Vec3,
-    pub principal_frame: glam::Quat,
-    pub local_center_of_mass: glam::Vec3,
+    pub inv_mass: Real,
+    pub principal_inertia: Vec3,
+    pub inv_principal_inertia: Vec3,
+    pub principal_frame: Quat,
+    pub local_center_of_mass: Vec3,
 }
 
 impl TryFrom<MassPropertiesData> for MassProperties {

@@ -1,8 +1,7 @@
 //! Rigid-body state and the external load applied over one step.
 
-use glam::{Quat, Vec3};
-
 use crate::error::{InvalidInput, check_finite_vec3, check_unit_quat};
+use crate::math::{Quat, Vec3};
 
 /// Kinematic state of one rigid body.
 ///
@@ -54,7 +53,7 @@ impl BodyState {
             self.rotation,
         );
         let vectors = p * 0.0 + v * 0.0 + w * 0.0;
-        let quat = glam::Vec4::from(q) * 0.0;
+        let quat = crate::math::Vec4::from(q) * 0.0;
         (vectors.x + vectors.y + vectors.z + quat.x + quat.y + quat.z + quat.w) == 0.0
     }
 

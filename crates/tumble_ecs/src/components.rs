@@ -1,7 +1,8 @@
 //! Components and resources: the whole public data model of a tumble world.
 
 use bevy_ecs::prelude::*;
-use glam::{Quat, Vec3};
+use tumble_core::math::{Quat, Real, Vec3};
+
 use tumble_core::{BodyState, Integrator, InvalidInput, MassProperties};
 
 use crate::validate::revalidate_body_hook;
@@ -213,7 +214,7 @@ impl ForceAccumulator {
 /// Multiplies the world [`Gravity`] for one body (1 = normal, 0 = none, −1 = reversed).
 #[derive(Component, Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-pub struct GravityScale(pub f32);
+pub struct GravityScale(pub Real);
 
 impl Default for GravityScale {
     fn default() -> Self {
@@ -227,9 +228,9 @@ impl Default for GravityScale {
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Damping {
     /// Linear coefficient `c_lin` (1/s).
-    pub linear: f32,
+    pub linear: Real,
     /// Angular coefficient `c_ang` (1/s).
-    pub angular: f32,
+    pub angular: Real,
 }
 
 /// Uniform gravitational acceleration `g` (m/s²). Absent resource ⇒ no gravity system at all.
@@ -251,26 +252,26 @@ impl Gravity {
     serde(try_from = "PhysicsSettingsData", into = "PhysicsSettingsData")
 )]
 pub struct PhysicsSettings {
-    dt: f32,
+    dt: Real,
     /// The integration method for every body of the world.
     pub integrator: Integrator,
 }
 
 impl PhysicsSettings {
     /// Settings with time step `dt` (s) and the given integrator; rejects `dt ≤ 0` and NaN/Inf.
-    pub fn new(dt: f32, integrator: Integrator) -> Result<Self, InvalidInput> {
+    pub fn new(dt: Real, integrator: Integrator) -> Result<Self, InvalidInput> {
         tumble_core::error::check_time_step(dt)?;
         Ok(Self { dt, integrator })
     }
 
     /// The fixed time step `Δt` (s).
     #[inline]
-    pub fn dt(&self) -> f32 {
+    pub fn dt(&self) -> Real {
         self.dt
     }
 
     /// Changes the time step; rejects `dt ≤ 0` and NaN/Inf and then leaves the settings unchanged.
-    pub fn set_dt(&mut self, dt: f32) -> Result<(), InvalidInput> {
+    pub fn set_dt(&mut self, dt: Real) -> Result<(), InvalidInput> {
         tumble_core::error::check_time_step(dt)?;
         self.dt = dt;
         Ok(())
@@ -282,7 +283,7 @@ impl PhysicsSettings {
 #[derive(serde::Serialize, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 struct PhysicsSettingsData {
-    dt: f32,
+    dt: Real,
     integrator: Integrator,
 }
 
@@ -322,9 +323,9 @@ impl Default for PhysicsSettings {
 /// bits sit there; when they happen to be a subnormal float pattern every such add takes a
 /// microcode assist (measured: 92 ns instead of 4 ns per body on this machine).
 #[inline]
-fn com_offset(rotation: glam::Quat, mass: &MassProps) -> Option<glam::Vec3> {
+fn com_offset(rotation: Quat, mass: &MassProps) -> Option<Vec3> {
     let c = mass.local_center_of_mass();
-    (c != glam::Vec3::ZERO).then(|| rotation * c)
+    (c != Vec3::ZERO).then(|| rotation * c)
 }
 
 /// Reads a body's core state (centre-of-mass position) from its components.
@@ -332,7 +333,7 @@ fn com_offset(rotation: glam::Quat, mass: &MassProps) -> Option<glam::Vec3> {
 pub fn body_state(transform: &Transform, velocity: &Velocity, mass: &MassProps) -> BodyState {
     let t = transform.translation;
     let position = match com_offset(transform.rotation, mass) {
-        Some(offset) => glam::Vec3::new(t.x + offset.x, t.y + offset.y, t.z + offset.z),
+        Some(offset) => Vec3::new(t.x + offset.x, t.y + offset.y, t.z + offset.z),
         None => t,
     };
     BodyState {
@@ -354,7 +355,7 @@ pub fn write_body_state(
     transform.rotation = state.rotation;
     let x = state.position;
     transform.translation = match com_offset(state.rotation, mass) {
-        Some(offset) => glam::Vec3::new(x.x - offset.x, x.y - offset.y, x.z - offset.z),
+        Some(offset) => Vec3::new(x.x - offset.x, x.y - offset.y, x.z - offset.z),
         None => x,
     };
     velocity.linear = state.linear_velocity;

@@ -6,7 +6,7 @@
 use bevy_ecs::lifecycle::HookContext;
 use bevy_ecs::prelude::*;
 use bevy_ecs::world::DeferredWorld;
-use glam::Vec3;
+use tumble_core::math::{Real, Vec3};
 
 use crate::components::{
     ForceAccumulator, Gravity, GravityScale, MassProps, RigidBody, Transform, Velocity,
@@ -70,11 +70,11 @@ pub struct Spring {
     /// The other end.
     pub b: SpringEnd,
     /// Stiffness `k` (N/m), `>= 0`.
-    pub stiffness: f32,
+    pub stiffness: Real,
     /// Damping `c` (N·s/m), `>= 0`.
-    pub damping: f32,
+    pub damping: Real,
     /// Rest length `L₀` (m), `>= 0`.
-    pub rest_length: f32,
+    pub rest_length: Real,
 }
 
 /// Inserts a zero [`ForceAccumulator`] on every body a generator names, where missing.

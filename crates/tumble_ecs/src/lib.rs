@@ -39,5 +39,6 @@ pub mod prelude {
     pub use crate::stability::{StabilityWarning, check_stability};
     pub use crate::stepper::{FixedStepper, FrameSteps, interpolate};
     pub use crate::validate::{BodyError, BodyErrorKind, PhysicsErrors, Rejected};
+    pub use tumble_core::math::{Quat, Real, Vec3};
     pub use tumble_core::{Density, Integrator, Mass, MassProperties};
 }

@@ -22,7 +22,7 @@ use crate::runner::PhysicsRunner;
 ///
 /// fn push(mut bodies: Query<&mut ForceAccumulator>) {
 ///     for mut acc in &mut bodies {
-///         acc.add_force(glam::Vec3::X);
+///         acc.add_force(Vec3::X);
 ///     }
 /// }
 ///

@@ -15,7 +15,7 @@ use crate::schedule::PhysicsPlan;
 ///
 /// ```
 /// use bevy_ecs::prelude::World;
-/// use glam::Vec3;
+/// use tumble_core::math::Vec3;
 /// use tumble_ecs::prelude::*;
 ///
 /// let mut world = World::new();

@@ -7,7 +7,9 @@
 //! Resuming from a snapshot taken between two steps gives **bit-identical** results to running
 //! straight through (tested over 10⁴ steps): floats are saved exactly, mass properties are
 //! restored without recomputation, and entities are respawned in their original order, so force
-//! generators sum in the same order.
+//! generators sum in the same order. The serde format must round-trip floats exactly, as binary
+//! formats do; with `serde_json`, enable its `float_roundtrip` feature (its default parser may be
+//! one ulp off for `f64`).
 
 use std::collections::HashMap;
 

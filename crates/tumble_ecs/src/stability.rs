@@ -17,16 +17,17 @@
 
 use bevy_ecs::prelude::*;
 use tumble_core::Integrator;
+use tumble_core::math::{Real, Vec3};
 
 use crate::components::{MassProps, PhysicsSettings, RigidBody, Velocity};
 use crate::forces::{Spring, SpringEnd};
 
 /// `ω Δt` above which the symplectic position update of a spring diverges.
-pub const SPRING_LIMIT: f32 = 2.0;
+pub const SPRING_LIMIT: Real = 2.0;
 
 /// Bodies whose explicit gyroscopic step would amplify round-off to order one within this many
 /// seconds are reported (s).
-pub const EXPLICIT_GYROSCOPIC_HORIZON: f32 = 600.0;
+pub const EXPLICIT_GYROSCOPIC_HORIZON: Real = 600.0;
 
 /// A setting outside the selected integrator's stable region.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -36,7 +37,7 @@ pub enum StabilityWarning {
         /// The spring entity.
         spring: Entity,
         /// `√(k/μ) Δt` (stable below [`SPRING_LIMIT`]).
-        omega_dt: f32,
+        omega_dt: Real,
     },
     /// A spin the explicit gyroscopic step will blow up.
     ExplicitGyroscopic {
@@ -45,7 +46,7 @@ pub enum StabilityWarning {
         /// The integrator.
         integrator: Integrator,
         /// Predicted time for round-off to grow to order one (s).
-        seconds: f32,
+        seconds: Real,
     },
 }
 
@@ -72,7 +73,7 @@ impl std::fmt::Display for StabilityWarning {
 
 /// Squared nutation frequency per unit `|ω|²`, largest over the principal axes:
 /// `max_i |(I_j − I_i)(I_k − I_i)| / (I_j I_k)`.
-fn nutation_factor(inertia: glam::Vec3) -> f32 {
+fn nutation_factor(inertia: Vec3) -> Real {
     let i = inertia.to_array();
     (0..3)
         .map(|a| {
@@ -83,7 +84,7 @@ fn nutation_factor(inertia: glam::Vec3) -> f32 {
                 0.0
             }
         })
-        .fold(0.0, f32::max)
+        .fold(0.0, Real::max)
 }
 
 /// Checks the world's springs and spins against the selected integrator's stable region.
@@ -126,7 +127,7 @@ pub fn check_stability(world: &mut World) -> Vec<StabilityWarning> {
             let omega2 =
                 velocity.angular.length_squared() * nutation_factor(mass.principal_inertia());
             if omega2 > 0.0 {
-                let seconds = 2.0 * 1e7_f32.ln() / (omega2 * dt);
+                let seconds = 2.0 * (1e7 as Real).ln() / (omega2 * dt);
                 if seconds < EXPLICIT_GYROSCOPIC_HORIZON {
                     warnings.push(StabilityWarning::ExplicitGyroscopic {
                         body,

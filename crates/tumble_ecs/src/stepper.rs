@@ -5,8 +5,8 @@
 //! frame): time beyond the cap is dropped and counted. The remainder gives the interpolation
 //! factor `α = accumulator / Δt ∈ [0, 1)` for rendering between the last two states.
 
-use glam::Vec3;
 use thiserror::Error;
+use tumble_core::math::{Real, Vec3, to_f64};
 
 use crate::components::Transform;
 
@@ -15,7 +15,7 @@ use crate::components::Transform;
 pub enum StepperError {
     /// The fixed step must be > 0 and finite.
     #[error("fixed time step must be > 0 and finite, got {0}")]
-    NonPositiveTimeStep(f32),
+    NonPositiveTimeStep(Real),
     /// At least one step per frame must be allowed.
     #[error("max steps per frame must be >= 1")]
     ZeroStepCap,
@@ -39,12 +39,12 @@ pub struct FrameSteps {
     /// Number of fixed steps to run this frame (≤ the cap).
     pub steps: u32,
     /// Interpolation factor `α ∈ [0, 1)` between the previous and the current physics state.
-    pub alpha: f32,
+    pub alpha: Real,
 }
 
 impl FixedStepper {
     /// A stepper with fixed step `dt` (s) and at most `max_steps_per_frame` steps per frame.
-    pub fn new(dt: f32, max_steps_per_frame: u32) -> Result<Self, StepperError> {
+    pub fn new(dt: Real, max_steps_per_frame: u32) -> Result<Self, StepperError> {
         if !(dt.is_finite() && dt > 0.0) {
             return Err(StepperError::NonPositiveTimeStep(dt));
         }
@@ -52,7 +52,7 @@ impl FixedStepper {
             return Err(StepperError::ZeroStepCap);
         }
         Ok(Self {
-            dt: f64::from(dt),
+            dt: to_f64(dt),
             max_steps_per_frame,
             accumulator: 0.0,
             dropped_time: 0.0,
@@ -67,7 +67,7 @@ impl FixedStepper {
         }
         self.accumulator += frame_time;
         let whole = (self.accumulator / self.dt).floor();
-        let cap = f64::from(self.max_steps_per_frame);
+        let cap = to_f64(self.max_steps_per_frame);
         let steps = whole.min(cap);
         self.accumulator -= steps * self.dt;
         if whole > cap {
@@ -78,7 +78,7 @@ impl FixedStepper {
         }
         Ok(FrameSteps {
             steps: steps as u32,
-            alpha: (self.accumulator / self.dt).clamp(0.0, 1.0) as f32,
+            alpha: (self.accumulator / self.dt).clamp(0.0, 1.0) as Real,
         })
     }
 
@@ -88,13 +88,13 @@ impl FixedStepper {
     }
 
     /// The fixed step (s).
-    pub fn dt(&self) -> f32 {
-        self.dt as f32
+    pub fn dt(&self) -> Real {
+        self.dt as Real
     }
 }
 
 /// Interpolates a pose for rendering: linear in translation, spherical (slerp) in rotation.
-pub fn interpolate(previous: &Transform, current: &Transform, alpha: f32) -> Transform {
+pub fn interpolate(previous: &Transform, current: &Transform, alpha: Real) -> Transform {
     Transform {
         translation: Vec3::lerp(previous.translation, current.translation, alpha),
         rotation: previous.rotation.slerp(current.rotation, alpha),

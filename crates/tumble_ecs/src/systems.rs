@@ -5,6 +5,7 @@
 //! quarantined with [`Rejected`] and keeps its last valid state, and the others step on unharmed.
 
 use std::sync::Mutex;
+use tumble_core::math::Vec3;
 
 use arrayvec::ArrayVec;
 use bevy_ecs::prelude::*;
@@ -35,7 +36,7 @@ const CHUNK: usize = 64;
 enum Loads<'a> {
     /// A uniform field (or nothing): `F = m s g`, no torque.
     Field {
-        gravity: Option<glam::Vec3>,
+        gravity: Option<Vec3>,
         scales: Option<&'a [GravityScale]>,
     },
     /// Accumulators that are only checked (the first half-drift samples no load).
@@ -76,7 +77,7 @@ impl Loads<'_> {
             Loads::Field { gravity, scales } => Ok(match gravity {
                 Some(g) => Wrench {
                     force: (mass.mass() * scales.map_or(1.0, |s| s[i].0)) * *g,
-                    torque: glam::Vec3::ZERO,
+                    torque: Vec3::ZERO,
                 },
                 None => Wrench::ZERO,
             }),

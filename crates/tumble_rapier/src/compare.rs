@@ -1,6 +1,7 @@
 //! Stepping both engines side by side and measuring their differences.
 
 use std::time::Instant;
+use tumble_core::math::{Real, to_f64};
 
 use tumble_core::rotation::angle_between;
 use tumble_core::{BodyState, Integrator};
@@ -39,13 +40,13 @@ pub struct BodyDifference {
     /// Body name.
     pub name: String,
     /// max |x_tumble − x_rapier| (m), centre of mass.
-    pub position: f32,
+    pub position: Real,
     /// max orientation angle between the engines (rad).
     pub angle: f64,
     /// max |v_tumble − v_rapier| (m/s).
-    pub linear_velocity: f32,
+    pub linear_velocity: Real,
     /// max |ω_tumble − ω_rapier| (rad/s).
-    pub angular_velocity: f32,
+    pub angular_velocity: Real,
     /// Against the exact solution, when one was given: (tumble, rapier) max position error (m).
     pub exact_position: Option<(f64, f64)>,
     /// Against the exact solution: (tumble, rapier) max orientation error (rad).
@@ -98,7 +99,7 @@ pub fn compare(
         let start = Instant::now();
         rapier.step();
         rapier_ns += start.elapsed().as_nanos();
-        let t = f64::from(scene.dt) * step as f64;
+        let t = to_f64(scene.dt) * step as f64;
         for (i, diff) in bodies.iter_mut().enumerate() {
             let (a, b) = (tumble.state(i), rapier.state(i));
             diff.position = diff.position.max((a.position - b.position).length());
@@ -110,7 +111,7 @@ pub fn compare(
                 .angular_velocity
                 .max((a.angular_velocity - b.angular_velocity).length());
             if let Some(reference) = exact.and_then(|f| f(i, t)) {
-                let pos = |s: &BodyState| f64::from((s.position - reference.position).length());
+                let pos = |s: &BodyState| to_f64((s.position - reference.position).length());
                 let (pt, pr) = diff.exact_position.unwrap_or((0.0, 0.0));
                 diff.exact_position = Some((pt.max(pos(&a)), pr.max(pos(&b))));
                 let (at, ar) = diff.exact_angle.unwrap_or((0.0, 0.0));

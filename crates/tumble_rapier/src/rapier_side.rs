@@ -1,13 +1,39 @@
 //! The scene built in rapier.
 
-use glam::Vec3;
 use rapier3d::prelude::{
     IntegrationParameters, MassProperties as RapierMass, PhysicsWorld, Pose, RigidBodyBuilder,
     RigidBodyHandle,
 };
 use tumble_core::BodyState;
+use tumble_core::math::{Narrow, Quat, Real, Vec3, Widen};
 
 use crate::scene::{ComparisonScene, Load};
+
+/// rapier links `parry3d` in `f32`: tumble's numbers are rounded to `f32` on the way in (exact in
+/// the default build, one rounding in an `f64` build) and widened exactly on the way out.
+fn vec_in(v: Vec3) -> glam::Vec3 {
+    v.widen().as_vec3()
+}
+
+/// A rotation into rapier's `f32`.
+fn quat_in(q: Quat) -> glam::Quat {
+    q.widen().as_quat()
+}
+
+/// A scalar into rapier's `f32`.
+fn real_in(x: Real) -> f32 {
+    x.widen() as f32
+}
+
+/// A vector out of rapier, in tumble's precision.
+fn vec_out(v: glam::Vec3) -> Vec3 {
+    v.as_dvec3().narrow()
+}
+
+/// A rotation out of rapier, in tumble's precision.
+fn quat_out(q: glam::Quat) -> Quat {
+    q.as_dquat().narrow()
+}
 
 /// A rapier world holding the bodies of a [`ComparisonScene`].
 pub struct RapierScene {
@@ -23,9 +49,9 @@ impl RapierScene {
     /// iterations (= substeps for free bodies; rapier's default is 4).
     pub fn new(scene: &ComparisonScene, gyroscopic: bool, solver_iterations: usize) -> Self {
         let mut world = PhysicsWorld::new();
-        world.gravity = scene.gravity.unwrap_or(Vec3::ZERO);
+        world.gravity = vec_in(scene.gravity.unwrap_or(Vec3::ZERO));
         world.integration_parameters = IntegrationParameters {
-            dt: scene.dt,
+            dt: real_in(scene.dt),
             num_solver_iterations: solver_iterations.max(1),
             ..IntegrationParameters::default()
         };
@@ -37,19 +63,22 @@ impl RapierScene {
             let c = m.local_center_of_mass();
             let origin = body.state.position - body.state.rotation * c;
             let props = RapierMass::with_principal_inertia_frame(
-                c,
-                m.mass(),
-                m.principal_inertia(),
-                m.principal_frame(),
+                vec_in(c),
+                real_in(m.mass()),
+                vec_in(m.principal_inertia()),
+                quat_in(m.principal_frame()),
             );
             let builder = RigidBodyBuilder::dynamic()
-                .pose(Pose::from_parts(origin, body.state.rotation))
-                .linvel(body.state.linear_velocity)
-                .angvel(body.state.angular_velocity)
+                .pose(Pose::from_parts(
+                    vec_in(origin),
+                    quat_in(body.state.rotation),
+                ))
+                .linvel(vec_in(body.state.linear_velocity))
+                .angvel(vec_in(body.state.angular_velocity))
                 .additional_mass_properties(props)
-                .gravity_scale(body.gravity_scale)
-                .linear_damping(body.linear_damping)
-                .angular_damping(body.angular_damping)
+                .gravity_scale(real_in(body.gravity_scale))
+                .linear_damping(real_in(body.linear_damping))
+                .angular_damping(real_in(body.angular_damping))
                 .gyroscopic_forces_enabled(gyroscopic)
                 .can_sleep(false)
                 .allow_fast_rotation(true);
@@ -86,15 +115,15 @@ impl RapierScene {
                     Load::Force {
                         force,
                         local_point: None,
-                    } => rb.add_force(force, false),
+                    } => rb.add_force(vec_in(force), false),
                     Load::Force {
                         force,
                         local_point: Some(p),
                     } => {
-                        let point = *rb.position() * p;
-                        rb.add_force_at_point(force, point, false);
+                        let point = *rb.position() * vec_in(p);
+                        rb.add_force_at_point(vec_in(force), point, false);
                     }
-                    Load::Torque(torque) => rb.add_torque(torque, false),
+                    Load::Torque(torque) => rb.add_torque(vec_in(torque), false),
                 }
             }
         }
@@ -109,12 +138,12 @@ impl RapierScene {
     /// The state of body `i` (position = centre of mass).
     pub fn state(&self, i: usize) -> BodyState {
         let rb = &self.world.bodies[self.handles[i]];
-        let rotation = *rb.rotation();
+        let rotation = quat_out(*rb.rotation());
         BodyState {
-            position: rb.translation() + rotation * self.local_com[i],
+            position: vec_out(rb.translation()) + rotation * self.local_com[i],
             rotation,
-            linear_velocity: rb.linvel(),
-            angular_velocity: rb.angvel(),
+            linear_velocity: vec_out(rb.linvel()),
+            angular_velocity: vec_out(rb.angvel()),
         }
     }
 

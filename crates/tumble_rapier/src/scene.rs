@@ -1,6 +1,6 @@
 //! The engine-neutral description of a scene both engines can run.
 
-use glam::Vec3;
+use tumble_core::math::{Real, Vec3};
 use tumble_core::{BodyState, MassProperties};
 
 /// A constant load on one body, sampled once per step at the current pose.
@@ -27,11 +27,11 @@ pub struct ComparisonBody {
     /// Initial state; `position` is the centre of mass.
     pub state: BodyState,
     /// Gravity scale (1 = normal).
-    pub gravity_scale: f32,
+    pub gravity_scale: Real,
     /// Padé linear damping coefficient (1/s).
-    pub linear_damping: f32,
+    pub linear_damping: Real,
     /// Padé angular damping coefficient (1/s).
-    pub angular_damping: f32,
+    pub angular_damping: Real,
     /// Constant loads.
     pub loads: Vec<Load>,
 }
@@ -61,7 +61,7 @@ impl ComparisonBody {
 #[derive(Debug, Clone, PartialEq)]
 pub struct ComparisonScene {
     /// Time step (s).
-    pub dt: f32,
+    pub dt: Real,
     /// Uniform gravity, or none.
     pub gravity: Option<Vec3>,
     /// The bodies.

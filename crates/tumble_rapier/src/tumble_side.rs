@@ -2,6 +2,7 @@
 
 use bevy_ecs::prelude::*;
 use bevy_ecs::schedule::Schedule;
+use tumble_core::math::Vec3;
 use tumble_core::{BodyState, Integrator};
 use tumble_ecs::components::{body_state, write_body_state};
 use tumble_ecs::prelude::*;
@@ -89,7 +90,7 @@ impl TumbleScene {
             self.world.get::<MassProps>(e),
         ) else {
             return BodyState {
-                position: glam::Vec3::NAN,
+                position: Vec3::NAN,
                 ..BodyState::default()
             };
         };

@@ -1,9 +1,9 @@
 //! Energy over time for long torque-free spins: where each method's energy error goes in
 //! 120 s at 60 Hz (I = diag(1, 2, 3), |ω| = 10 rad/s).
 
-use glam::Vec3;
 use serde::Serialize;
 use tumble_core::invariants::kinetic_energy;
+use tumble_core::math::{Vec3, to_f64};
 use tumble_core::{BodyState, Mass, MassProperties, Wrench};
 use tumble_rapier::{ComparisonBody, ComparisonScene, RapierScene};
 
@@ -40,7 +40,7 @@ pub fn traces(seconds: usize) -> Vec<EnergyTrace> {
             angular_velocity: omega0,
             ..Default::default()
         };
-        let e0 = f64::from(kinetic_energy(&initial, &mass));
+        let e0 = to_f64(kinetic_energy(&initial, &mass));
         for method in Method::all() {
             let mut values = vec![0.0];
             match method {
@@ -55,7 +55,7 @@ pub fn traces(seconds: usize) -> Vec<EnergyTrace> {
                                 state.angular_velocity = Vec3::NAN;
                             }
                         }
-                        values.push(f64::from(kinetic_energy(&state, &mass)) / e0 - 1.0);
+                        values.push(to_f64(kinetic_energy(&state, &mass)) / e0 - 1.0);
                     }
                 }
                 Method::Rapier => {
@@ -70,7 +70,7 @@ pub fn traces(seconds: usize) -> Vec<EnergyTrace> {
                             world.step();
                         }
                         let s = world.state(0);
-                        values.push(f64::from(kinetic_energy(&s, &mass)) / e0 - 1.0);
+                        values.push(to_f64(kinetic_energy(&s, &mass)) / e0 - 1.0);
                     }
                 }
             }

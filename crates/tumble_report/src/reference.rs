@@ -1,7 +1,8 @@
 //! Reference scenes with exact solutions (f64).
 
-use glam::{DQuat, DVec3, Quat, Vec3};
+use glam::{DQuat, DVec3};
 use tumble_core::exact::TorqueFreeTop;
+use tumble_core::math::{Quat, Real, Vec3, Widen, to_f64};
 use tumble_core::{BodyState, Mass, MassProperties, Wrench};
 
 /// The load of a reference scene, evaluated at the state where the integrator samples it.
@@ -12,7 +13,7 @@ pub enum Load {
     /// Uniform gravity `g` (m/s²).
     Gravity(Vec3),
     /// A spring of stiffness `k` from the centre of mass to the world origin, rest length 0.
-    Spring(f32),
+    Spring(Real),
     /// A constant world force through a body-local point.
     ForceAtPoint {
         /// Force (N), world frame.
@@ -44,14 +45,14 @@ impl Load {
 
     /// Potential energy (J), so that kinetic + potential is conserved.
     pub fn potential(&self, state: &BodyState, mass: &MassProperties) -> f64 {
-        let x = state.position.as_dvec3();
+        let x = state.position.widen();
         match *self {
             Load::Free => 0.0,
-            Load::Gravity(g) => -f64::from(mass.mass()) * g.as_dvec3().dot(x),
-            Load::Spring(k) => 0.5 * f64::from(k) * x.length_squared(),
-            Load::ForceAtPoint { force, point } => -force
-                .as_dvec3()
-                .dot(x + (state.rotation * point).as_dvec3()),
+            Load::Gravity(g) => -to_f64(mass.mass()) * g.widen().dot(x),
+            Load::Spring(k) => 0.5 * to_f64(k) * x.length_squared(),
+            Load::ForceAtPoint { force, point } => {
+                -force.widen().dot(x + (state.rotation * point).widen())
+            }
         }
     }
 }
@@ -105,7 +106,7 @@ fn pendulum(point: DVec3, force: DVec3, inertia: f64, t: f64) -> DQuat {
 
 fn top(name: &'static str, description: &'static str, omega0: Vec3) -> Case {
     let inertia = Vec3::new(1.0, 2.0, 3.0);
-    let exact_top = TorqueFreeTop::new(inertia.as_dvec3(), omega0.as_dvec3(), DQuat::IDENTITY)
+    let exact_top = TorqueFreeTop::new(inertia.widen(), omega0.widen(), DQuat::IDENTITY)
         .expect("an asymmetric top with finite rates");
     Case {
         name,
@@ -130,7 +131,7 @@ pub fn cases() -> Vec<Case> {
         Vec3::new(3.0, 12.0, -1.0),
         Vec3::new(0.0, -9.81, 0.0),
     );
-    let (k, m) = (100.0_f32, 1.0_f32);
+    let (k, m) = (100.0 as Real, 1.0 as Real);
     let spring_x0 = Vec3::new(0.5, 0.0, 0.0);
     let force = Vec3::new(0.0, 0.0, 1.0);
     let point = Vec3::new(0.5, 0.0, 0.0);
@@ -162,7 +163,7 @@ pub fn cases() -> Vec<Case> {
             load: Load::Gravity(g),
             horizon: 5.0,
             exact: Box::new(move |t| {
-                let x = x0.as_dvec3() + v0.as_dvec3() * t + 0.5 * g.as_dvec3() * t * t;
+                let x = x0.widen() + v0.widen() * t + 0.5 * g.widen() * t * t;
                 (x, DQuat::IDENTITY)
             }),
             rapier: true,
@@ -178,8 +179,8 @@ pub fn cases() -> Vec<Case> {
             load: Load::Spring(k),
             horizon: 10.0,
             exact: Box::new(move |t| {
-                let w = f64::from(k / m).sqrt();
-                (spring_x0.as_dvec3() * (w * t).cos(), DQuat::IDENTITY)
+                let w = to_f64(k / m).sqrt();
+                (spring_x0.widen() * (w * t).cos(), DQuat::IDENTITY)
             }),
             rapier: false,
         },
@@ -192,9 +193,9 @@ pub fn cases() -> Vec<Case> {
             load: Load::ForceAtPoint { force, point },
             horizon: 3.0,
             exact: Box::new(move |t| {
-                let x = 0.5 * (force.as_dvec3() / f64::from(sphere.mass())) * t * t;
-                let inertia = f64::from(sphere.principal_inertia().x);
-                (x, pendulum(point.as_dvec3(), force.as_dvec3(), inertia, t))
+                let x = 0.5 * (force.widen() / to_f64(sphere.mass())) * t * t;
+                let inertia = to_f64(sphere.principal_inertia().x);
+                (x, pendulum(point.widen(), force.widen(), inertia, t))
             }),
             rapier: true,
         },
@@ -203,5 +204,5 @@ pub fn cases() -> Vec<Case> {
 
 /// f64 → f32 quaternion.
 pub fn to_quat(q: DQuat) -> Quat {
-    Quat::from_xyzw(q.x as f32, q.y as f32, q.z as f32, q.w as f32)
+    Quat::from_xyzw(q.x as Real, q.y as Real, q.z as Real, q.w as Real)
 }

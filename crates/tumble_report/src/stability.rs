@@ -2,7 +2,8 @@
 //! game would run, with tumble's stability prediction checked against what happened.
 
 use bevy_ecs::prelude::*;
-use glam::{Quat, Vec3};
+use tumble_core::math::{Quat, Real, Vec3, to_f64};
+
 use serde::Serialize;
 use tumble_core::invariants::kinetic_energy;
 use tumble_core::{Integrator, Mass, MassProperties};
@@ -40,7 +41,7 @@ impl Cell {
     }
 }
 
-fn sphere(m: f32) -> MassProps {
+fn sphere(m: Real) -> MassProps {
     MassProps(MassProperties::solid_sphere(Mass::new(m).expect("valid"), 0.1).expect("valid"))
 }
 
@@ -61,7 +62,7 @@ fn run(
         world.clear_trackers();
         let mut q = world.query::<(&Transform, Option<&Rejected>)>();
         for (t, rejected) in q.iter(world) {
-            max_q = max_q.max(f64::from((t.rotation.length() - 1.0).abs()));
+            max_q = max_q.max(to_f64((t.rotation.length() - 1.0).abs()));
             finite &= rejected.is_none() && t.translation.is_finite();
         }
         if !finite {
@@ -85,7 +86,7 @@ fn total_energy(world: &mut World) -> f64 {
     let mut q = world.query_filtered::<(&Transform, &Velocity, &MassProps), With<RigidBody>>();
     let kinetic: f64 = q
         .iter(world)
-        .map(|(t, v, m)| f64::from(kinetic_energy(&body_state(t, v, m), m)))
+        .map(|(t, v, m)| to_f64(kinetic_energy(&body_state(t, v, m), m)))
         .sum();
     let springs: Vec<Spring> = world.query::<&Spring>().iter(world).copied().collect();
     let mut poses = world.query::<&Transform>();
@@ -103,21 +104,21 @@ fn total_energy(world: &mut World) -> f64 {
                 SpringEnd::World(p) => p,
                 SpringEnd::Body { body, anchor } => point(&mut poses, world, body, anchor),
             };
-            let stretch = f64::from((a - b).length() - s.rest_length);
-            0.5 * f64::from(s.stiffness) * stretch * stretch
+            let stretch = to_f64((a - b).length() - s.rest_length);
+            0.5 * to_f64(s.stiffness) * stretch * stretch
         })
         .sum();
     kinetic + potential
 }
 
-fn world(dt: f32, integrator: Integrator) -> World {
+fn world(dt: Real, integrator: Integrator) -> World {
     let mut w = World::new();
     w.insert_resource(PhysicsSettings::new(dt, integrator).expect("valid dt"));
     w
 }
 
 /// Thin rod (I = (1e-4, 1, 1)) spinning at `|ω|Δt` about a tilted axis.
-fn thin_rod(integrator: Integrator, omega_dt: f32, steps: usize) -> Cell {
+fn thin_rod(integrator: Integrator, omega_dt: Real, steps: usize) -> Cell {
     let dt = 1.0 / 60.0;
     let mut w = world(dt, integrator);
     let mass = MassProperties::new(Mass::new(1.0).expect("valid"), Vec3::new(1e-4, 1.0, 1.0))
@@ -138,8 +139,8 @@ fn thin_rod(integrator: Integrator, omega_dt: f32, steps: usize) -> Cell {
 }
 
 /// A mass on a stiff spring to a world anchor, √(k/m)Δt = `omega_dt`.
-fn stiff_spring(integrator: Integrator, omega_dt: f32, steps: usize) -> Cell {
-    let (dt, m) = (1.0 / 60.0_f32, 1.0_f32);
+fn stiff_spring(integrator: Integrator, omega_dt: Real, steps: usize) -> Cell {
+    let (dt, m) = (1.0 / 60.0 as Real, 1.0 as Real);
     let mut w = world(dt, integrator);
     let body = w
         .spawn((RigidBody, sphere(m), Transform::from_translation(Vec3::X)))
@@ -162,7 +163,7 @@ fn stiff_spring(integrator: Integrator, omega_dt: f32, steps: usize) -> Cell {
 }
 
 /// 1e9 kg and 1 kg on a spring with √(k/m_light)Δt = 1.
-fn mass_ratio(integrator: Integrator, dt: f32, steps: usize) -> Cell {
+fn mass_ratio(integrator: Integrator, dt: Real, steps: usize) -> Cell {
     let mut w = world(dt, integrator);
     let heavy = w.spawn((RigidBody, sphere(1e9))).id();
     let light = w
@@ -193,7 +194,7 @@ fn mass_ratio(integrator: Integrator, dt: f32, steps: usize) -> Cell {
 }
 
 /// A tumbling asymmetric body 1e5 m from the origin.
-fn far_away(integrator: Integrator, dt: f32, steps: usize) -> Cell {
+fn far_away(integrator: Integrator, dt: Real, steps: usize) -> Cell {
     let mut w = world(dt, integrator);
     let mass = MassProperties::new(Mass::new(1.0).expect("valid"), Vec3::new(1.0, 2.0, 3.0))
         .expect("valid");

@@ -1,6 +1,7 @@
 //! Work–precision: error at a fixed horizon against run time per body-step.
 
 use std::time::Instant;
+use tumble_core::math::{Real, Widen, to_f64};
 
 use serde::Serialize;
 use tumble_core::invariants::{angular_momentum, kinetic_energy};
@@ -73,13 +74,13 @@ pub struct Effort {
 }
 
 fn energy(case: &Case, s: &BodyState) -> f64 {
-    f64::from(kinetic_energy(s, &case.mass)) + case.load.potential(s, &case.mass)
+    to_f64(kinetic_energy(s, &case.mass)) + case.load.potential(s, &case.mass)
 }
 
 fn tumble_run(
     case: &Case,
     integrator: Integrator,
-    dt: f32,
+    dt: Real,
     steps: usize,
     batch: usize,
 ) -> (BodyState, f64) {
@@ -105,7 +106,7 @@ fn tumble_run(
     (states[0], start.elapsed().as_nanos() as f64)
 }
 
-fn rapier_run(case: &Case, dt: f32, steps: usize, batch: usize) -> (BodyState, f64) {
+fn rapier_run(case: &Case, dt: Real, steps: usize, batch: usize) -> (BodyState, f64) {
     let mut body = ComparisonBody::new(case.name, case.mass, case.initial);
     let gravity = match case.load {
         Load::Gravity(g) => Some(g),
@@ -134,7 +135,7 @@ fn rapier_run(case: &Case, dt: f32, steps: usize, batch: usize) -> (BodyState, f
 /// Measures one (scene, method, Δt) point.
 pub fn measure(case: &Case, method: Method, dt: f64, effort: Effort) -> Point {
     let steps = (case.horizon / dt).round() as usize;
-    let dt32 = dt as f32;
+    let dt32 = dt as Real;
     let mut best = f64::INFINITY;
     let mut last = case.initial;
     for _ in 0..effort.repetitions.max(1) {
@@ -145,20 +146,20 @@ pub fn measure(case: &Case, method: Method, dt: f64, effort: Effort) -> Point {
         best = best.min(ns / (steps * effort.batch) as f64);
         last = state;
     }
-    let t = steps as f64 * f64::from(dt32);
+    let t = steps as f64 * to_f64(dt32);
     let (x, q) = (case.exact)(t);
     let finite = last.is_finite();
     let e0 = energy(case, &case.initial);
-    let l0 = f64::from(angular_momentum(&case.initial, &case.mass).length());
+    let l0 = to_f64(angular_momentum(&case.initial, &case.mass).length());
     let momentum_drift = (case.load == Load::Free)
-        .then(|| (f64::from(angular_momentum(&last, &case.mass).length()) / l0 - 1.0).abs());
+        .then(|| (to_f64(angular_momentum(&last, &case.mass).length()) / l0 - 1.0).abs());
     Point {
         scene: case.name.to_owned(),
         method: method.name(),
-        dt_s: f64::from(dt32),
+        dt_s: to_f64(dt32),
         steps,
         orientation_error_rad: angle_between(last.rotation, to_quat(q)),
-        position_error_m: (last.position.as_dvec3() - x).length(),
+        position_error_m: (last.position.widen() - x).length(),
         energy_drift: (energy(case, &last) / e0 - 1.0).abs(),
         momentum_drift,
         ns_per_body_step: best,

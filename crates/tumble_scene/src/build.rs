@@ -1,12 +1,13 @@
 //! A validated scene, and the world built from it.
 
 use std::collections::HashMap;
+use tumble_core::math::{Quat, REAL_NAME, Real, Vec3};
 
 use bevy_ecs::prelude::*;
 use bevy_ecs::schedule::Schedule;
-use glam::{Quat, Vec3};
-use parry3d::shape::{Ball, Capsule, Cone, ConvexPolyhedron, Cuboid, Cylinder};
+
 use tumble_core::shapes::mass_properties_of;
+use tumble_core::shapes::parry::shape::{Ball, Capsule, Cone, ConvexPolyhedron, Cuboid, Cylinder};
 use tumble_core::{Density, Integrator, Mass, MassProperties};
 use tumble_ecs::prelude::*;
 
@@ -20,7 +21,7 @@ pub struct Scene {
     /// The file model (for saving).
     pub file: SceneFile,
     /// Time step (s).
-    pub dt: f32,
+    pub dt: Real,
     /// Number of steps.
     pub steps: u64,
     /// Integrator.
@@ -37,7 +38,7 @@ struct ValidBody {
     mass: MassProperties,
     transform: Transform,
     velocity: Velocity,
-    gravity_scale: f32,
+    gravity_scale: Real,
     damping: Damping,
 }
 
@@ -57,9 +58,9 @@ enum ValidForce {
         anchor_a: Vec3,
         b: Option<usize>,
         anchor_b: Vec3,
-        k: f32,
-        c: f32,
-        rest: f32,
+        k: Real,
+        c: Real,
+        rest: Real,
     },
 }
 
@@ -183,7 +184,7 @@ impl Scene {
                     damping,
                     rest_length,
                 } => {
-                    let non_negative = |key: &str, x: f64| -> Result<f32, SceneError> {
+                    let non_negative = |key: &str, x: f64| -> Result<Real, SceneError> {
                         let y = ck.scalar("forces", Some(i), key, x)?;
                         if y < 0.0 {
                             return Err(ck.error(
@@ -239,9 +240,9 @@ impl Scene {
         String,
         MassProperties,
         tumble_core::BodyState,
-        f32,
-        f32,
-        f32,
+        Real,
+        Real,
+        Real,
     )> {
         self.bodies
             .iter()
@@ -367,7 +368,7 @@ fn validate_body(ck: &Checker<'_>, i: usize, b: &BodyDef) -> Result<ValidBody, S
     };
     let position = ck.vec3(t, Some(i), "position", b.position)?;
     let r = b.rotation;
-    let mut q = [0.0f32; 4];
+    let mut q = [0.0 as Real; 4];
     for (o, x) in q.iter_mut().zip(r) {
         *o = ck.scalar(t, Some(i), "rotation", x)?;
     }
@@ -417,7 +418,7 @@ fn shape_mass(
     shape: &ShapeDef,
     density: Density,
 ) -> Result<MassProperties, SceneError> {
-    let positive = |x: f64| -> Result<f32, SceneError> {
+    let positive = |x: f64| -> Result<Real, SceneError> {
         let y = ck.scalar("bodies", Some(i), "shape", x)?;
         if y <= 0.0 {
             return Err(ck.error(
@@ -467,7 +468,7 @@ fn shape_mass(
             "shape",
             format!(
                 "{e}: expected dimensions and a density whose mass and moments of inertia are \
-                 finite and > 0 in f32"
+                 finite and > 0 in {REAL_NAME}"
             ),
         )
     })

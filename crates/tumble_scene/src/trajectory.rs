@@ -2,6 +2,7 @@
 
 use std::io::Write;
 use std::path::Path;
+use tumble_core::math::{Real, to_f64};
 
 use bevy_ecs::prelude::*;
 use tumble_ecs::prelude::*;
@@ -16,7 +17,7 @@ pub const CSV_HEADER: &str = "step,time,body,px,py,pz,qx,qy,qz,qw,vx,vy,vz,wx,wy
 /// written to a temporary name and renamed only when complete.
 pub fn write_trajectory(
     scene: &mut BuiltScene,
-    dt: f32,
+    dt: Real,
     steps: u64,
     every: u64,
     out: &Path,
@@ -44,8 +45,8 @@ pub fn write_trajectory(
     }
 }
 
-fn write_rows(w: &mut impl Write, scene: &BuiltScene, step: u64, dt: f32) -> std::io::Result<()> {
-    let time = f64::from(dt) * step as f64;
+fn write_rows(w: &mut impl Write, scene: &BuiltScene, step: u64, dt: Real) -> std::io::Result<()> {
+    let time = to_f64(dt) * step as f64;
     for (name, e) in &scene.bodies {
         let world: &World = &scene.world;
         let (Some(t), Some(v)) = (world.get::<Transform>(*e), world.get::<Velocity>(*e)) else {

@@ -1,6 +1,7 @@
 //! Semantic checks of a parsed scene file, with the line of each offending field.
 
 use toml::de::{DeTable, DeValue};
+use tumble_core::math::{REAL_NAME, Real, Vec3};
 
 use crate::error::SceneError;
 
@@ -104,14 +105,14 @@ impl Checker<'_> {
         )
     }
 
-    /// A finite number that fits in f32.
+    /// A finite number that fits in the engine precision ([`Real`]).
     pub fn scalar(
         &self,
         table: &str,
         index: Option<usize>,
         key: &str,
         x: f64,
-    ) -> Result<f32, SceneError> {
+    ) -> Result<Real, SceneError> {
         if !x.is_finite() {
             return Err(self.error(
                 table,
@@ -120,30 +121,33 @@ impl Checker<'_> {
                 format!("expected a finite number, got {x}"),
             ));
         }
-        let y = x as f32;
+        let y = x as Real;
         if !y.is_finite() {
             return Err(self.error(
                 table,
                 index,
                 key,
-                format!("{x} overflows f32 (|x| must be below 3.4e38)"),
+                format!(
+                    "{x} overflows {REAL_NAME} (|x| must be below {:.1e})",
+                    Real::MAX
+                ),
             ));
         }
         Ok(y)
     }
 
-    /// A vector of finite f32 numbers.
+    /// A vector of finite [`Real`] numbers.
     pub fn vec3(
         &self,
         table: &str,
         index: Option<usize>,
         key: &str,
         v: [f64; 3],
-    ) -> Result<glam::Vec3, SceneError> {
-        let mut out = [0.0f32; 3];
+    ) -> Result<Vec3, SceneError> {
+        let mut out: [Real; 3] = [0.0; 3];
         for (o, x) in out.iter_mut().zip(v) {
             *o = self.scalar(table, index, key, x)?;
         }
-        Ok(glam::Vec3::from_array(out))
+        Ok(Vec3::from_array(out))
     }
 }

@@ -40,6 +40,12 @@ fn bad_scene_files_name_file_line_and_field() {
         let parts: Vec<&str> = entry.splitn(4, '|').collect();
         let (file, line, field, message) = (parts[0], parts[1], parts[2], parts[3]);
         let path = dir.join(file);
+        if message.contains("f32") && tumble_core::math::DOUBLE_PRECISION {
+            // Out of range for f32 only: an `f64` build holds these numbers and loads the file.
+            load_scene(&path).unwrap_or_else(|e| panic!("{file} in an f64 build: {e}"));
+            checked += 1;
+            continue;
+        }
         let e: SceneError = load_scene(&path).expect_err(file);
         let ok = e.file.ends_with(file)
             && e.line.to_string() == line

@@ -20,9 +20,9 @@ pub use top::{TopMotion, TorqueFreeTop};
 
 /// Largest accepted `||q₀| − 1|` of an initial orientation; it is renormalized on input.
 ///
-/// Same as the crate-wide [`crate::UNIT_QUATERNION_TOLERANCE`], so any state the f32 engine
+/// Same as the crate-wide [`crate::UNIT_QUATERNION_TOLERANCE`], so any state the engine
 /// accepts can seed a reference.
-pub const ORIENTATION_TOLERANCE: f64 = crate::UNIT_QUATERNION_TOLERANCE as f64;
+pub const ORIENTATION_TOLERANCE: f64 = 1e-4;
 
 /// Why an exact solution could not be built from its input.
 #[derive(Debug, Clone, PartialEq, Error)]
@@ -44,4 +44,17 @@ pub enum ExactError {
         /// The mass given (kg).
         mass: f64,
     },
+}
+
+#[cfg(test)]
+mod tolerance_tests {
+    use crate::math::Narrow;
+
+    #[test]
+    fn orientation_tolerance_is_the_engine_tolerance() {
+        assert_eq!(
+            super::ORIENTATION_TOLERANCE.narrow(),
+            crate::UNIT_QUATERNION_TOLERANCE
+        );
+    }
 }

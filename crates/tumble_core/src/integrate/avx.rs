@@ -15,7 +15,7 @@
 use std::arch::x86_64::*;
 use std::ops::{Add, Div, Mul, Neg, Sub};
 
-use super::lanes::{LANES, Lanes4, Real};
+use super::lanes::{LANES, Lane, Lanes4};
 
 /// Four f64 lanes in a `__m256d`.
 #[derive(Clone, Copy)]
@@ -65,7 +65,7 @@ impl Neg for Avx4 {
     }
 }
 
-impl Real for Avx4 {
+impl Lane for Avx4 {
     type Mask = __m256d;
     #[inline(always)]
     fn splat(x: f64) -> Self {

@@ -7,6 +7,7 @@
 //! each body's result is bit-identical to [`Integrator::try_step`] and friends on that body
 //! alone, whatever the batch, its order or the thread that runs it.
 
+use crate::math::{Quat, Real, Vec3};
 use std::borrow::Borrow;
 
 use super::lanes::LANES;
@@ -24,7 +25,7 @@ struct PendingRotations {
     index: [usize; LANES],
     state: [BodyState; LANES],
     input: [SymmetricInput; LANES],
-    h: [f32; LANES],
+    h: [Real; LANES],
     len: usize,
 }
 
@@ -47,7 +48,7 @@ impl PendingRotations {
         index: usize,
         mut state: BodyState,
         mass: &MassProperties,
-        h: f32,
+        h: Real,
         done: &mut impl FnMut(usize, &BodyState),
     ) {
         if mass.is_spherical() {
@@ -89,8 +90,8 @@ impl PendingRotations {
     fn finish(
         &self,
         lane: usize,
-        rotation: glam::Quat,
-        omega: glam::Vec3,
+        rotation: Quat,
+        omega: Vec3,
         done: &mut impl FnMut(usize, &BodyState),
     ) {
         let mut state = self.state[lane];
@@ -132,7 +133,7 @@ fn each_alone<M: Borrow<MassProperties>>(
 fn batched<M: Borrow<MassProperties>>(
     states: &mut [BodyState],
     masses: &[M],
-    mut translate: impl FnMut(usize, &mut BodyState, &MassProperties) -> Option<f32>,
+    mut translate: impl FnMut(usize, &mut BodyState, &MassProperties) -> Option<Real>,
     mut alone: impl FnMut(usize, &mut BodyState, &MassProperties) -> Result<(), StepError>,
 ) -> Vec<usize> {
     let mut diverged = Vec::new();
@@ -166,7 +167,7 @@ impl Integrator {
         states: &mut [BodyState],
         masses: &[M],
         wrenches: &[Wrench],
-        dt: f32,
+        dt: Real,
     ) -> Vec<usize> {
         assert!(states.len() == masses.len() && states.len() == wrenches.len());
         let alone =
@@ -177,7 +178,7 @@ impl Integrator {
         let translate = |i: usize, next: &mut BodyState, m: &MassProperties| {
             let wrench = &wrenches[i];
             // A torque must be kicked between two half rotations: that body steps alone.
-            (wrench.torque == glam::Vec3::ZERO).then(|| {
+            (wrench.torque == Vec3::ZERO).then(|| {
                 translate_dkd(next, m, wrench, dt);
                 dt
             })
@@ -191,7 +192,7 @@ impl Integrator {
         self,
         states: &mut [BodyState],
         masses: &[M],
-        dt: f32,
+        dt: Real,
     ) -> Vec<usize> {
         assert!(states.len() == masses.len());
         let alone = |_: usize, s: &mut BodyState, m: &MassProperties| self.try_begin_step(s, m, dt);
@@ -213,7 +214,7 @@ impl Integrator {
         states: &mut [BodyState],
         masses: &[M],
         wrenches: &[Wrench],
-        dt: f32,
+        dt: Real,
     ) -> Vec<usize> {
         assert!(states.len() == masses.len() && states.len() == wrenches.len());
         let alone = |i: usize, s: &mut BodyState, m: &MassProperties| {

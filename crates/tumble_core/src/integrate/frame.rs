@@ -3,7 +3,8 @@
 //! The frame conversions world ↔ principal are done in f64 and rounded once (see [`rotate`]), so
 //! that a conversion every step adds unbiased round-off only.
 
-use glam::{DQuat, DVec3, Quat, Vec3};
+use crate::math::{Narrow, Quat, Vec3, Widen};
+use glam::{DQuat, DVec3};
 
 use crate::mass::MassProperties;
 use crate::state::BodyState;
@@ -35,13 +36,13 @@ pub fn rotate64(q: DQuat, v: DVec3) -> DVec3 {
 /// Dzhanibekov flips into 56. With one final rounding per conversion the error stays unbiased.
 #[inline]
 pub fn rotate(q: Quat, v: Vec3) -> Vec3 {
-    rotate64(q.as_dquat(), v.as_dvec3()).as_vec3()
+    rotate64(q.widen(), v.widen()).narrow()
 }
 
 /// `q* v q / |q|²`: the inverse rotation (see [`rotate`]).
 #[inline]
 pub fn rotate_inv(q: Quat, v: Vec3) -> Vec3 {
-    rotate64(q.conjugate().as_dquat(), v.as_dvec3()).as_vec3()
+    rotate64(q.conjugate().widen(), v.widen()).narrow()
 }
 
 /// Orientation of the principal axes in the world: `Q = q P`.
@@ -53,20 +54,20 @@ pub fn principal_orientation(state: &BodyState, mass: &MassProperties) -> Quat {
 /// World angular momentum `L = Q I_b Qᵀ ω`, in f64 with a single rounding.
 #[inline]
 pub fn world_momentum(q_principal: Quat, inertia: Vec3, omega: Vec3) -> Vec3 {
-    let q = q_principal.as_dquat();
-    let body = rotate64(q.conjugate(), omega.as_dvec3());
-    rotate64(q, inertia.as_dvec3() * body).as_vec3()
+    let q = q_principal.widen();
+    let body = rotate64(q.conjugate(), omega.widen());
+    rotate64(q, inertia.widen() * body).narrow()
 }
 
 /// World angular velocity `ω = Q I_b⁻¹ Qᵀ L` (zero about locked axes), in f64 with a single
 /// rounding (the reciprocal of `I_b` is taken in f64, not the biased f32 `fl(1/I)`).
 #[inline]
 pub fn world_omega(q_principal: Quat, inertia: Vec3, momentum: Vec3) -> Vec3 {
-    let q = q_principal.as_dquat();
-    let body = rotate64(q.conjugate(), momentum.as_dvec3());
-    let i = inertia.as_dvec3();
+    let q = q_principal.widen();
+    let body = rotate64(q.conjugate(), momentum.widen());
+    let i = inertia.widen();
     let rate = body * DVec3::new(recip(i.x), recip(i.y), recip(i.z));
-    rotate64(q, rate).as_vec3()
+    rotate64(q, rate).narrow()
 }
 
 /// Removes the angular velocity about locked principal axes (zero moment ⇒ no rotation about

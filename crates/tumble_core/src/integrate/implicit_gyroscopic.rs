@@ -11,10 +11,9 @@
 //! then `q' = exp(½Δt ω') q`. Backward Euler dissipates: it never gains energy and never blows
 //! up, but it damps spins about the middle axis strongly. First order.
 
-use glam::{Mat3, Vec3};
-
 use super::frame::{clear_locked_axes, principal_orientation, rotate, rotate_inv};
 use crate::mass::MassProperties;
+use crate::math::{Mat3, Real, Vec3};
 use crate::rotation::rotate_exact;
 use crate::state::{BodyState, Wrench};
 
@@ -30,14 +29,14 @@ fn skew(a: Vec3) -> Mat3 {
 
 /// One Newton step of the implicit gyroscopic update, in the principal frame.
 #[inline]
-pub fn implicit_gyroscopic_rate(omega: Vec3, inertia: Vec3, dt: f32) -> Vec3 {
+pub fn implicit_gyroscopic_rate(omega: Vec3, inertia: Vec3, dt: Real) -> Vec3 {
     let momentum = inertia * omega;
     let residual = dt * omega.cross(momentum);
     let jacobian = Mat3::from_diagonal(inertia)
         + (skew(omega) * Mat3::from_diagonal(inertia) - skew(momentum)) * dt;
     let det = jacobian.determinant();
     // A locked axis can make J singular; then no correction is the safe choice.
-    if !det.is_finite() || det.abs() <= f32::MIN_POSITIVE {
+    if !det.is_finite() || det.abs() <= Real::MIN_POSITIVE {
         return omega;
     }
     omega - jacobian.inverse() * residual
@@ -45,7 +44,12 @@ pub fn implicit_gyroscopic_rate(omega: Vec3, inertia: Vec3, dt: f32) -> Vec3 {
 
 /// One step of the `implicit-gyroscopic` method.
 #[inline]
-pub fn implicit_gyroscopic(state: &mut BodyState, mass: &MassProperties, wrench: &Wrench, dt: f32) {
+pub fn implicit_gyroscopic(
+    state: &mut BodyState,
+    mass: &MassProperties,
+    wrench: &Wrench,
+    dt: Real,
+) {
     state.linear_velocity += (dt * mass.inv_mass()) * wrench.force;
     state.position += dt * state.linear_velocity;
     let q = principal_orientation(state, mass);

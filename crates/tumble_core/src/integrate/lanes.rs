@@ -1,4 +1,4 @@
-//! Lane-generic f64 arithmetic: the free-flow kernels are written once over [`Real`] and run
+//! Lane-generic f64 arithmetic: the free-flow kernels are written once over [`Lane`] and run
 //! either on one body (`f64`) or on four bodies at once ([`F64x4`], SIMD).
 //!
 //! Every operation used here is lane-wise IEEE-754 arithmetic (`+ − × ÷ √`, compare, select),
@@ -27,7 +27,7 @@ const PIO2_LO: f64 = 2.022_266_248_795_950_6e-21;
 const REDUCTION_LIMIT: f64 = 1.0e5;
 
 /// f64 lanes: `f64` itself (one body) or `F64x4` (four bodies).
-pub trait Real:
+pub trait Lane:
     Copy
     + Add<Output = Self>
     + Sub<Output = Self>
@@ -51,7 +51,7 @@ pub trait Real:
     fn platform_sin_cos(self) -> (Self, Self);
 }
 
-impl Real for f64 {
+impl Lane for f64 {
     type Mask = bool;
     #[inline(always)]
     fn splat(x: f64) -> Self {
@@ -120,7 +120,7 @@ impl F64x4 {
     }
 }
 
-impl Real for F64x4 {
+impl Lane for F64x4 {
     type Mask = wide::f64x4;
     #[inline(always)]
     fn splat(x: f64) -> Self {
@@ -152,8 +152,8 @@ impl Real for F64x4 {
     }
 }
 
-/// A [`Real`] of exactly [`LANES`] f64 lanes, to load and store batches.
-pub trait Lanes4: Real {
+/// A [`Lane`] of exactly [`LANES`] f64 lanes, to load and store batches.
+pub trait Lanes4: Lane {
     /// Lanes from an array.
     fn from_lanes(lanes: [f64; LANES]) -> Self;
     /// The lanes as an array.
@@ -173,7 +173,7 @@ impl Lanes4 for F64x4 {
 
 /// Round to the nearest integer (ties to even) for `|x| < 2⁵¹`, in plain IEEE additions.
 #[inline(always)]
-fn round_nearest<T: Real>(x: T) -> T {
+fn round_nearest<T: Lane>(x: T) -> T {
     (x + T::splat(ROUNDING_MAGIC)) - T::splat(ROUNDING_MAGIC)
 }
 
@@ -181,7 +181,7 @@ fn round_nearest<T: Real>(x: T) -> T {
 /// through `r¹⁵` and `r¹⁶` (truncation below 5e-17 there), and the quadrant `k mod 4` applied
 /// with selects. Error ≲ 2 ulp for `|x| ≤ 1e5`; beyond that the platform function is used.
 #[inline(always)]
-pub fn sin_cos<T: Real>(x: T) -> (T, T) {
+pub fn sin_cos<T: Lane>(x: T) -> (T, T) {
     if !x.any_beyond(SMALL_ANGLE) {
         // k = 0 in every lane: the reduction and the quadrant below would be exact no-ops.
         return sin_cos_reduced(x);
@@ -210,7 +210,7 @@ const SMALL_ANGLE: f64 = 0.78;
 /// `(sin r, cos r)` for `|r| ≤ π/4`: `sin r = r (1 − z/3! + z²/5! − …)`,
 /// `cos r = 1 − z/2! + z²/4! − …` with `z = r²`, Horner in `z`.
 #[inline(always)]
-fn sin_cos_reduced<T: Real>(r: T) -> (T, T) {
+fn sin_cos_reduced<T: Lane>(r: T) -> (T, T) {
     let z = r * r;
     let sp = T::splat(-1.0 / 1_307_674_368_000.0);
     let sp = T::splat(1.0 / 6_227_020_800.0) + z * sp;
@@ -233,13 +233,13 @@ fn sin_cos_reduced<T: Real>(r: T) -> (T, T) {
 
 /// `k mod 4` for an integral `k`, exactly: `floor(k/4) = round(k/4 − 3/8)`.
 #[inline(always)]
-fn modulo_4<T: Real>(k: T) -> T {
+fn modulo_4<T: Lane>(k: T) -> T {
     k - T::splat(4.0) * round_nearest(k * T::splat(0.25) - T::splat(0.375))
 }
 
 /// For `j ∈ {0,1,2,3}`: the masks `j ≥ 2` and `j odd` (`⌊j/2⌋ = round(j/2 − 1/4)`).
 #[inline(always)]
-fn quadrant_bits<T: Real>(j: T) -> (T::Mask, T::Mask) {
+fn quadrant_bits<T: Lane>(j: T) -> (T::Mask, T::Mask) {
     let half = T::splat(0.5);
     let upper = round_nearest(j * half - T::splat(0.25));
     (upper.gt(half), (j - T::splat(2.0) * upper).gt(half))

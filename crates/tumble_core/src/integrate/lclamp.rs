@@ -13,12 +13,13 @@
 
 use super::frame::{clear_locked_axes, principal_orientation, rotate, rotate_inv};
 use crate::mass::MassProperties;
+use crate::math::Real;
 use crate::rotation::rotate_exact;
 use crate::state::{BodyState, Wrench};
 
 /// One step of the `lclamp` method.
 #[inline]
-pub fn lclamp(state: &mut BodyState, mass: &MassProperties, wrench: &Wrench, dt: f32) {
+pub fn lclamp(state: &mut BodyState, mass: &MassProperties, wrench: &Wrench, dt: Real) {
     state.linear_velocity += (dt * mass.inv_mass()) * wrench.force;
     state.position += dt * state.linear_velocity;
     let q = principal_orientation(state, mass);

@@ -38,6 +38,7 @@ mod symmetric_kernel;
 mod symplectic_euler;
 mod yoshida;
 
+use crate::math::{Real, Vec3};
 use std::fmt;
 use std::str::FromStr;
 
@@ -151,7 +152,7 @@ impl Integrator {
     /// First phase of a step, before forces are sampled: half a drift for the drift–kick–drift
     /// methods, nothing for the others.
     #[inline]
-    pub fn begin_step(self, state: &mut BodyState, mass: &MassProperties, dt: f32) {
+    pub fn begin_step(self, state: &mut BodyState, mass: &MassProperties, dt: Real) {
         if self.samples_forces_at_midpoint() {
             begin_dkd(state, mass, dt, self.free_rotation());
         }
@@ -164,7 +165,7 @@ impl Integrator {
         state: &mut BodyState,
         mass: &MassProperties,
         wrench: &Wrench,
-        dt: f32,
+        dt: Real,
     ) {
         match self {
             Integrator::SymplecticEuler => symplectic_euler(state, mass, wrench, dt),
@@ -185,8 +186,8 @@ impl Integrator {
     /// For the drift–kick–drift methods a torque-free step takes its rotation as one free flow
     /// over `Δt` instead of two halves (nothing is kicked between them): half the cost, same
     /// order. The ECS takes this path for bodies without a `ForceAccumulator`.
-    pub fn step(self, state: &mut BodyState, mass: &MassProperties, wrench: &Wrench, dt: f32) {
-        if self.samples_forces_at_midpoint() && wrench.torque == glam::Vec3::ZERO {
+    pub fn step(self, state: &mut BodyState, mass: &MassProperties, wrench: &Wrench, dt: Real) {
+        if self.samples_forces_at_midpoint() && wrench.torque == Vec3::ZERO {
             torque_free_dkd(state, mass, wrench, dt, self.free_rotation());
         } else {
             self.begin_step(state, mass, dt);
@@ -201,7 +202,7 @@ impl Integrator {
         self,
         state: &mut BodyState,
         mass: &MassProperties,
-        dt: f32,
+        dt: Real,
         load: impl FnOnce(&BodyState) -> Wrench,
     ) {
         self.begin_step(state, mass, dt);
@@ -217,7 +218,7 @@ impl Integrator {
         state: &mut BodyState,
         mass: &MassProperties,
         wrench: &Wrench,
-        dt: f32,
+        dt: Real,
     ) -> Result<(), StepError> {
         self.commit_if_finite(state, |next| self.step(next, mass, wrench, dt))
     }
@@ -229,7 +230,7 @@ impl Integrator {
         state: &mut BodyState,
         mass: &MassProperties,
         wrench: &Wrench,
-        dt: f32,
+        dt: Real,
     ) -> Result<(), StepError> {
         self.commit_if_finite(state, |next| self.finish_step(next, mass, wrench, dt))
     }
@@ -257,7 +258,7 @@ impl Integrator {
         self,
         state: &mut BodyState,
         mass: &MassProperties,
-        dt: f32,
+        dt: Real,
     ) -> Result<(), StepError> {
         self.commit_if_finite(state, |next| self.begin_step(next, mass, dt))
     }

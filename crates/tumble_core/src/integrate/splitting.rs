@@ -43,6 +43,7 @@
 //! first drift before the force systems), so constant forces are integrated exactly and springs
 //! get the second-order, symplectic position-Verlet scheme.
 
+use crate::math::{Narrow, Real, Vec3, Widen};
 use glam::{DQuat, DVec3};
 
 use super::frame::{recip, rotate64};
@@ -145,11 +146,11 @@ pub fn symmetric_free_flow(body: &mut FreeBody, r: DVec3, h: f64) {
 }
 
 /// The rotational part of a drift over `h` at constant world `L`: a method's free rotation.
-pub type Rotation = fn(&mut BodyState, &MassProperties, f32);
+pub type Rotation = fn(&mut BodyState, &MassProperties, Real);
 
 /// Drift for `h`: `x += h v` and the free rotation over `h` at constant `L`.
 #[inline]
-pub fn drift(state: &mut BodyState, mass: &MassProperties, h: f32, rotation: Rotation) {
+pub fn drift(state: &mut BodyState, mass: &MassProperties, h: Real, rotation: Rotation) {
     state.position += h * state.linear_velocity;
     rotation(state, mass, h);
 }
@@ -159,7 +160,7 @@ pub fn drift(state: &mut BodyState, mass: &MassProperties, h: f32, rotation: Rot
 /// [`symmetric_kernel`](super::symmetric_kernel) — the same code the batched step runs, so one
 /// body gets the same bits alone or in a batch.
 #[inline]
-pub fn rotate_symmetric(state: &mut BodyState, mass: &MassProperties, h: f32) {
+pub fn rotate_symmetric(state: &mut BodyState, mass: &MassProperties, h: Real) {
     if mass.is_spherical() {
         state.rotation = rotate_exact(state.rotation, state.angular_velocity, h);
         return;
@@ -170,37 +171,37 @@ pub fn rotate_symmetric(state: &mut BodyState, mass: &MassProperties, h: f32) {
 
 /// The rotational part of a drift: the free flow over `h` at constant world `L`.
 #[inline]
-pub fn rotate_freely(state: &mut BodyState, mass: &MassProperties, h: f32, flow: FreeFlow) {
+pub fn rotate_freely(state: &mut BodyState, mass: &MassProperties, h: Real, flow: FreeFlow) {
     if mass.is_spherical() {
         state.rotation = rotate_exact(state.rotation, state.angular_velocity, h);
         return;
     }
-    let frame = mass.principal_frame().as_dquat();
-    let q = state.rotation.as_dquat() * frame;
-    let inertia = mass.principal_inertia().as_dvec3();
+    let frame = mass.principal_frame().widen();
+    let q = state.rotation.widen() * frame;
+    let inertia = mass.principal_inertia().widen();
     let r = DVec3::new(recip(inertia.x), recip(inertia.y), recip(inertia.z));
     let mut body = FreeBody {
         q,
-        m: inertia * rotate64(q.conjugate(), state.angular_velocity.as_dvec3()),
+        m: inertia * rotate64(q.conjugate(), state.angular_velocity.widen()),
     };
-    flow(&mut body, r, f64::from(h));
+    flow(&mut body, r, h.widen());
     let q = body.q.normalize();
-    state.angular_velocity = rotate64(q, r * body.m).as_vec3();
-    state.rotation = (q * frame.conjugate()).as_quat().normalize();
+    state.angular_velocity = rotate64(q, r * body.m).narrow();
+    state.rotation = (q * frame.conjugate()).narrow().normalize();
 }
 
 /// Kick for `h`: `v += h F/m`, `L += h τ` (so `ω += h I⁻¹ τ` at the current pose).
 #[inline]
-pub fn kick(state: &mut BodyState, mass: &MassProperties, wrench: &Wrench, h: f32) {
+pub fn kick(state: &mut BodyState, mass: &MassProperties, wrench: &Wrench, h: Real) {
     state.linear_velocity += (h * mass.inv_mass()) * wrench.force;
-    if wrench.torque != glam::Vec3::ZERO {
+    if wrench.torque != Vec3::ZERO {
         state.angular_velocity += mass.world_inv_inertia_mul(state.rotation, h * wrench.torque);
     }
 }
 
 /// First half of a drift–kick–drift step: `D(h/2)`, before forces are sampled.
 #[inline]
-pub fn begin_dkd(state: &mut BodyState, mass: &MassProperties, h: f32, rotation: Rotation) {
+pub fn begin_dkd(state: &mut BodyState, mass: &MassProperties, h: Real, rotation: Rotation) {
     drift(state, mass, 0.5 * h, rotation);
 }
 
@@ -210,7 +211,7 @@ pub fn finish_dkd(
     state: &mut BodyState,
     mass: &MassProperties,
     wrench: &Wrench,
-    h: f32,
+    h: Real,
     rotation: Rotation,
 ) {
     kick(state, mass, wrench, h);
@@ -225,7 +226,7 @@ pub fn torque_free_dkd(
     state: &mut BodyState,
     mass: &MassProperties,
     wrench: &Wrench,
-    h: f32,
+    h: Real,
     rotation: Rotation,
 ) {
     translate_dkd(state, mass, wrench, h);
@@ -235,7 +236,7 @@ pub fn torque_free_dkd(
 /// The translational part of a whole drift–kick–drift step:
 /// `x += ½h v; v += h F/m; x += ½h v` (exact for a constant force).
 #[inline]
-pub fn translate_dkd(state: &mut BodyState, mass: &MassProperties, wrench: &Wrench, h: f32) {
+pub fn translate_dkd(state: &mut BodyState, mass: &MassProperties, wrench: &Wrench, h: Real) {
     state.position += (0.5 * h) * state.linear_velocity;
     state.linear_velocity += (h * mass.inv_mass()) * wrench.force;
     state.position += (0.5 * h) * state.linear_velocity;

@@ -16,10 +16,9 @@
 //! A rotation by a zero angle is the exact identity (`sin 0 = 0`, `cos 0 = 1`), so locked axes
 //! (`r = 0`) and symmetric bodies need no branches.
 
-use glam::{Quat, Vec3};
-
-use super::lanes::{F64x4, LANES, Lanes4, Real, sin_cos};
+use super::lanes::{F64x4, LANES, Lane, Lanes4, sin_cos};
 use crate::mass::MassProperties;
+use crate::math::{Narrow, Quat, Real, Vec3, Widen};
 
 /// A quaternion `(x, y, z, w)` in lanes.
 pub type Quat4<T> = [T; 4];
@@ -28,7 +27,7 @@ pub type Vec3L<T> = [T; 3];
 
 /// Hamilton product `a b`.
 #[inline(always)]
-fn mul<T: Real>(a: Quat4<T>, b: Quat4<T>) -> Quat4<T> {
+fn mul<T: Lane>(a: Quat4<T>, b: Quat4<T>) -> Quat4<T> {
     let [ax, ay, az, aw] = a;
     let [bx, by, bz, bw] = b;
     [
@@ -41,7 +40,7 @@ fn mul<T: Real>(a: Quat4<T>, b: Quat4<T>) -> Quat4<T> {
 
 /// `q v q* / |q|²`: a rotation even for a slightly non-unit `q`.
 #[inline(always)]
-fn rotate<T: Real>(q: Quat4<T>, v: Vec3L<T>) -> Vec3L<T> {
+fn rotate<T: Lane>(q: Quat4<T>, v: Vec3L<T>) -> Vec3L<T> {
     let [x, y, z, w] = q;
     let b2 = x * x + y * y + z * z;
     let inv = T::splat(1.0) / (w * w + b2);
@@ -61,7 +60,7 @@ fn rotate<T: Real>(q: Quat4<T>, v: Vec3L<T>) -> Vec3L<T> {
 }
 
 #[inline(always)]
-fn conjugate<T: Real>(q: Quat4<T>) -> Quat4<T> {
+fn conjugate<T: Lane>(q: Quat4<T>) -> Quat4<T> {
     [-q[0], -q[1], -q[2], q[3]]
 }
 
@@ -71,7 +70,7 @@ struct Free<T> {
     m: Vec3L<T>,
 }
 
-impl<T: Real> Free<T> {
+impl<T: Lane> Free<T> {
     /// `Q ← Q exp(θ e_x)`, `m ← exp(−θ e_x) m`.
     #[inline(always)]
     fn rotate_x(&mut self, angle: T) {
@@ -134,7 +133,7 @@ impl SymmetricInput {
     pub fn new(rotation: Quat, omega: Vec3, mass: &MassProperties) -> Self {
         let r = mass.inv_principal_inertia();
         let gaps = [(r.y - r.z).abs(), (r.x - r.z).abs(), (r.x - r.y).abs()];
-        let i = mass.principal_inertia().as_dvec3();
+        let i = mass.principal_inertia().widen();
         let (a, inertia) = if gaps[0] <= gaps[1] && gaps[0] <= gaps[2] {
             (0, [i.x, i.y, i.z])
         } else if gaps[1] <= gaps[2] {
@@ -142,8 +141,8 @@ impl SymmetricInput {
         } else {
             (2, [i.z, i.x, i.y])
         };
-        let f = mass.principal_frame().as_dquat();
-        let (q, w) = (rotation.as_dquat(), omega.as_dvec3());
+        let f = mass.principal_frame().widen();
+        let (q, w) = (rotation.widen(), omega.widen());
         Self {
             rotation: [q.x, q.y, q.z, q.w],
             omega: [w.x, w.y, w.z],
@@ -156,7 +155,7 @@ impl SymmetricInput {
 
 /// Reciprocal of a principal moment, `0` for a locked axis.
 #[inline(always)]
-fn reciprocal<T: Real>(moment: T) -> T {
+fn reciprocal<T: Lane>(moment: T) -> T {
     let zero = T::splat(0.0);
     T::select(moment.gt(zero), T::splat(1.0) / moment, zero)
 }
@@ -164,7 +163,7 @@ fn reciprocal<T: Real>(moment: T) -> T {
 /// The free rotation over `h` of the `splitting` method, in lanes: returns the new orientation
 /// (unit, f64) and world angular velocity. See the module documentation for the sequence.
 #[inline(always)]
-pub fn symmetric_rotation<T: Real>(input: &SymmetricInput<T>, h: T) -> (Quat4<T>, Vec3L<T>) {
+pub fn symmetric_rotation<T: Lane>(input: &SymmetricInput<T>, h: T) -> (Quat4<T>, Vec3L<T>) {
     let inertia = input.inertia;
     let r = [
         reciprocal(inertia[0]),
@@ -195,20 +194,20 @@ pub fn symmetric_rotation<T: Real>(input: &SymmetricInput<T>, h: T) -> (Quat4<T>
     ([x * inv, y * inv, z * inv, w * inv], omega)
 }
 
-/// Rounds a kernel result to f32, lane `i`.
+/// Rounds a kernel result to the engine's precision, lane `i`.
 #[inline(always)]
-fn to_f32(q: [f64; 4], w: [f64; 3]) -> (Quat, Vec3) {
+fn to_real(q: [f64; 4], w: [f64; 3]) -> (Quat, Vec3) {
     (
-        Quat::from_xyzw(q[0] as f32, q[1] as f32, q[2] as f32, q[3] as f32),
-        Vec3::new(w[0] as f32, w[1] as f32, w[2] as f32),
+        Quat::from_xyzw(q[0].narrow(), q[1].narrow(), q[2].narrow(), q[3].narrow()),
+        Vec3::new(w[0].narrow(), w[1].narrow(), w[2].narrow()),
     )
 }
 
-/// One body through the kernel (`f64` lanes): the new `(q, ω)`, rounded to f32 once.
+/// One body through the kernel (`f64` lanes): the new `(q, ω)`, rounded to the engine precision once.
 #[inline]
-pub fn rotate_symmetric_one(input: &SymmetricInput, h: f32) -> (Quat, Vec3) {
-    let (q, w) = symmetric_rotation::<f64>(input, f64::from(h));
-    to_f32(q, w)
+pub fn rotate_symmetric_one(input: &SymmetricInput, h: Real) -> (Quat, Vec3) {
+    let (q, w) = symmetric_rotation::<f64>(input, h.widen());
+    to_real(q, w)
 }
 
 /// Four bodies through the kernel at once (SIMD lanes), each over its own `h`; lane `i` of the
@@ -216,7 +215,7 @@ pub fn rotate_symmetric_one(input: &SymmetricInput, h: f32) -> (Quat, Vec3) {
 #[inline]
 pub fn rotate_symmetric_lanes(
     inputs: &[SymmetricInput; LANES],
-    h: [f32; LANES],
+    h: [Real; LANES],
 ) -> [(Quat, Vec3); LANES] {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx") {
@@ -234,7 +233,7 @@ pub fn rotate_symmetric_lanes(
 #[target_feature(enable = "avx")]
 fn rotate_symmetric_lanes_avx(
     inputs: &[SymmetricInput; LANES],
-    h: [f32; LANES],
+    h: [Real; LANES],
 ) -> [(Quat, Vec3); LANES] {
     rotate_symmetric_lanes_in::<super::avx::Avx4>(inputs, h)
 }
@@ -243,7 +242,7 @@ fn rotate_symmetric_lanes_avx(
 #[inline(always)]
 fn rotate_symmetric_lanes_portable(
     inputs: &[SymmetricInput; LANES],
-    h: [f32; LANES],
+    h: [Real; LANES],
 ) -> [(Quat, Vec3); LANES] {
     rotate_symmetric_lanes_in::<F64x4>(inputs, h)
 }
@@ -252,7 +251,7 @@ fn rotate_symmetric_lanes_portable(
 #[inline(always)]
 fn rotate_symmetric_lanes_in<T: Lanes4>(
     inputs: &[SymmetricInput; LANES],
-    h: [f32; LANES],
+    h: [Real; LANES],
 ) -> [(Quat, Vec3); LANES] {
     // Plain indexing, no closures: inside the AVX function every helper must inline.
     macro_rules! lane {
@@ -287,11 +286,11 @@ fn rotate_symmetric_lanes_in<T: Lanes4>(
         ],
         inertia: [lane!(inertia[0]), lane!(inertia[1]), lane!(inertia[2])],
     };
-    let hs = T::from_lanes([h[0] as f64, h[1] as f64, h[2] as f64, h[3] as f64]);
+    let hs = T::from_lanes([h[0].widen(), h[1].widen(), h[2].widen(), h[3].widen()]);
     let (q, w) = symmetric_rotation::<T>(&input, hs);
     let [qx, qy, qz, qw] = [q[0].lanes(), q[1].lanes(), q[2].lanes(), q[3].lanes()];
     let [wx, wy, wz] = [w[0].lanes(), w[1].lanes(), w[2].lanes()];
-    let one = |i: usize| to_f32([qx[i], qy[i], qz[i], qw[i]], [wx[i], wy[i], wz[i]]);
+    let one = |i: usize| to_real([qx[i], qy[i], qz[i], qw[i]], [wx[i], wy[i], wz[i]]);
     [one(0), one(1), one(2), one(3)]
 }
 
@@ -315,21 +314,21 @@ mod tests {
             let (inertia, omega) = bodies[i];
             let mass = MassProperties::new(Mass::new(1.0).unwrap(), inertia)
                 .unwrap()
-                .with_principal_frame(Quat::from_rotation_x(0.2 * i as f32))
+                .with_principal_frame(Quat::from_rotation_x(0.2 * i as Real))
                 .unwrap();
-            SymmetricInput::new(Quat::from_rotation_y(i as f32), omega, &mass)
+            SymmetricInput::new(Quat::from_rotation_y(i as Real), omega, &mass)
         });
         let h = [1.0 / 60.0, 0.1, 0.05, 1.0 / 240.0];
         let expected: Vec<(Quat, Vec3)> = (0..LANES)
             .map(|i| rotate_symmetric_one(&owned[i], h[i]))
             .collect();
-        let bits = |r: &[(Quat, Vec3)]| -> Vec<u32> {
+        let bits = |r: &[(Quat, Vec3)]| -> Vec<u64> {
             r.iter()
                 .flat_map(|(q, w)| {
                     q.to_array()
                         .into_iter()
                         .chain(w.to_array())
-                        .map(f32::to_bits)
+                        .map(|x| x.widen().to_bits())
                 })
                 .collect()
         };

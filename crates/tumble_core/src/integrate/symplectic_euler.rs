@@ -13,10 +13,9 @@
 //! Under constant force the position carries the known bias `½ F/m Δt t`:
 //! `x_n = x₀ + v₀ nΔt + F/m Δt² n(n+1)/2`.
 
-use glam::Vec3;
-
 use super::frame::clear_locked_axes;
 use crate::mass::MassProperties;
+use crate::math::{Real, Vec3};
 use crate::rotation::{rotate_exact, rotate_linearized};
 use crate::state::{BodyState, Wrench};
 
@@ -32,7 +31,7 @@ pub fn explicit_gyroscopic_kick(
     state: &mut BodyState,
     mass: &MassProperties,
     torque: Vec3,
-    dt: f32,
+    dt: Real,
 ) {
     let frame = state.rotation * mass.principal_frame();
     let to_principal = frame.conjugate();
@@ -45,14 +44,14 @@ pub fn explicit_gyroscopic_kick(
 }
 
 #[inline]
-fn linear_kick_drift(state: &mut BodyState, mass: &MassProperties, force: Vec3, dt: f32) {
+fn linear_kick_drift(state: &mut BodyState, mass: &MassProperties, force: Vec3, dt: Real) {
     state.linear_velocity += (dt * mass.inv_mass()) * force;
     state.position += dt * state.linear_velocity;
 }
 
 /// One step of the textbook symplectic Euler method with the exact rotation update.
 #[inline]
-pub fn symplectic_euler(state: &mut BodyState, mass: &MassProperties, wrench: &Wrench, dt: f32) {
+pub fn symplectic_euler(state: &mut BodyState, mass: &MassProperties, wrench: &Wrench, dt: Real) {
     linear_kick_drift(state, mass, wrench.force, dt);
     explicit_gyroscopic_kick(state, mass, wrench.torque, dt);
     clear_locked_axes(state, mass);
@@ -65,7 +64,7 @@ pub fn symplectic_euler_linear(
     state: &mut BodyState,
     mass: &MassProperties,
     wrench: &Wrench,
-    dt: f32,
+    dt: Real,
 ) {
     linear_kick_drift(state, mass, wrench.force, dt);
     explicit_gyroscopic_kick(state, mass, wrench.torque, dt);

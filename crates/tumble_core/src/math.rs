@@ -1,0 +1,180 @@
+//! The engine's scalar, vector and rotation types: single precision by default, double precision
+//! with the cargo feature `f64`.
+//!
+//! | feature   | [`Real`] | [`Vec3`]       | [`Quat`]       | [`Mat3`]       |
+//! |-----------|----------|----------------|----------------|----------------|
+//! | (default) | `f32`    | `glam::Vec3`   | `glam::Quat`   | `glam::Mat3`   |
+//! | `f64`     | `f64`    | `glam::DVec3`  | `glam::DQuat`  | `glam::DMat3`  |
+//!
+//! Every component, resource, state and parameter of tumble uses these aliases, so one feature
+//! switches the whole engine (the ECS layer, scene files, the CLI) to double precision. The
+//! internal kernels that already work in `f64` (frame changes, the splitting rotations, the exact
+//! references) read and write through [`Widen`] / [`Narrow`], which are the identity in an `f64`
+//! build and one rounding in the default build.
+//!
+//! ```
+//! use tumble_core::math::{Real, Vec3};
+//! let v = Vec3::new(1.0, 2.0, 2.0);
+//! let length: Real = v.length();
+//! assert_eq!(length, 3.0);
+//! ```
+
+use glam::{DQuat, DVec3};
+
+#[cfg(not(feature = "f64"))]
+mod precision {
+    /// The engine's scalar: `f32` (enable the feature `f64` for `f64`).
+    pub type Real = f32;
+    pub use glam::{Mat3, Quat, Vec3, Vec4};
+}
+
+#[cfg(feature = "f64")]
+mod precision {
+    /// The engine's scalar: `f64` (the feature `f64` is on).
+    pub type Real = f64;
+    /// A 3-vector of [`Real`]: `glam::DVec3` (the feature `f64` is on).
+    pub type Vec3 = glam::DVec3;
+    /// A rotation quaternion of [`Real`]: `glam::DQuat` (the feature `f64` is on).
+    pub type Quat = glam::DQuat;
+    /// A 3×3 matrix of [`Real`]: `glam::DMat3` (the feature `f64` is on).
+    pub type Mat3 = glam::DMat3;
+    /// A 4-vector of [`Real`]: `glam::DVec4` (the feature `f64` is on).
+    pub type Vec4 = glam::DVec4;
+}
+
+pub use precision::{Mat3, Quat, Real, Vec3, Vec4};
+
+/// The name of [`Real`], for messages: `"f32"`, or `"f64"` with the feature `f64`.
+pub const REAL_NAME: &str = if DOUBLE_PRECISION { "f64" } else { "f32" };
+
+/// `true` when the engine runs in double precision (feature `f64`).
+pub const DOUBLE_PRECISION: bool = cfg!(feature = "f64");
+
+/// Any number that converts to `f64` exactly (`Real`, `f32`, `u32`, `i32`, …), as `f64`.
+///
+/// For code that must read the same in both precisions: `f64::from(x)` on an `f64` is flagged
+/// as a useless conversion, this is not.
+#[inline(always)]
+#[must_use]
+pub fn to_f64(x: impl Into<f64>) -> f64 {
+    x.into()
+}
+
+/// Conversion to `f64` (exact): `Real → f64`, `Vec3 → DVec3`, `Quat → DQuat`.
+///
+/// The identity in an `f64` build; one exact widening in the default build.
+pub trait Widen {
+    /// The `f64` counterpart.
+    type Wide;
+    /// `self` in `f64`, exactly.
+    fn widen(self) -> Self::Wide;
+}
+
+/// Conversion from `f64` to the engine's precision, rounding to nearest component-wise (the
+/// identity in an `f64` build; quaternions are not renormalized).
+pub trait Narrow {
+    /// The engine-precision counterpart.
+    type Narrow;
+    /// `self` rounded to the engine's precision.
+    fn narrow(self) -> Self::Narrow;
+}
+
+impl Widen for Real {
+    type Wide = f64;
+    #[inline(always)]
+    fn widen(self) -> f64 {
+        #[cfg(not(feature = "f64"))]
+        {
+            f64::from(self)
+        }
+        #[cfg(feature = "f64")]
+        {
+            self
+        }
+    }
+}
+
+impl Widen for Vec3 {
+    type Wide = DVec3;
+    #[inline(always)]
+    fn widen(self) -> DVec3 {
+        DVec3::new(self.x.widen(), self.y.widen(), self.z.widen())
+    }
+}
+
+impl Widen for Quat {
+    type Wide = DQuat;
+    #[inline(always)]
+    fn widen(self) -> DQuat {
+        DQuat::from_xyzw(
+            self.x.widen(),
+            self.y.widen(),
+            self.z.widen(),
+            self.w.widen(),
+        )
+    }
+}
+
+impl Narrow for f64 {
+    type Narrow = Real;
+    #[inline(always)]
+    fn narrow(self) -> Real {
+        self as Real
+    }
+}
+
+impl Narrow for DVec3 {
+    type Narrow = Vec3;
+    #[inline(always)]
+    fn narrow(self) -> Vec3 {
+        Vec3::new(self.x.narrow(), self.y.narrow(), self.z.narrow())
+    }
+}
+
+impl Narrow for DQuat {
+    type Narrow = Quat;
+    #[inline(always)]
+    fn narrow(self) -> Quat {
+        Quat::from_xyzw(
+            self.x.narrow(),
+            self.y.narrow(),
+            self.z.narrow(),
+            self.w.narrow(),
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn widen_then_narrow_is_the_identity() {
+        let values: [Real; 8] = [
+            0.0,
+            -0.0,
+            1.0,
+            0.1,
+            -3.5e7,
+            Real::MIN_POSITIVE,
+            Real::MAX,
+            Real::EPSILON,
+        ];
+        for x in values {
+            assert_eq!(x.widen().narrow().to_bits(), x.to_bits());
+        }
+        let v = Vec3::new(0.1, -0.2, 0.3);
+        assert_eq!(v.widen().narrow(), v);
+        let q = Quat::from_xyzw(0.1, 0.2, 0.3, 0.9);
+        assert_eq!(q.widen().narrow(), q);
+    }
+
+    #[test]
+    fn narrow_rounds_to_the_engine_precision() {
+        let third = (1.0_f64 / 3.0).narrow();
+        let expected: Real = 1.0 / 3.0;
+        assert_eq!(third, expected);
+        assert!(Real::EPSILON.widen() > 1e-17);
+        assert_eq!(DOUBLE_PRECISION, Real::EPSILON < 1e-10);
+    }
+}
