@@ -1,7 +1,10 @@
 //! Bodies made from parry3d shapes and a density: mass properties are computed by parry,
 //! then each body is spun about its middle principal axis and stepped for 1 s.
 // Only `main` differs in an `f64` build with parry3d's `f32` shapes, which leaves these unused.
-#![cfg_attr(all(feature = "f64", not(feature = "parry-f64")), allow(unused_imports))]
+#![cfg_attr(
+    all(feature = "f64", not(feature = "parry-f64")),
+    allow(unused_imports)
+)]
 
 use tumble::bevy_ecs::prelude::World;
 use tumble::math::{Quat, Real, Vec3};
