@@ -62,7 +62,7 @@ pub use tumble_scene as scene;
 pub mod prelude {
     #[cfg(any(feature = "parry", feature = "parry-f64"))]
     pub use tumble_core::shapes::mass_properties_of;
-    pub use tumble_core::{BodyState, Integrator, Wrench};
+    pub use tumble_core::{BodyBatch, BodyState, Integrator, StepPhase, Wrench};
     pub use tumble_ecs::prelude::*;
 }
 

@@ -152,3 +152,114 @@ fn a_diverging_body_in_a_batch_is_reported_and_harms_no_neighbour() {
         );
     }
 }
+
+/// A [`BodyBatch`] over arrays that skips every third body and records every call.
+struct Recording {
+    states: Vec<BodyState>,
+    masses: Vec<MassProperties>,
+    wrenches: Vec<Wrench>,
+    reads: Vec<usize>,
+    written: Vec<usize>,
+    diverged: Vec<usize>,
+}
+
+impl BodyBatch for Recording {
+    fn len(&self) -> usize {
+        self.states.len()
+    }
+
+    fn read(&mut self, i: usize, state: &mut BodyState) -> Option<Wrench> {
+        self.reads.push(i);
+        if i % 3 == 2 {
+            return None;
+        }
+        let from = self.states[i];
+        state.position = from.position;
+        state.rotation = from.rotation;
+        state.linear_velocity = from.linear_velocity;
+        state.angular_velocity = from.angular_velocity;
+        Some(self.wrenches[i])
+    }
+
+    fn mass(&self, i: usize) -> &MassProperties {
+        &self.masses[i]
+    }
+
+    fn write(&mut self, i: usize, state: &BodyState) {
+        self.written.push(i);
+        self.states[i] = *state;
+    }
+
+    fn diverged(&mut self, i: usize) {
+        self.diverged.push(i);
+    }
+}
+
+#[test]
+fn step_batch_keeps_the_body_batch_contract() {
+    let dt = 1.0 / 60.0;
+    for &integrator in Integrator::ALL {
+        for phase in [StepPhase::Whole, StepPhase::Begin, StepPhase::Finish] {
+            let (states, masses, mut wrenches) = population(23);
+            // Body 4 diverges (an overflowing kick in every phase that kicks).
+            wrenches[4].force = Vec3::splat(Real::MAX);
+            let mut batch = Recording {
+                states: states.clone(),
+                masses: masses.clone(),
+                wrenches: wrenches.clone(),
+                reads: Vec::new(),
+                written: Vec::new(),
+                diverged: Vec::new(),
+            };
+            let mut start = states.clone();
+            start[4].linear_velocity = Vec3::splat(Real::MAX);
+            batch.states[4] = start[4];
+            integrator.step_batch(phase, &mut batch, dt);
+            let label = format!("{integrator} {phase:?}");
+            assert_eq!(batch.reads, (0..23).collect::<Vec<_>>(), "{label}");
+            let mut touched: Vec<usize> = batch
+                .written
+                .iter()
+                .chain(&batch.diverged)
+                .copied()
+                .collect();
+            touched.sort_unstable();
+            let stepped: Vec<usize> = (0..23).filter(|i| i % 3 != 2).collect();
+            assert_eq!(
+                touched, stepped,
+                "{label}: one write or divergence per body read"
+            );
+            for i in 0..23 {
+                let mut alone = start[i];
+                let result = match phase {
+                    StepPhase::Whole => {
+                        integrator.try_step(&mut alone, &masses[i], &wrenches[i], dt)
+                    }
+                    StepPhase::Begin => integrator.try_begin_step(&mut alone, &masses[i], dt),
+                    StepPhase::Finish => {
+                        integrator.try_finish_step(&mut alone, &masses[i], &wrenches[i], dt)
+                    }
+                };
+                if i % 3 == 2 {
+                    assert!(
+                        same_bits(&batch.states[i], &start[i]),
+                        "{label}: skipped body {i} moved"
+                    );
+                    continue;
+                }
+                assert_eq!(
+                    batch.diverged.contains(&i),
+                    result.is_err(),
+                    "{label}: body {i}"
+                );
+                assert!(
+                    same_bits(&batch.states[i], &alone),
+                    "{label}: body {i} differs"
+                );
+            }
+            if phase != StepPhase::Begin {
+                assert!(batch.diverged.contains(&4), "{label}: body 4 must diverge");
+            }
+        }
+    }
+}

@@ -30,6 +30,6 @@ pub mod shapes;
 pub mod state;
 
 pub use error::{InvalidInput, UNIT_QUATERNION_TOLERANCE};
-pub use integrate::{Integrator, StepError};
+pub use integrate::{BodyBatch, Integrator, StepError, StepPhase};
 pub use mass::{Density, Mass, MassProperties};
 pub use state::{BodyState, Wrench};

@@ -7,9 +7,9 @@
 use std::sync::Mutex;
 use tumble_core::math::Vec3;
 
-use arrayvec::ArrayVec;
 use bevy_ecs::prelude::*;
-use tumble_core::{BodyState, MassProperties, Wrench};
+use tumble_core::math::Real;
+use tumble_core::{BodyBatch, BodyState, Integrator, MassProperties, StepPhase, Wrench};
 
 use crate::components::{
     Damping, ForceAccumulator, Gravity, GravityScale, Kinematic, MassProps, PhysicsSettings,
@@ -17,20 +17,6 @@ use crate::components::{
 };
 use crate::parallel::Parallelism;
 use crate::validate::{BodyError, BodyErrorKind, Rejected, check_accumulator, check_body, reject};
-
-/// Which part of a step the integrate system performs for a body.
-#[derive(Clone, Copy, PartialEq, Eq)]
-enum Phase {
-    /// The whole step (forces sampled at the start, or constant).
-    Whole,
-    /// The first half-drift of a drift–kick–drift step, before forces are sampled.
-    Begin,
-    /// The rest of a step whose first half-drift already ran in [`begin_step`].
-    Finish,
-}
-
-/// Bodies are gathered from a table slice in chunks of this many (stack arrays, no allocation).
-const CHUNK: usize = 64;
 
 /// Where each body's load comes from.
 enum Loads<'a> {
@@ -71,7 +57,7 @@ impl Loads<'_> {
     }
 
     /// Checks body `i`'s load and returns it (consuming an accumulator).
-    #[inline]
+    #[inline(always)]
     fn take(&mut self, i: usize, mass: &MassProps) -> Result<Wrench, BodyErrorKind> {
         match self {
             Loads::Field { gravity, scales } => Ok(match gravity {
@@ -134,83 +120,95 @@ impl<'a> Bodies<'a> {
     }
 }
 
-/// Steps every body of `bodies` through `phase`, in chunks, with the batched core entry points
-/// (bit-identical to stepping each body alone). A body whose data is bad or whose step diverges
-/// keeps its state and is reported in `errors`.
-fn step_bodies(
-    settings: &PhysicsSettings,
-    phase: Phase,
-    mut bodies: Bodies<'_>,
-    errors: &mut Vec<BodyError>,
-) {
-    let dt = settings.dt();
-    let integrator = settings.integrator;
-    let total = bodies.len();
-    for start in (0..total).step_by(CHUNK) {
-        let end = (start + CHUNK).min(total);
-        // Not initialised up front: a one-body world pays for one body, not for CHUNK.
-        let mut index = ArrayVec::<usize, CHUNK>::new();
-        // Zeroed, then written field by field: `BodyState` has padding lanes that vectorized
-        // code reads along with the fields, and stale stack bytes there can be subnormal float
-        // patterns that cost a microcode assist per operation (seen: +40 ns per body-step).
-        let mut states = [BodyState::ZEROED; CHUNK];
-        let mut len = 0;
-        let mut masses = ArrayVec::<&MassProperties, CHUNK>::new();
-        let mut wrenches = ArrayVec::<Wrench, CHUNK>::new();
-        for i in start..end {
-            let (transform, velocity) = (&bodies.transforms[i], &bodies.velocities[i]);
-            let mass = &bodies.masses[i];
-            match check_body(transform, velocity, None).and_then(|()| bodies.loads.take(i, mass)) {
-                Ok(wrench) => {
-                    index.push(i);
-                    let state = &mut states[len];
-                    let read = body_state(transform, velocity, mass);
-                    state.position = read.position;
-                    state.rotation = read.rotation;
-                    state.linear_velocity = read.linear_velocity;
-                    state.angular_velocity = read.angular_velocity;
-                    len += 1;
-                    masses.push(&mass.0);
-                    wrenches.push(wrench);
-                }
-                Err(kind) => errors.push(BodyError {
-                    entity: bodies.entities[i],
-                    kind,
-                }),
+/// One table run of bodies as a [`BodyBatch`] for the core's batched step: bodies are read
+/// from and written to their components directly. A body whose data is bad is skipped and one
+/// whose step diverges keeps its state; both are reported in `errors`.
+struct TableBatch<'a, 'e> {
+    bodies: Bodies<'a>,
+    /// Damping applies after the phases that end a step.
+    damp: bool,
+    dt: Real,
+    integrator: Integrator,
+    errors: &'e mut Vec<BodyError>,
+}
+
+impl BodyBatch for TableBatch<'_, '_> {
+    fn len(&self) -> usize {
+        self.bodies.len()
+    }
+
+    #[inline(always)]
+    fn read(&mut self, i: usize, state: &mut BodyState) -> Option<Wrench> {
+        let bodies = &mut self.bodies;
+        let (transform, velocity) = (&bodies.transforms[i], &bodies.velocities[i]);
+        let mass = &bodies.masses[i];
+        match check_body(transform, velocity, None).and_then(|()| bodies.loads.take(i, mass)) {
+            Ok(wrench) => {
+                let read = body_state(transform, velocity, mass);
+                state.position = read.position;
+                state.rotation = read.rotation;
+                state.linear_velocity = read.linear_velocity;
+                state.angular_velocity = read.angular_velocity;
+                Some(wrench)
             }
-        }
-        let (states, masses, wrenches) = (&mut states[..len], &masses[..], &wrenches[..]);
-        let diverged = match phase {
-            Phase::Whole => integrator.try_step_many(states, masses, wrenches, dt),
-            Phase::Begin => integrator.try_begin_step_many(states, masses, dt),
-            Phase::Finish => integrator.try_finish_step_many(states, masses, wrenches, dt),
-        };
-        let mut diverged = diverged.into_iter().peekable();
-        for (k, state) in states.iter_mut().enumerate() {
-            let i = index[k];
-            if diverged.next_if_eq(&k).is_some() {
-                let kind = BodyErrorKind::Diverged(tumble_core::StepError::Diverged { integrator });
-                errors.push(BodyError {
+            Err(kind) => {
+                self.errors.push(BodyError {
                     entity: bodies.entities[i],
                     kind,
                 });
-                continue;
+                None
             }
-            if phase != Phase::Begin
-                && let Some(d) = bodies.dampings.map(|d| &d[i])
-            {
-                // Padé damping v ← v / (1 + Δt c): unconditionally stable, as in rapier and avian.
-                state.linear_velocity /= 1.0 + dt * d.linear;
-                state.angular_velocity /= 1.0 + dt * d.angular;
-            }
-            write_body_state(
-                state,
-                &bodies.masses[i],
-                &mut bodies.transforms[i],
-                &mut bodies.velocities[i],
-            );
         }
     }
+
+    #[inline(always)]
+    fn mass(&self, i: usize) -> &MassProperties {
+        &self.bodies.masses[i].0
+    }
+
+    #[inline(always)]
+    fn write(&mut self, i: usize, state: &BodyState) {
+        let bodies = &mut self.bodies;
+        let (transform, velocity) = (&mut bodies.transforms[i], &mut bodies.velocities[i]);
+        write_body_state(state, &bodies.masses[i], transform, velocity);
+        if self.damp
+            && let Some(d) = bodies.dampings.map(|d| &d[i])
+        {
+            // Padé damping v ← v / (1 + Δt c): unconditionally stable, as in rapier and avian.
+            velocity.linear /= 1.0 + self.dt * d.linear;
+            velocity.angular /= 1.0 + self.dt * d.angular;
+        }
+    }
+
+    fn diverged(&mut self, i: usize) {
+        let integrator = self.integrator;
+        self.errors.push(BodyError {
+            entity: self.bodies.entities[i],
+            kind: BodyErrorKind::Diverged(tumble_core::StepError::Diverged { integrator }),
+        });
+    }
+}
+
+/// Steps every body of `bodies` through `phase` with the core's batched step (bit-identical
+/// to stepping each body alone). Errors are appended sorted by entity.
+fn step_bodies(
+    settings: &PhysicsSettings,
+    phase: StepPhase,
+    bodies: Bodies<'_>,
+    errors: &mut Vec<BodyError>,
+) {
+    let found = errors.len();
+    let mut batch = TableBatch {
+        bodies,
+        damp: phase != StepPhase::Begin,
+        dt: settings.dt(),
+        integrator: settings.integrator,
+        errors,
+    };
+    settings
+        .integrator
+        .step_batch(phase, &mut batch, settings.dt());
+    errors[found..].sort_by_key(|e| e.entity);
 }
 
 /// Steps one table's bodies, split over the compute pool's threads when [`Parallelism`] says
@@ -219,7 +217,7 @@ fn step_bodies(
 fn step_table(
     settings: &PhysicsSettings,
     parallelism: &Parallelism,
-    phase: Phase,
+    phase: StepPhase,
     bodies: Bodies<'_>,
     errors: &mut Vec<BodyError>,
 ) {
@@ -339,7 +337,13 @@ pub fn begin_step(
             dampings: None,
             loads: Loads::Checked(accs),
         };
-        step_table(&settings, &parallelism, Phase::Begin, bodies, &mut errors);
+        step_table(
+            &settings,
+            &parallelism,
+            StepPhase::Begin,
+            bodies,
+            &mut errors,
+        );
     }
     reject_all(&mut commands, errors);
 }
@@ -368,11 +372,11 @@ pub fn integrate_with_forces(
     >,
 ) {
     let phase = if drifted.0 {
-        Phase::Finish
+        StepPhase::Finish
     } else {
-        Phase::Whole
+        StepPhase::Whole
     };
-    if settings.integrator.samples_forces_at_midpoint() && phase == Phase::Whole && !*warned {
+    if settings.integrator.samples_forces_at_midpoint() && phase == StepPhase::Whole && !*warned {
         *warned = true;
         tracing::warn!(
             integrator = %settings.integrator,
@@ -429,7 +433,13 @@ pub fn integrate_without_forces(
             dampings,
             loads: Loads::Field { gravity, scales },
         };
-        step_table(&settings, &parallelism, Phase::Whole, bodies, &mut errors);
+        step_table(
+            &settings,
+            &parallelism,
+            StepPhase::Whole,
+            bodies,
+            &mut errors,
+        );
     }
     reject_all(&mut commands, errors);
 }

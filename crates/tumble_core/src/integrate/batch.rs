@@ -1,26 +1,79 @@
 //! Stepping many bodies at once: the entry points the ECS systems and the raw benchmark loop
 //! share.
 //!
-//! For `splitting` (the default) the free rotations of up to [`LANES`] non-spherical bodies are
-//! computed together in SIMD lanes by the kernel of [`super::symmetric_kernel`]; the translation,
-//! the kicks and spherical bodies stay scalar. Every other method steps body by body. Either way
-//! each body's result is bit-identical to [`Integrator::try_step`] and friends on that body
-//! alone, whatever the batch, its order or the thread that runs it.
+//! A batch reads each body from a [`BodyBatch`] (plain arrays, or an ECS table without an
+//! intermediate copy), steps it and writes it back. For `splitting` (the default) the free
+//! rotations of up to [`LANES`] non-spherical bodies are computed together in SIMD lanes by the
+//! kernel of [`super::symmetric_kernel`]; the translation, the kicks and spherical bodies stay
+//! scalar. Every other method steps body by body. Either way each body's result is bit-identical
+//! to [`Integrator::try_step`] and friends on that body alone, whatever the batch, its order or
+//! the thread that runs it.
 
 use crate::math::{Quat, Real, Vec3};
 use std::borrow::Borrow;
 
+use super::Integrator;
 use super::lanes::LANES;
 use super::splitting::{kick, translate_dkd};
 use super::symmetric_kernel::{SymmetricInput, rotate_symmetric_lanes, rotate_symmetric_one};
-use super::{Integrator, StepError};
 use crate::mass::MassProperties;
 use crate::rotation::rotate_exact;
 use crate::state::{BodyState, Wrench};
 
-/// Bodies waiting for their free rotation, flushed [`LANES`] at a time: each body's translated
-/// state and its kernel inputs. (Inputs stored as structure of arrays were slower: four scalar
-/// stores then one vector load of the same bytes stalls store forwarding.)
+/// Which part of a step a batch performs (see [`Integrator::begin_step`] and
+/// [`Integrator::finish_step`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StepPhase {
+    /// The whole step, [`Integrator::step`], under the body's constant load.
+    Whole,
+    /// The first phase, [`Integrator::begin_step`]; the load is not used.
+    Begin,
+    /// The second phase, [`Integrator::finish_step`], under the load sampled after
+    /// [`Begin`](Self::Begin).
+    Finish,
+}
+
+/// Where a batched step finds its bodies and puts them back.
+///
+/// [`Integrator::step_batch`] calls [`read`](Self::read) once for every index in `0..len()`,
+/// in increasing order, then exactly one of [`write`](Self::write) (the new state is finite)
+/// or [`diverged`](Self::diverged) (it is not: the body keeps its old state) for every body that
+/// `read` returned, not necessarily in order.
+pub trait BodyBatch {
+    /// Number of bodies.
+    fn len(&self) -> usize;
+    /// True when there are no bodies.
+    fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+    /// Writes body `i`'s state into `state`, field by field, and returns its load; or returns
+    /// `None` when the body must not be stepped (the implementation records why). `state` is a
+    /// scratch value whose padding bytes are zero: vectorized code reads them along with the
+    /// fields, and stale bytes there can be subnormal patterns that cost a microcode assist per
+    /// operation, so assign the fields rather than the whole struct.
+    fn read(&mut self, i: usize, state: &mut BodyState) -> Option<Wrench>;
+    /// Body `i`'s mass properties.
+    fn mass(&self, i: usize) -> &MassProperties;
+    /// Stores body `i`'s new, finite state.
+    fn write(&mut self, i: usize, state: &BodyState);
+    /// Body `i`'s step did not give a finite state; it keeps its old one.
+    fn diverged(&mut self, i: usize);
+}
+
+/// Hands `next` to `bodies` as body `i`'s new state if it is finite, else reports divergence.
+#[inline(always)]
+fn commit(bodies: &mut impl BodyBatch, i: usize, next: &BodyState) {
+    if next.is_finite() {
+        bodies.write(i, next);
+    } else {
+        bodies.diverged(i);
+    }
+}
+
+/// Bodies waiting for their free rotation over the same `h`, flushed [`LANES`] at a time: each
+/// body's translated state and its kernel inputs. (Inputs stored as structure of arrays were
+/// slower: four scalar stores then one vector load of the same bytes stalls store forwarding;
+/// for the same reason `h` is written once, not per body.)
 struct PendingRotations {
     index: [usize; LANES],
     state: [BodyState; LANES],
@@ -30,134 +83,230 @@ struct PendingRotations {
 }
 
 impl PendingRotations {
-    fn new() -> Self {
+    /// No bodies yet; all of them will rotate over `h`.
+    fn new(h: Real) -> Self {
         Self {
             index: [0; LANES],
-            state: [BodyState::default(); LANES],
+            state: [BodyState::ZEROED; LANES],
             input: [SymmetricInput::default(); LANES],
-            h: [0.0; LANES],
+            h: [h; LANES],
             len: 0,
         }
     }
 
-    /// Queues body `index` (already translated, as `state`) for a free rotation over `h`;
-    /// spherical bodies rotate at once, exactly about `ω`.
+    /// Queues body `index` (already translated, as `state`, and not spherical) for its free
+    /// rotation; returns true when the batch is full and must be flushed.
     #[inline(always)]
-    fn push(
-        &mut self,
-        index: usize,
-        mut state: BodyState,
-        mass: &MassProperties,
-        h: Real,
-        done: &mut impl FnMut(usize, &BodyState),
-    ) {
-        if mass.is_spherical() {
-            state.rotation = rotate_exact(state.rotation, state.angular_velocity, h);
-            done(index, &state);
-            return;
-        }
+    fn queue(&mut self, index: usize, state: &BodyState, mass: &MassProperties) -> bool {
         let lane = self.len;
         self.input[lane] = SymmetricInput::new(state.rotation, state.angular_velocity, mass);
         self.index[lane] = index;
-        self.state[lane] = state;
-        self.h[lane] = h;
+        self.state[lane] = *state;
         self.len = lane + 1;
-        if self.len == LANES {
-            self.flush(done);
-        }
+        self.len == LANES
     }
 
     /// Rotates the queued bodies (a partial batch goes through the scalar kernel, which gives
-    /// the same bits) and hands each result to `done`.
+    /// the same bits) and commits each result.
     #[inline(always)]
-    fn flush(&mut self, done: &mut impl FnMut(usize, &BodyState)) {
+    fn flush(&mut self, bodies: &mut impl BodyBatch) {
         if self.len == LANES {
             let rotated = rotate_symmetric_lanes(&self.input, self.h);
-            for (lane, (rotation, omega)) in rotated.into_iter().enumerate() {
-                self.finish(lane, rotation, omega, done);
+            for lane in 0..LANES {
+                let (rotation, omega) = rotated.lane(lane);
+                self.finish(lane, rotation, omega, bodies);
             }
         } else {
             for lane in 0..self.len {
                 let (rotation, omega) = rotate_symmetric_one(&self.input[lane], self.h[lane]);
-                self.finish(lane, rotation, omega, done);
+                self.finish(lane, rotation, omega, bodies);
             }
         }
         self.len = 0;
     }
 
-    /// Hands lane `lane`'s rotated body to `done`.
+    /// Commits lane `lane`'s rotated body.
     #[inline(always)]
-    fn finish(
-        &self,
-        lane: usize,
-        rotation: Quat,
-        omega: Vec3,
-        done: &mut impl FnMut(usize, &BodyState),
-    ) {
-        let mut state = self.state[lane];
-        state.rotation = rotation;
-        state.angular_velocity = omega;
-        done(self.index[lane], &state);
+    fn finish(&self, lane: usize, rotation: Quat, omega: Vec3, bodies: &mut impl BodyBatch) {
+        // A fresh value rather than an update of the queued one in place: stores of the new
+        // fields followed by the wide loads of `is_finite` across field boundaries would stall
+        // store forwarding.
+        let queued = &self.state[lane];
+        let next = BodyState {
+            position: queued.position,
+            rotation,
+            linear_velocity: queued.linear_velocity,
+            angular_velocity: omega,
+        };
+        commit(bodies, self.index[lane], &next);
     }
 }
 
-/// Commits `next` into `states[index]` if it is finite, else records the divergence.
-#[inline]
-fn commit(states: &mut [BodyState], diverged: &mut Vec<usize>, index: usize, next: &BodyState) {
-    if next.is_finite() {
-        states[index] = *next;
-    } else {
-        diverged.push(index);
+/// The methods without a batched kernel: every body steps alone with `single`.
+fn each_alone(
+    bodies: &mut impl BodyBatch,
+    mut single: impl FnMut(&mut BodyState, &MassProperties, &Wrench),
+) {
+    let mut next = BodyState::ZEROED;
+    for i in 0..bodies.len() {
+        let Some(wrench) = bodies.read(i, &mut next) else {
+            continue;
+        };
+        single(&mut next, bodies.mass(i), &wrench);
+        commit(bodies, i, &next);
     }
 }
 
-/// Steps every body alone with `single` (the methods without a batched kernel); returns the
-/// indices of the bodies that diverged.
-fn each_alone<M: Borrow<MassProperties>>(
-    states: &mut [BodyState],
-    masses: &[M],
-    mut single: impl FnMut(usize, &mut BodyState, &MassProperties) -> Result<(), StepError>,
-) -> Vec<usize> {
-    let mut diverged = Vec::new();
-    for (i, state) in states.iter_mut().enumerate() {
-        if single(i, state, masses[i].borrow()).is_err() {
-            diverged.push(i);
-        }
-    }
-    diverged
-}
-
-/// The `splitting` batch: `translate(i, next, mass)` does a body's scalar part on a copy and
-/// returns the time over which it then rotates freely (queued for the SIMD kernel), or `None` if
-/// the body needs the whole scalar step `alone` instead. Returns the diverged indices, sorted.
-fn batched<M: Borrow<MassProperties>>(
-    states: &mut [BodyState],
-    masses: &[M],
-    mut translate: impl FnMut(usize, &mut BodyState, &MassProperties) -> Option<Real>,
-    mut alone: impl FnMut(usize, &mut BodyState, &MassProperties) -> Result<(), StepError>,
-) -> Vec<usize> {
-    let mut diverged = Vec::new();
-    let mut pending = PendingRotations::new();
-    for i in 0..states.len() {
-        let mass = masses[i].borrow();
-        let mut next = states[i];
-        match translate(i, &mut next, mass) {
-            Some(h) => pending.push(i, next, mass, h, &mut |j, s| {
-                commit(states, &mut diverged, j, s)
-            }),
-            None => {
-                if alone(i, &mut states[i], mass).is_err() {
-                    diverged.push(i);
+/// The `splitting` batch: `translate(next, mass, wrench)` does a body's scalar part and returns
+/// true if the body then rotates freely over `h` (queued for the SIMD kernel), or false if it
+/// needs the whole scalar step `alone` instead (and `next` is untouched).
+fn batched(
+    bodies: &mut impl BodyBatch,
+    h: Real,
+    mut translate: impl FnMut(&mut BodyState, &MassProperties, &Wrench) -> bool,
+    mut alone: impl FnMut(&mut BodyState, &MassProperties, &Wrench),
+) {
+    let mut pending = PendingRotations::new(h);
+    let mut next = BodyState::ZEROED;
+    for i in 0..bodies.len() {
+        let Some(wrench) = bodies.read(i, &mut next) else {
+            continue;
+        };
+        let mass = bodies.mass(i);
+        match translate(&mut next, mass, &wrench) {
+            true if mass.is_spherical() => {
+                next.rotation = rotate_exact(next.rotation, next.angular_velocity, h);
+                commit(bodies, i, &next);
+            }
+            true => {
+                if pending.queue(i, &next, mass) {
+                    pending.flush(bodies);
                 }
+            }
+            false => {
+                // A copy, so that `next` never escapes into the (not inlined) scalar step and
+                // stays in registers on the hot path.
+                let mut single = next;
+                alone(&mut single, mass, &wrench);
+                commit(bodies, i, &single);
             }
         }
     }
-    pending.flush(&mut |j, s| commit(states, &mut diverged, j, s));
-    diverged.sort_unstable();
-    diverged
+    pending.flush(bodies);
+}
+
+/// Plain arrays as a [`BodyBatch`]; divergent indices are collected in order of discovery.
+struct Slices<'a, M> {
+    states: &'a mut [BodyState],
+    masses: &'a [M],
+    wrenches: Option<&'a [Wrench]>,
+    diverged: Vec<usize>,
+}
+
+impl<M: Borrow<MassProperties>> BodyBatch for Slices<'_, M> {
+    fn len(&self) -> usize {
+        self.states.len()
+    }
+
+    #[inline(always)]
+    fn read(&mut self, i: usize, state: &mut BodyState) -> Option<Wrench> {
+        let from = &self.states[i];
+        state.position = from.position;
+        state.rotation = from.rotation;
+        state.linear_velocity = from.linear_velocity;
+        state.angular_velocity = from.angular_velocity;
+        Some(self.wrenches.map_or(Wrench::ZERO, |w| w[i]))
+    }
+
+    #[inline(always)]
+    fn mass(&self, i: usize) -> &MassProperties {
+        self.masses[i].borrow()
+    }
+
+    #[inline(always)]
+    fn write(&mut self, i: usize, state: &BodyState) {
+        self.states[i] = *state;
+    }
+
+    fn diverged(&mut self, i: usize) {
+        self.diverged.push(i);
+    }
 }
 
 impl Integrator {
+    /// Steps every body of `bodies` through `phase` by `dt` (each body's load held constant),
+    /// reading and writing through the [`BodyBatch`]. A body whose result is not finite keeps
+    /// its state and is reported to [`BodyBatch::diverged`]; no other body is affected. Does not
+    /// allocate.
+    pub fn step_batch(self, phase: StepPhase, bodies: &mut impl BodyBatch, dt: Real) {
+        if self != Integrator::Splitting {
+            return match phase {
+                StepPhase::Whole => each_alone(bodies, |s, m, w| self.step(s, m, w, dt)),
+                StepPhase::Begin => each_alone(bodies, |s, m, _| self.begin_step(s, m, dt)),
+                StepPhase::Finish => each_alone(bodies, |s, m, w| self.finish_step(s, m, w, dt)),
+            };
+        }
+        let h = 0.5 * dt;
+        match phase {
+            StepPhase::Whole => batched(
+                bodies,
+                dt,
+                |next, m, wrench| {
+                    // A torque must be kicked between two half rotations: that body steps alone.
+                    let free = wrench.torque == Vec3::ZERO;
+                    if free {
+                        translate_dkd(next, m, wrench, dt);
+                    }
+                    free
+                },
+                |s, m, w| self.step(s, m, w, dt),
+            ),
+            StepPhase::Begin => batched(
+                bodies,
+                h,
+                |next, _, _| {
+                    next.position += h * next.linear_velocity;
+                    true
+                },
+                |s, m, _| self.begin_step(s, m, dt),
+            ),
+            StepPhase::Finish => batched(
+                bodies,
+                h,
+                |next, m, wrench| {
+                    kick(next, m, wrench, dt);
+                    next.position += h * next.linear_velocity;
+                    true
+                },
+                |s, m, w| self.finish_step(s, m, w, dt),
+            ),
+        }
+    }
+
+    /// Runs [`step_batch`](Self::step_batch) over plain arrays; returns the diverged indices
+    /// in increasing order.
+    fn step_slices<M: Borrow<MassProperties>>(
+        self,
+        phase: StepPhase,
+        states: &mut [BodyState],
+        masses: &[M],
+        wrenches: Option<&[Wrench]>,
+        dt: Real,
+    ) -> Vec<usize> {
+        assert!(states.len() == masses.len());
+        assert!(wrenches.is_none_or(|w| w.len() == states.len()));
+        let mut slices = Slices {
+            states,
+            masses,
+            wrenches,
+            diverged: Vec::new(),
+        };
+        self.step_batch(phase, &mut slices, dt);
+        let mut diverged = slices.diverged;
+        diverged.sort_unstable();
+        diverged
+    }
+
     /// [`try_step`](Self::try_step) for every body: `states[i]` advances by `dt` under
     /// `wrenches[i]` with mass `masses[i]`. A body whose result is not finite keeps its state and
     /// its index is returned (in increasing order); no other body is affected. Allocates only
@@ -169,21 +318,7 @@ impl Integrator {
         wrenches: &[Wrench],
         dt: Real,
     ) -> Vec<usize> {
-        assert!(states.len() == masses.len() && states.len() == wrenches.len());
-        let alone =
-            |i: usize, s: &mut BodyState, m: &MassProperties| self.try_step(s, m, &wrenches[i], dt);
-        if self != Integrator::Splitting {
-            return each_alone(states, masses, alone);
-        }
-        let translate = |i: usize, next: &mut BodyState, m: &MassProperties| {
-            let wrench = &wrenches[i];
-            // A torque must be kicked between two half rotations: that body steps alone.
-            (wrench.torque == Vec3::ZERO).then(|| {
-                translate_dkd(next, m, wrench, dt);
-                dt
-            })
-        };
-        batched(states, masses, translate, alone)
+        self.step_slices(StepPhase::Whole, states, masses, Some(wrenches), dt)
     }
 
     /// [`try_begin_step`](Self::try_begin_step) for every body (see
@@ -194,17 +329,7 @@ impl Integrator {
         masses: &[M],
         dt: Real,
     ) -> Vec<usize> {
-        assert!(states.len() == masses.len());
-        let alone = |_: usize, s: &mut BodyState, m: &MassProperties| self.try_begin_step(s, m, dt);
-        if self != Integrator::Splitting {
-            return each_alone(states, masses, alone);
-        }
-        let h = 0.5 * dt;
-        let translate = |_: usize, next: &mut BodyState, _: &MassProperties| {
-            next.position += h * next.linear_velocity;
-            Some(h)
-        };
-        batched(states, masses, translate, alone)
+        self.step_slices(StepPhase::Begin, states, masses, None, dt)
     }
 
     /// [`try_finish_step`](Self::try_finish_step) for every body (see
@@ -216,19 +341,6 @@ impl Integrator {
         wrenches: &[Wrench],
         dt: Real,
     ) -> Vec<usize> {
-        assert!(states.len() == masses.len() && states.len() == wrenches.len());
-        let alone = |i: usize, s: &mut BodyState, m: &MassProperties| {
-            self.try_finish_step(s, m, &wrenches[i], dt)
-        };
-        if self != Integrator::Splitting {
-            return each_alone(states, masses, alone);
-        }
-        let h = 0.5 * dt;
-        let translate = |i: usize, next: &mut BodyState, m: &MassProperties| {
-            kick(next, m, &wrenches[i], dt);
-            next.position += h * next.linear_velocity;
-            Some(h)
-        };
-        batched(states, masses, translate, alone)
+        self.step_slices(StepPhase::Finish, states, masses, Some(wrenches), dt)
     }
 }

@@ -28,6 +28,7 @@
 #[cfg(target_arch = "x86_64")]
 mod avx;
 mod batch;
+pub use batch::{BodyBatch, StepPhase};
 mod frame;
 mod implicit_gyroscopic;
 pub mod lanes;

@@ -210,13 +210,35 @@ pub fn rotate_symmetric_one(input: &SymmetricInput, h: Real) -> (Quat, Vec3) {
     to_real(q, w)
 }
 
+/// The results of [`rotate_symmetric_lanes`], component by component (structure of arrays,
+/// already rounded to the engine precision): the kernel stores each component of the four
+/// bodies with one vector store, and a reader that picks one body's scalars out of them is
+/// served by store forwarding (four scalar stores read back as one vector stall instead).
+#[derive(Debug, Clone, Copy)]
+pub struct RotatedLanes {
+    /// New orientations: `rotation[k][i]` is component `k` (x, y, z, w) of body `i`.
+    pub rotation: [[Real; LANES]; 4],
+    /// New world angular velocities: `omega[k][i]` is component `k` of body `i`.
+    pub omega: [[Real; LANES]; 3],
+}
+
+impl RotatedLanes {
+    /// Body `i`'s new orientation and world angular velocity.
+    #[inline(always)]
+    pub fn lane(&self, i: usize) -> (Quat, Vec3) {
+        let [qx, qy, qz, qw] = &self.rotation;
+        let [wx, wy, wz] = &self.omega;
+        (
+            Quat::from_xyzw(qx[i], qy[i], qz[i], qw[i]),
+            Vec3::new(wx[i], wy[i], wz[i]),
+        )
+    }
+}
+
 /// Four bodies through the kernel at once (SIMD lanes), each over its own `h`; lane `i` of the
 /// result is bit-identical to [`rotate_symmetric_one`]`(&inputs[i], h[i])`.
 #[inline]
-pub fn rotate_symmetric_lanes(
-    inputs: &[SymmetricInput; LANES],
-    h: [Real; LANES],
-) -> [(Quat, Vec3); LANES] {
+pub fn rotate_symmetric_lanes(inputs: &[SymmetricInput; LANES], h: [Real; LANES]) -> RotatedLanes {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx") {
         #[allow(unsafe_code)]
@@ -231,10 +253,7 @@ pub fn rotate_symmetric_lanes(
 /// operations, so the same bits.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx")]
-fn rotate_symmetric_lanes_avx(
-    inputs: &[SymmetricInput; LANES],
-    h: [Real; LANES],
-) -> [(Quat, Vec3); LANES] {
+fn rotate_symmetric_lanes_avx(inputs: &[SymmetricInput; LANES], h: [Real; LANES]) -> RotatedLanes {
     rotate_symmetric_lanes_in::<super::avx::Avx4>(inputs, h)
 }
 
@@ -243,7 +262,7 @@ fn rotate_symmetric_lanes_avx(
 fn rotate_symmetric_lanes_portable(
     inputs: &[SymmetricInput; LANES],
     h: [Real; LANES],
-) -> [(Quat, Vec3); LANES] {
+) -> RotatedLanes {
     rotate_symmetric_lanes_in::<F64x4>(inputs, h)
 }
 
@@ -252,7 +271,7 @@ fn rotate_symmetric_lanes_portable(
 fn rotate_symmetric_lanes_in<T: Lanes4>(
     inputs: &[SymmetricInput; LANES],
     h: [Real; LANES],
-) -> [(Quat, Vec3); LANES] {
+) -> RotatedLanes {
     // Plain indexing, no closures: inside the AVX function every helper must inline.
     macro_rules! lane {
         ($field:ident[$k:expr]) => {
@@ -288,10 +307,15 @@ fn rotate_symmetric_lanes_in<T: Lanes4>(
     };
     let hs = T::from_lanes([h[0].widen(), h[1].widen(), h[2].widen(), h[3].widen()]);
     let (q, w) = symmetric_rotation::<T>(&input, hs);
-    let [qx, qy, qz, qw] = [q[0].lanes(), q[1].lanes(), q[2].lanes(), q[3].lanes()];
-    let [wx, wy, wz] = [w[0].lanes(), w[1].lanes(), w[2].lanes()];
-    let one = |i: usize| to_real([qx[i], qy[i], qz[i], qw[i]], [wx[i], wy[i], wz[i]]);
-    [one(0), one(1), one(2), one(3)]
+    // Rounded lane-wise, exactly as `to_real` rounds one body (one conversion per value).
+    let narrow = |x: T| {
+        let [a, b, c, d] = x.lanes();
+        [a.narrow(), b.narrow(), c.narrow(), d.narrow()]
+    };
+    RotatedLanes {
+        rotation: [narrow(q[0]), narrow(q[1]), narrow(q[2]), narrow(q[3])],
+        omega: [narrow(w[0]), narrow(w[1]), narrow(w[2])],
+    }
 }
 
 #[cfg(test)]
@@ -333,10 +357,14 @@ mod tests {
                 .collect()
         };
         let inputs = &owned;
+        let lanes = |r: RotatedLanes| (0..LANES).map(|i| r.lane(i)).collect::<Vec<_>>();
         assert_eq!(
-            bits(&rotate_symmetric_lanes_portable(inputs, h)),
+            bits(&lanes(rotate_symmetric_lanes_portable(inputs, h))),
             bits(&expected)
         );
-        assert_eq!(bits(&rotate_symmetric_lanes(inputs, h)), bits(&expected));
+        assert_eq!(
+            bits(&lanes(rotate_symmetric_lanes(inputs, h))),
+            bits(&expected)
+        );
     }
 }
