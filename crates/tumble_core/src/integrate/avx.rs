@@ -15,7 +15,7 @@
 use std::arch::x86_64::*;
 use std::ops::{Add, Div, Mul, Neg, Sub};
 
-use super::lanes::{LANES, Lane, Lanes4};
+use super::lanes::{Lane, Quad};
 
 /// Four f64 lanes in a `__m256d`.
 #[derive(Clone, Copy)]
@@ -24,15 +24,15 @@ pub struct Avx4(__m256d);
 impl Avx4 {
     /// Lanes from an array.
     #[inline(always)]
-    pub fn new(lanes: [f64; LANES]) -> Self {
+    pub fn new(lanes: [f64; 4]) -> Self {
         // SAFETY: AVX is available (module contract); the load reads exactly 4 f64.
         Self(unsafe { _mm256_loadu_pd(lanes.as_ptr()) })
     }
 
     /// The lanes as an array.
     #[inline(always)]
-    pub fn to_array(self) -> [f64; LANES] {
-        let mut out = [0.0; LANES];
+    pub fn to_array(self) -> [f64; 4] {
+        let mut out = [0.0; 4];
         // SAFETY: AVX is available (module contract); the store writes exactly 4 f64.
         unsafe { _mm256_storeu_pd(out.as_mut_ptr(), self.0) };
         out
@@ -96,6 +96,14 @@ impl Lane for Avx4 {
             _mm256_movemask_pd(beyond) != 0
         }
     }
+    #[inline(always)]
+    fn beyond(self, limit: f64) -> __m256d {
+        // SAFETY: AVX is available (module contract). |x| > limit, or NaN (unordered).
+        unsafe {
+            let abs = _mm256_andnot_pd(_mm256_set1_pd(-0.0), self.0);
+            _mm256_cmp_pd::<_CMP_NLE_UQ>(abs, _mm256_set1_pd(limit))
+        }
+    }
     #[inline]
     fn platform_sin_cos(self) -> (Self, Self) {
         let lanes = self.to_array().map(f64::sin_cos);
@@ -103,13 +111,13 @@ impl Lane for Avx4 {
     }
 }
 
-impl Lanes4 for Avx4 {
+impl Quad for Avx4 {
     #[inline(always)]
-    fn from_lanes(lanes: [f64; LANES]) -> Self {
+    fn from_quad(lanes: [f64; 4]) -> Self {
         Self::new(lanes)
     }
     #[inline(always)]
-    fn lanes(self) -> [f64; LANES] {
+    fn quad(self) -> [f64; 4] {
         self.to_array()
     }
 }

@@ -15,7 +15,9 @@ use std::borrow::Borrow;
 use super::Integrator;
 use super::lanes::LANES;
 use super::splitting::{kick, translate_dkd};
-use super::symmetric_kernel::{SymmetricInput, rotate_symmetric_lanes, rotate_symmetric_one};
+use super::symmetric_kernel::{
+    LaneInputs, SymmetricInput, rotate_symmetric_lanes, rotate_symmetric_one,
+};
 use crate::mass::MassProperties;
 use crate::rotation::rotate_exact;
 use crate::state::{BodyState, Wrench};
@@ -71,13 +73,13 @@ fn commit(bodies: &mut impl BodyBatch, i: usize, next: &BodyState) {
 }
 
 /// Bodies waiting for their free rotation over the same `h`, flushed [`LANES`] at a time: each
-/// body's translated state and its kernel inputs. (Inputs stored as structure of arrays were
-/// slower: four scalar stores then one vector load of the same bytes stalls store forwarding;
-/// for the same reason `h` is written once, not per body.)
+/// body's translated state and its kernel inputs, the latter component by component so that the
+/// kernel loads them as vectors. (`h` is written once, not per body: scalar stores read back at
+/// once by a vector load stall store forwarding.)
 struct PendingRotations {
     index: [usize; LANES],
     state: [BodyState; LANES],
-    input: [SymmetricInput; LANES],
+    input: LaneInputs,
     h: [Real; LANES],
     len: usize,
 }
@@ -88,7 +90,7 @@ impl PendingRotations {
         Self {
             index: [0; LANES],
             state: [BodyState::ZEROED; LANES],
-            input: [SymmetricInput::default(); LANES],
+            input: LaneInputs::default(),
             h: [h; LANES],
             len: 0,
         }
@@ -99,27 +101,32 @@ impl PendingRotations {
     #[inline(always)]
     fn queue(&mut self, index: usize, state: &BodyState, mass: &MassProperties) -> bool {
         let lane = self.len;
-        self.input[lane] = SymmetricInput::new(state.rotation, state.angular_velocity, mass);
+        let input = SymmetricInput::new(state.rotation, state.angular_velocity, mass);
+        self.input.set(lane, &input);
         self.index[lane] = index;
         self.state[lane] = *state;
         self.len = lane + 1;
         self.len == LANES
     }
 
-    /// Rotates the queued bodies (a partial batch goes through the scalar kernel, which gives
-    /// the same bits) and commits each result.
+    /// Rotates the queued bodies and commits each result. A batch of one goes through the
+    /// scalar kernel; a partial batch fills its empty lanes with copies of its first body (lanes
+    /// are independent, so the results are the same bits either way).
     #[inline(always)]
     fn flush(&mut self, bodies: &mut impl BodyBatch) {
-        if self.len == LANES {
-            let rotated = rotate_symmetric_lanes(&self.input, self.h);
-            for lane in 0..LANES {
-                let (rotation, omega) = rotated.lane(lane);
-                self.finish(lane, rotation, omega, bodies);
+        match self.len {
+            0 => {}
+            1 => {
+                let (rotation, omega) = rotate_symmetric_one(&self.input.get(0), self.h[0]);
+                self.finish(0, rotation, omega, bodies);
             }
-        } else {
-            for lane in 0..self.len {
-                let (rotation, omega) = rotate_symmetric_one(&self.input[lane], self.h[lane]);
-                self.finish(lane, rotation, omega, bodies);
+            len => {
+                self.input.fill_from_first(len);
+                let rotated = rotate_symmetric_lanes(&self.input, self.h);
+                for lane in 0..len {
+                    let (rotation, omega) = rotated.lane(lane);
+                    self.finish(lane, rotation, omega, bodies);
+                }
             }
         }
         self.len = 0;

@@ -1,5 +1,6 @@
 //! Lane-generic f64 arithmetic: the free-flow kernels are written once over [`Lane`] and run
-//! either on one body (`f64`) or on four bodies at once ([`F64x4`], SIMD).
+//! either on one body (`f64`) or on [`LANES`] bodies at once ([`Pair`]`<`[`F64x4`]`>`, or the
+//! AVX and AVX-512 types of the kernel, SIMD).
 //!
 //! Every operation used here is lane-wise IEEE-754 arithmetic (`+ − × ÷ √`, compare, select),
 //! with no fused multiply–add and no horizontal operation, so a body gets **bit-identical**
@@ -9,8 +10,9 @@
 
 use std::ops::{Add, Div, Mul, Neg, Sub};
 
-/// Number of bodies a batch kernel steps at once.
-pub const LANES: usize = 4;
+/// Number of bodies a batch kernel steps at once: one AVX-512 register of f64, or two AVX ones
+/// (two independent chains also hide the latency of the kernel's divisions and square roots).
+pub const LANES: usize = 8;
 
 /// `1.5 · 2⁵²`: adding and subtracting it rounds an f64 below 2⁵¹ in magnitude to the nearest
 /// integer (ties to even), with plain IEEE additions.
@@ -47,6 +49,8 @@ pub trait Lane:
     fn select(mask: Self::Mask, yes: Self, no: Self) -> Self;
     /// True when any lane's magnitude exceeds `limit` or is NaN.
     fn any_beyond(self, limit: f64) -> bool;
+    /// Lane-wise: the magnitude exceeds `limit`, or the lane is NaN.
+    fn beyond(self, limit: f64) -> Self::Mask;
     /// The platform `(sin, cos)` applied lane by lane.
     fn platform_sin_cos(self) -> (Self, Self);
 }
@@ -71,6 +75,10 @@ impl Lane for f64 {
     }
     #[inline(always)]
     fn any_beyond(self, limit: f64) -> bool {
+        self.beyond(limit)
+    }
+    #[inline(always)]
+    fn beyond(self, limit: f64) -> bool {
         self.abs() > limit || self.is_nan()
     }
     #[inline]
@@ -110,12 +118,12 @@ impl Neg for F64x4 {
 impl F64x4 {
     /// Lanes from an array.
     #[inline(always)]
-    pub fn new(lanes: [f64; LANES]) -> Self {
+    pub fn new(lanes: [f64; 4]) -> Self {
         Self(wide::f64x4::new(lanes))
     }
     /// The lanes as an array.
     #[inline(always)]
-    pub fn to_array(self) -> [f64; LANES] {
+    pub fn to_array(self) -> [f64; 4] {
         self.0.to_array()
     }
 }
@@ -142,6 +150,10 @@ impl Lane for F64x4 {
     fn any_beyond(self, limit: f64) -> bool {
         self.to_array().iter().any(|x| x.any_beyond(limit))
     }
+    #[inline(always)]
+    fn beyond(self, limit: f64) -> wide::f64x4 {
+        self.0.abs().simd_gt(wide::f64x4::splat(limit)) | self.0.is_nan()
+    }
     #[inline]
     fn platform_sin_cos(self) -> (Self, Self) {
         let lanes = self.to_array().map(f64::sin_cos);
@@ -152,22 +164,110 @@ impl Lane for F64x4 {
     }
 }
 
+/// A [`Lane`] of four f64 lanes, the half of a [`Pair`].
+pub trait Quad: Lane {
+    /// Lanes from an array.
+    fn from_quad(lanes: [f64; 4]) -> Self;
+    /// The lanes as an array.
+    fn quad(self) -> [f64; 4];
+}
+
+impl Quad for F64x4 {
+    #[inline(always)]
+    fn from_quad(lanes: [f64; 4]) -> Self {
+        Self::new(lanes)
+    }
+    #[inline(always)]
+    fn quad(self) -> [f64; 4] {
+        self.to_array()
+    }
+}
+
 /// A [`Lane`] of exactly [`LANES`] f64 lanes, to load and store batches.
-pub trait Lanes4: Lane {
+pub trait LaneBatch: Lane {
     /// Lanes from an array.
     fn from_lanes(lanes: [f64; LANES]) -> Self;
     /// The lanes as an array.
     fn lanes(self) -> [f64; LANES];
 }
 
-impl Lanes4 for F64x4 {
+/// Two four-lane values side by side: [`LANES`] lanes from two registers, every operation
+/// applied to both halves.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Pair<T>(pub T, pub T);
+
+macro_rules! pair_op {
+    ($trait:ident, $method:ident) => {
+        impl<T: $trait<Output = T>> $trait for Pair<T> {
+            type Output = Self;
+            #[inline(always)]
+            fn $method(self, rhs: Self) -> Self {
+                Pair(self.0.$method(rhs.0), self.1.$method(rhs.1))
+            }
+        }
+    };
+}
+pair_op!(Add, add);
+pair_op!(Sub, sub);
+pair_op!(Mul, mul);
+pair_op!(Div, div);
+
+impl<T: Neg<Output = T>> Neg for Pair<T> {
+    type Output = Self;
+    #[inline(always)]
+    fn neg(self) -> Self {
+        Pair(-self.0, -self.1)
+    }
+}
+
+impl<T: Lane> Lane for Pair<T> {
+    type Mask = (T::Mask, T::Mask);
+    #[inline(always)]
+    fn splat(x: f64) -> Self {
+        Pair(T::splat(x), T::splat(x))
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        Pair(self.0.sqrt(), self.1.sqrt())
+    }
+    #[inline(always)]
+    fn gt(self, other: Self) -> Self::Mask {
+        (self.0.gt(other.0), self.1.gt(other.1))
+    }
+    #[inline(always)]
+    fn select(mask: Self::Mask, yes: Self, no: Self) -> Self {
+        Pair(
+            T::select(mask.0, yes.0, no.0),
+            T::select(mask.1, yes.1, no.1),
+        )
+    }
+    #[inline(always)]
+    fn any_beyond(self, limit: f64) -> bool {
+        self.0.any_beyond(limit) | self.1.any_beyond(limit)
+    }
+    #[inline(always)]
+    fn beyond(self, limit: f64) -> Self::Mask {
+        (self.0.beyond(limit), self.1.beyond(limit))
+    }
+    #[inline]
+    fn platform_sin_cos(self) -> (Self, Self) {
+        let (s0, c0) = self.0.platform_sin_cos();
+        let (s1, c1) = self.1.platform_sin_cos();
+        (Pair(s0, s1), Pair(c0, c1))
+    }
+}
+
+impl<T: Quad> LaneBatch for Pair<T> {
     #[inline(always)]
     fn from_lanes(lanes: [f64; LANES]) -> Self {
-        Self::new(lanes)
+        let [a, b, c, d, e, f, g, h] = lanes;
+        Pair(T::from_quad([a, b, c, d]), T::from_quad([e, f, g, h]))
     }
     #[inline(always)]
     fn lanes(self) -> [f64; LANES] {
-        self.to_array()
+        let [a, b, c, d] = self.0.quad();
+        let [e, f, g, h] = self.1.quad();
+        [a, b, c, d, e, f, g, h]
     }
 }
 
@@ -179,16 +279,32 @@ fn round_nearest<T: Lane>(x: T) -> T {
 
 /// `(sin x, cos x)`: Cody–Waite reduction to `r = x − k π/2`, `|r| ≤ π/4`, Taylor polynomials
 /// through `r¹⁵` and `r¹⁶` (truncation below 5e-17 there), and the quadrant `k mod 4` applied
-/// with selects. Error ≲ 2 ulp for `|x| ≤ 1e5`; beyond that the platform function is used.
+/// with selects. Error ≲ 2 ulp for `|x| ≤ 1e5`; beyond that (and for NaN) the platform
+/// function is used. Each lane's result depends on that lane alone: the shortcuts taken for the
+/// whole register give the same bits as the general path.
 #[inline(always)]
 pub fn sin_cos<T: Lane>(x: T) -> (T, T) {
     if !x.any_beyond(SMALL_ANGLE) {
         // k = 0 in every lane: the reduction and the quadrant below would be exact no-ops.
         return sin_cos_reduced(x);
     }
+    let (sin, cos) = sin_cos_reduced_quadrant(x);
     if x.any_beyond(REDUCTION_LIMIT) {
-        return x.platform_sin_cos();
+        // Only the lanes beyond the limit take the platform values, so a neighbour that
+        // diverged (NaN) or spins absurdly fast changes no other lane's bits.
+        let far = x.beyond(REDUCTION_LIMIT);
+        let (platform_sin, platform_cos) = x.platform_sin_cos();
+        return (
+            T::select(far, platform_sin, sin),
+            T::select(far, platform_cos, cos),
+        );
     }
+    (sin, cos)
+}
+
+/// [`sin_cos`] by reduction and quadrant, for `|x| ≤` [`REDUCTION_LIMIT`].
+#[inline(always)]
+fn sin_cos_reduced_quadrant<T: Lane>(x: T) -> (T, T) {
     let k = round_nearest(x * T::splat(std::f64::consts::FRAC_2_PI));
     let r = ((x - k * T::splat(PIO2_HI)) - k * T::splat(PIO2_MID)) - k * T::splat(PIO2_LO);
     let (s, c) = sin_cos_reduced(r);

@@ -27,6 +27,8 @@
 
 #[cfg(target_arch = "x86_64")]
 mod avx;
+#[cfg(target_arch = "x86_64")]
+mod avx512;
 mod batch;
 pub use batch::{BodyBatch, StepPhase};
 mod frame;

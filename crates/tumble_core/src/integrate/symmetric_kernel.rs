@@ -1,5 +1,5 @@
 //! The `splitting` free flow as one lane-generic kernel: the same code steps one body (`f64`)
-//! or four (`F64x4`), so a body's result does not depend on how it was batched.
+//! or [`LANES`] (SIMD), so a body's result does not depend on how it was batched.
 //!
 //! The axes are relabelled per body so that the symmetric pair is always `(y, z)` and the odd
 //! axis `x` (see [`super::splitting`] for the splitting itself): a cyclic relabelling is a proper
@@ -16,7 +16,7 @@
 //! A rotation by a zero angle is the exact identity (`sin 0 = 0`, `cos 0 = 1`), so locked axes
 //! (`r = 0`) and symmetric bodies need no branches.
 
-use super::lanes::{F64x4, LANES, Lane, Lanes4, sin_cos};
+use super::lanes::{F64x4, LANES, Lane, LaneBatch, Pair, sin_cos};
 use crate::mass::MassProperties;
 use crate::math::{Narrow, Quat, Real, Vec3, Widen};
 
@@ -104,7 +104,7 @@ impl<T: Lane> Free<T> {
     }
 }
 
-/// Inputs of the kernel for one body (`T = f64`) or four (`T = F64x4`).
+/// Inputs of the kernel for one body (`T = f64`) or [`LANES`] (a [`LaneBatch`] type).
 #[derive(Debug, Clone, Copy, Default)]
 pub struct SymmetricInput<T = f64> {
     /// Body orientation `q`.
@@ -150,6 +150,53 @@ impl SymmetricInput {
             relabel: RELABEL[a],
             inertia,
         }
+    }
+}
+
+/// The inputs of [`LANES`] bodies, component by component (`rotation[k][i]` is component `k` of
+/// body `i`), so that the kernel loads each component of all bodies with one vector load.
+pub type LaneInputs = SymmetricInput<[f64; LANES]>;
+
+impl LaneInputs {
+    /// Puts one body's inputs into lane `lane`.
+    #[inline(always)]
+    pub fn set(&mut self, lane: usize, input: &SymmetricInput) {
+        for k in 0..4 {
+            self.rotation[k][lane] = input.rotation[k];
+            self.frame[k][lane] = input.frame[k];
+            self.relabel[k][lane] = input.relabel[k];
+        }
+        for k in 0..3 {
+            self.omega[k][lane] = input.omega[k];
+            self.inertia[k][lane] = input.inertia[k];
+        }
+    }
+
+    /// The inputs in lane `lane`.
+    #[inline(always)]
+    pub fn get(&self, lane: usize) -> SymmetricInput {
+        SymmetricInput {
+            rotation: self.rotation.map(|c| c[lane]),
+            omega: self.omega.map(|c| c[lane]),
+            frame: self.frame.map(|c| c[lane]),
+            relabel: self.relabel.map(|c| c[lane]),
+            inertia: self.inertia.map(|c| c[lane]),
+        }
+    }
+
+    /// Copies lane 0 into lanes `from..LANES` (the filler of a partial batch; lanes are
+    /// independent, so any valid input will do).
+    #[inline(always)]
+    pub fn fill_from_first(&mut self, from: usize) {
+        let fill = |c: &mut [f64; LANES]| {
+            let first = c[0];
+            c[from..].fill(first);
+        };
+        self.rotation.iter_mut().for_each(fill);
+        self.omega.iter_mut().for_each(fill);
+        self.frame.iter_mut().for_each(fill);
+        self.relabel.iter_mut().for_each(fill);
+        self.inertia.iter_mut().for_each(fill);
     }
 }
 
@@ -235,83 +282,71 @@ impl RotatedLanes {
     }
 }
 
-/// Four bodies through the kernel at once (SIMD lanes), each over its own `h`; lane `i` of the
-/// result is bit-identical to [`rotate_symmetric_one`]`(&inputs[i], h[i])`.
+/// [`LANES`] bodies through the kernel at once (SIMD lanes), each over its own `h`; lane `i`
+/// of the result is bit-identical to [`rotate_symmetric_one`]`(&inputs[i], h[i])`.
+///
+/// The widest instruction set the CPU has is picked at run time: AVX-512F (one register of
+/// eight f64), AVX (two registers of four), else the portable build (SSE2 pairs).
 #[inline]
-pub fn rotate_symmetric_lanes(inputs: &[SymmetricInput; LANES], h: [Real; LANES]) -> RotatedLanes {
+pub fn rotate_symmetric_lanes(inputs: &LaneInputs, h: [Real; LANES]) -> RotatedLanes {
     #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx") {
-        #[allow(unsafe_code)]
-        // SAFETY: the CPU supports AVX (checked just above), the only requirement of calling a
-        // function compiled with `#[target_feature(enable = "avx")]`.
-        return unsafe { rotate_symmetric_lanes_avx(inputs, h) };
+    {
+        if std::arch::is_x86_feature_detected!("avx512f") {
+            #[allow(unsafe_code)]
+            // SAFETY: the CPU supports AVX-512F (checked just above), the only requirement of
+            // calling a function compiled with `#[target_feature(enable = "avx512f")]`.
+            return unsafe { rotate_symmetric_lanes_avx512(inputs, h) };
+        }
+        if std::arch::is_x86_feature_detected!("avx") {
+            #[allow(unsafe_code)]
+            // SAFETY: the CPU supports AVX (checked just above), the only requirement of
+            // calling a function compiled with `#[target_feature(enable = "avx")]`.
+            return unsafe { rotate_symmetric_lanes_avx(inputs, h) };
+        }
     }
     rotate_symmetric_lanes_portable(inputs, h)
 }
 
-/// The kernel compiled with AVX enabled, on 256-bit registers ([`Avx4`]): the same IEEE
-/// operations, so the same bits.
+/// The kernel compiled with AVX-512F enabled, on one 512-bit register
+/// ([`Avx8`](super::avx512::Avx8)): the same IEEE operations, so the same bits.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+fn rotate_symmetric_lanes_avx512(inputs: &LaneInputs, h: [Real; LANES]) -> RotatedLanes {
+    rotate_symmetric_lanes_in::<super::avx512::Avx8>(inputs, h)
+}
+
+/// The kernel compiled with AVX enabled, on pairs of 256-bit registers
+/// ([`Avx4`](super::avx::Avx4)): the same IEEE operations, so the same bits.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx")]
-fn rotate_symmetric_lanes_avx(inputs: &[SymmetricInput; LANES], h: [Real; LANES]) -> RotatedLanes {
-    rotate_symmetric_lanes_in::<super::avx::Avx4>(inputs, h)
+fn rotate_symmetric_lanes_avx(inputs: &LaneInputs, h: [Real; LANES]) -> RotatedLanes {
+    rotate_symmetric_lanes_in::<Pair<super::avx::Avx4>>(inputs, h)
 }
 
-/// The kernel on [`F64x4`] lanes (SSE2 pairs on a portable build).
+/// The kernel on pairs of [`F64x4`] (SSE2 pairs on a portable build).
 #[inline(always)]
-fn rotate_symmetric_lanes_portable(
-    inputs: &[SymmetricInput; LANES],
-    h: [Real; LANES],
-) -> RotatedLanes {
-    rotate_symmetric_lanes_in::<F64x4>(inputs, h)
+fn rotate_symmetric_lanes_portable(inputs: &LaneInputs, h: [Real; LANES]) -> RotatedLanes {
+    rotate_symmetric_lanes_in::<Pair<F64x4>>(inputs, h)
 }
 
-/// Transposes four bodies' inputs into lanes of `T`, runs the kernel, transposes back.
+/// Loads the bodies' inputs into lanes of `T` (one vector load per component), runs the kernel
+/// and rounds the results.
 #[inline(always)]
-fn rotate_symmetric_lanes_in<T: Lanes4>(
-    inputs: &[SymmetricInput; LANES],
-    h: [Real; LANES],
-) -> RotatedLanes {
-    // Plain indexing, no closures: inside the AVX function every helper must inline.
-    macro_rules! lane {
-        ($field:ident[$k:expr]) => {
-            T::from_lanes([
-                inputs[0].$field[$k],
-                inputs[1].$field[$k],
-                inputs[2].$field[$k],
-                inputs[3].$field[$k],
-            ])
-        };
-    }
+fn rotate_symmetric_lanes_in<T: LaneBatch>(inputs: &LaneInputs, h: [Real; LANES]) -> RotatedLanes {
+    let load4 = |c: &[[f64; LANES]; 4]| c.map(T::from_lanes);
+    let load3 = |c: &[[f64; LANES]; 3]| c.map(T::from_lanes);
     let input = SymmetricInput {
-        rotation: [
-            lane!(rotation[0]),
-            lane!(rotation[1]),
-            lane!(rotation[2]),
-            lane!(rotation[3]),
-        ],
-        omega: [lane!(omega[0]), lane!(omega[1]), lane!(omega[2])],
-        frame: [
-            lane!(frame[0]),
-            lane!(frame[1]),
-            lane!(frame[2]),
-            lane!(frame[3]),
-        ],
-        relabel: [
-            lane!(relabel[0]),
-            lane!(relabel[1]),
-            lane!(relabel[2]),
-            lane!(relabel[3]),
-        ],
-        inertia: [lane!(inertia[0]), lane!(inertia[1]), lane!(inertia[2])],
+        rotation: load4(&inputs.rotation),
+        omega: load3(&inputs.omega),
+        frame: load4(&inputs.frame),
+        relabel: load4(&inputs.relabel),
+        inertia: load3(&inputs.inertia),
     };
-    let hs = T::from_lanes([h[0].widen(), h[1].widen(), h[2].widen(), h[3].widen()]);
+    let [h0, h1, h2, h3, h4, h5, h6, h7] = h.map(Widen::widen);
+    let hs = T::from_lanes([h0, h1, h2, h3, h4, h5, h6, h7]);
     let (q, w) = symmetric_rotation::<T>(&input, hs);
     // Rounded lane-wise, exactly as `to_real` rounds one body (one conversion per value).
-    let narrow = |x: T| {
-        let [a, b, c, d] = x.lanes();
-        [a.narrow(), b.narrow(), c.narrow(), d.narrow()]
-    };
+    let narrow = |x: T| x.lanes().map(Narrow::narrow);
     RotatedLanes {
         rotation: [narrow(q[0]), narrow(q[1]), narrow(q[2]), narrow(q[3])],
         omega: [narrow(w[0]), narrow(w[1]), narrow(w[2])],
@@ -323,9 +358,10 @@ mod tests {
     use super::*;
     use crate::mass::Mass;
 
-    /// Both compilations of the lane kernel (portable and AVX) and the scalar kernel agree bit
-    /// for bit, on bodies that exercise every relabelling, a locked axis and the wide-angle
-    /// sine path.
+    /// Every compilation of the lane kernel (portable, and AVX or AVX-512 where the CPU has
+    /// them) and the scalar kernel agree bit for bit, on bodies that exercise every
+    /// relabelling, a locked axis, the wide-angle sine path and (lane 6) an angle beyond the
+    /// polynomial's range, which must not change its neighbours' bits.
     #[test]
     fn lane_kernels_match_the_scalar_kernel() {
         let bodies: Vec<(Vec3, Vec3)> = vec![
@@ -333,6 +369,10 @@ mod tests {
             (Vec3::new(2.0, 1.0, 2.05), Vec3::new(-40.0, 1.0, 3.0)),
             (Vec3::new(3.0, 3.1, 0.2), Vec3::new(1.0, 1.0, 90.0)),
             (Vec3::new(0.0, 1.0, 1.5), Vec3::new(2.0, -1.0, 0.5)),
+            (Vec3::splat(0.7), Vec3::new(0.01, 0.02, -0.03)),
+            (Vec3::new(1.0, 2.0, 3.0), Vec3::new(-0.2, 0.0, 0.0)),
+            (Vec3::new(1.0, 2.0, 30.0), Vec3::new(1e8, -3e7, 2e7)),
+            (Vec3::new(5.0, 0.5, 2.0), Vec3::new(7.0, 0.1, -7.0)),
         ];
         let owned: [SymmetricInput; LANES] = std::array::from_fn(|i| {
             let (inertia, omega) = bodies[i];
@@ -342,7 +382,16 @@ mod tests {
                 .unwrap();
             SymmetricInput::new(Quat::from_rotation_y(i as Real), omega, &mass)
         });
-        let h = [1.0 / 60.0, 0.1, 0.05, 1.0 / 240.0];
+        let h = [
+            1.0 / 60.0,
+            0.1,
+            0.05,
+            1.0 / 240.0,
+            0.2,
+            1.0 / 60.0,
+            1.0 / 60.0,
+            0.01,
+        ];
         let expected: Vec<(Quat, Vec3)> = (0..LANES)
             .map(|i| rotate_symmetric_one(&owned[i], h[i]))
             .collect();
@@ -356,7 +405,11 @@ mod tests {
                 })
                 .collect()
         };
-        let inputs = &owned;
+        let mut inputs = LaneInputs::default();
+        for (lane, input) in owned.iter().enumerate() {
+            inputs.set(lane, input);
+        }
+        let inputs = &inputs;
         let lanes = |r: RotatedLanes| (0..LANES).map(|i| r.lane(i)).collect::<Vec<_>>();
         assert_eq!(
             bits(&lanes(rotate_symmetric_lanes_portable(inputs, h))),
@@ -366,5 +419,19 @@ mod tests {
             bits(&lanes(rotate_symmetric_lanes(inputs, h))),
             bits(&expected)
         );
+        #[cfg(target_arch = "x86_64")]
+        #[allow(unsafe_code)]
+        {
+            if std::arch::is_x86_feature_detected!("avx") {
+                // SAFETY: AVX is available (checked just above).
+                let avx = unsafe { rotate_symmetric_lanes_avx(inputs, h) };
+                assert_eq!(bits(&lanes(avx)), bits(&expected));
+            }
+            if std::arch::is_x86_feature_detected!("avx512f") {
+                // SAFETY: AVX-512F is available (checked just above).
+                let avx512 = unsafe { rotate_symmetric_lanes_avx512(inputs, h) };
+                assert_eq!(bits(&lanes(avx512)), bits(&expected));
+            }
+        }
     }
 }
