@@ -15,7 +15,7 @@
 use std::arch::x86_64::*;
 use std::ops::{Add, Div, Mul, Neg, Sub};
 
-use super::lanes::{Lane, Quad};
+use super::lanes::{Lane, Run};
 
 /// Four f64 lanes in a `__m256d`.
 #[derive(Clone, Copy)]
@@ -111,13 +111,14 @@ impl Lane for Avx4 {
     }
 }
 
-impl Quad for Avx4 {
+impl Run for Avx4 {
+    const WIDTH: usize = 4;
     #[inline(always)]
-    fn from_quad(lanes: [f64; 4]) -> Self {
-        Self::new(lanes)
+    fn load(values: &[f64]) -> Self {
+        Self::new([values[0], values[1], values[2], values[3]])
     }
     #[inline(always)]
-    fn quad(self) -> [f64; 4] {
-        self.to_array()
+    fn store(self, out: &mut [f64]) {
+        out[..4].copy_from_slice(&self.to_array());
     }
 }

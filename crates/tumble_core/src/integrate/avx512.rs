@@ -14,7 +14,7 @@
 use std::arch::x86_64::*;
 use std::ops::{Add, Div, Mul, Neg, Sub};
 
-use super::lanes::{LANES, Lane, LaneBatch};
+use super::lanes::{Lane, Run};
 
 /// Eight f64 lanes in a `__m512d`.
 #[derive(Clone, Copy)]
@@ -112,13 +112,16 @@ impl Lane for Avx8 {
     }
 }
 
-impl LaneBatch for Avx8 {
+impl Run for Avx8 {
+    const WIDTH: usize = 8;
     #[inline(always)]
-    fn from_lanes(lanes: [f64; LANES]) -> Self {
-        Self::new(lanes)
+    fn load(values: &[f64]) -> Self {
+        Self::new([
+            values[0], values[1], values[2], values[3], values[4], values[5], values[6], values[7],
+        ])
     }
     #[inline(always)]
-    fn lanes(self) -> [f64; LANES] {
-        self.to_array()
+    fn store(self, out: &mut [f64]) {
+        out[..8].copy_from_slice(&self.to_array());
     }
 }

@@ -1,6 +1,6 @@
 //! Lane-generic f64 arithmetic: the free-flow kernels are written once over [`Lane`] and run
-//! either on one body (`f64`) or on [`LANES`] bodies at once ([`Pair`]`<`[`F64x4`]`>`, or the
-//! AVX and AVX-512 types of the kernel, SIMD).
+//! either on one body (`f64`) or on several bodies at once ([`F64x4`], or the AVX and AVX-512
+//! types of the kernel, SIMD).
 //!
 //! Every operation used here is lane-wise IEEE-754 arithmetic (`+ − × ÷ √`, compare, select),
 //! with no fused multiply–add and no horizontal operation, so a body gets **bit-identical**
@@ -10,8 +10,8 @@
 
 use std::ops::{Add, Div, Mul, Neg, Sub};
 
-/// Number of bodies a batch kernel steps at once: one AVX-512 register of f64, or two AVX ones
-/// (two independent chains also hide the latency of the kernel's divisions and square roots).
+/// Number of bodies a batch kernel steps at once: one AVX-512 register of f64, or two runs of
+/// four.
 pub const LANES: usize = 8;
 
 /// `1.5 · 2⁵²`: adding and subtracting it rounds an f64 below 2⁵¹ in magnitude to the nearest
@@ -164,110 +164,27 @@ impl Lane for F64x4 {
     }
 }
 
-/// A [`Lane`] of four f64 lanes, the half of a [`Pair`].
-pub trait Quad: Lane {
-    /// Lanes from an array.
-    fn from_quad(lanes: [f64; 4]) -> Self;
-    /// The lanes as an array.
-    fn quad(self) -> [f64; 4];
+/// A [`Lane`] type that holds a run of `WIDTH` consecutive bodies of a batch: the kernel steps a
+/// batch of [`LANES`] bodies as `LANES / WIDTH` runs (two runs of four with AVX, one run of
+/// eight with AVX-512: one run per register keeps the kernel within the register file).
+pub trait Run: Lane {
+    /// Bodies per run (divides [`LANES`]).
+    const WIDTH: usize;
+    /// Lanes from the first `WIDTH` values of `values`.
+    fn load(values: &[f64]) -> Self;
+    /// Writes the lanes to the first `WIDTH` values of `out`.
+    fn store(self, out: &mut [f64]);
 }
 
-impl Quad for F64x4 {
+impl Run for F64x4 {
+    const WIDTH: usize = 4;
     #[inline(always)]
-    fn from_quad(lanes: [f64; 4]) -> Self {
-        Self::new(lanes)
+    fn load(values: &[f64]) -> Self {
+        Self::new([values[0], values[1], values[2], values[3]])
     }
     #[inline(always)]
-    fn quad(self) -> [f64; 4] {
-        self.to_array()
-    }
-}
-
-/// A [`Lane`] of exactly [`LANES`] f64 lanes, to load and store batches.
-pub trait LaneBatch: Lane {
-    /// Lanes from an array.
-    fn from_lanes(lanes: [f64; LANES]) -> Self;
-    /// The lanes as an array.
-    fn lanes(self) -> [f64; LANES];
-}
-
-/// Two four-lane values side by side: [`LANES`] lanes from two registers, every operation
-/// applied to both halves.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Pair<T>(pub T, pub T);
-
-macro_rules! pair_op {
-    ($trait:ident, $method:ident) => {
-        impl<T: $trait<Output = T>> $trait for Pair<T> {
-            type Output = Self;
-            #[inline(always)]
-            fn $method(self, rhs: Self) -> Self {
-                Pair(self.0.$method(rhs.0), self.1.$method(rhs.1))
-            }
-        }
-    };
-}
-pair_op!(Add, add);
-pair_op!(Sub, sub);
-pair_op!(Mul, mul);
-pair_op!(Div, div);
-
-impl<T: Neg<Output = T>> Neg for Pair<T> {
-    type Output = Self;
-    #[inline(always)]
-    fn neg(self) -> Self {
-        Pair(-self.0, -self.1)
-    }
-}
-
-impl<T: Lane> Lane for Pair<T> {
-    type Mask = (T::Mask, T::Mask);
-    #[inline(always)]
-    fn splat(x: f64) -> Self {
-        Pair(T::splat(x), T::splat(x))
-    }
-    #[inline(always)]
-    fn sqrt(self) -> Self {
-        Pair(self.0.sqrt(), self.1.sqrt())
-    }
-    #[inline(always)]
-    fn gt(self, other: Self) -> Self::Mask {
-        (self.0.gt(other.0), self.1.gt(other.1))
-    }
-    #[inline(always)]
-    fn select(mask: Self::Mask, yes: Self, no: Self) -> Self {
-        Pair(
-            T::select(mask.0, yes.0, no.0),
-            T::select(mask.1, yes.1, no.1),
-        )
-    }
-    #[inline(always)]
-    fn any_beyond(self, limit: f64) -> bool {
-        self.0.any_beyond(limit) | self.1.any_beyond(limit)
-    }
-    #[inline(always)]
-    fn beyond(self, limit: f64) -> Self::Mask {
-        (self.0.beyond(limit), self.1.beyond(limit))
-    }
-    #[inline]
-    fn platform_sin_cos(self) -> (Self, Self) {
-        let (s0, c0) = self.0.platform_sin_cos();
-        let (s1, c1) = self.1.platform_sin_cos();
-        (Pair(s0, s1), Pair(c0, c1))
-    }
-}
-
-impl<T: Quad> LaneBatch for Pair<T> {
-    #[inline(always)]
-    fn from_lanes(lanes: [f64; LANES]) -> Self {
-        let [a, b, c, d, e, f, g, h] = lanes;
-        Pair(T::from_quad([a, b, c, d]), T::from_quad([e, f, g, h]))
-    }
-    #[inline(always)]
-    fn lanes(self) -> [f64; LANES] {
-        let [a, b, c, d] = self.0.quad();
-        let [e, f, g, h] = self.1.quad();
-        [a, b, c, d, e, f, g, h]
+    fn store(self, out: &mut [f64]) {
+        out[..4].copy_from_slice(&self.to_array());
     }
 }
 

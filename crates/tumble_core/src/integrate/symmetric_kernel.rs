@@ -16,7 +16,7 @@
 //! A rotation by a zero angle is the exact identity (`sin 0 = 0`, `cos 0 = 1`), so locked axes
 //! (`r = 0`) and symmetric bodies need no branches.
 
-use super::lanes::{F64x4, LANES, Lane, LaneBatch, Pair, sin_cos};
+use super::lanes::{F64x4, LANES, Lane, Run, sin_cos};
 use crate::mass::MassProperties;
 use crate::math::{Narrow, Quat, Real, Vec3, Widen};
 
@@ -104,7 +104,7 @@ impl<T: Lane> Free<T> {
     }
 }
 
-/// Inputs of the kernel for one body (`T = f64`) or [`LANES`] (a [`LaneBatch`] type).
+/// Inputs of the kernel for one body (`T = f64`) or a run of bodies (a [`Run`] type).
 #[derive(Debug, Clone, Copy, Default)]
 pub struct SymmetricInput<T = f64> {
     /// Body orientation `q`.
@@ -315,41 +315,78 @@ fn rotate_symmetric_lanes_avx512(inputs: &LaneInputs, h: [Real; LANES]) -> Rotat
     rotate_symmetric_lanes_in::<super::avx512::Avx8>(inputs, h)
 }
 
-/// The kernel compiled with AVX enabled, on pairs of 256-bit registers
-/// ([`Avx4`](super::avx::Avx4)): the same IEEE operations, so the same bits.
+/// The kernel compiled with AVX enabled, two runs of four bodies in 256-bit registers
+/// ([`Avx4`](super::avx::Avx4)): the same IEEE operations, so the same bits. (One run of eight
+/// as two registers side by side spills the register file and ran 1.7× slower.)
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx")]
 fn rotate_symmetric_lanes_avx(inputs: &LaneInputs, h: [Real; LANES]) -> RotatedLanes {
-    rotate_symmetric_lanes_in::<Pair<super::avx::Avx4>>(inputs, h)
+    rotate_symmetric_lanes_in::<super::avx::Avx4>(inputs, h)
 }
 
-/// The kernel on pairs of [`F64x4`] (SSE2 pairs on a portable build).
+/// The kernel on runs of four, [`F64x4`] (SSE2 pairs on a portable build).
 #[inline(always)]
 fn rotate_symmetric_lanes_portable(inputs: &LaneInputs, h: [Real; LANES]) -> RotatedLanes {
-    rotate_symmetric_lanes_in::<Pair<F64x4>>(inputs, h)
+    rotate_symmetric_lanes_in::<F64x4>(inputs, h)
 }
 
-/// Loads the bodies' inputs into lanes of `T` (one vector load per component), runs the kernel
-/// and rounds the results.
+/// Runs the kernel over the batch in runs of `T::WIDTH` bodies: loads each input component of a
+/// run with one vector load, rotates, rounds the results to the engine precision.
 #[inline(always)]
-fn rotate_symmetric_lanes_in<T: LaneBatch>(inputs: &LaneInputs, h: [Real; LANES]) -> RotatedLanes {
-    let load4 = |c: &[[f64; LANES]; 4]| c.map(T::from_lanes);
-    let load3 = |c: &[[f64; LANES]; 3]| c.map(T::from_lanes);
-    let input = SymmetricInput {
-        rotation: load4(&inputs.rotation),
-        omega: load3(&inputs.omega),
-        frame: load4(&inputs.frame),
-        relabel: load4(&inputs.relabel),
-        inertia: load3(&inputs.inertia),
+fn rotate_symmetric_lanes_in<T: Run>(inputs: &LaneInputs, h: [Real; LANES]) -> RotatedLanes {
+    let mut wide_h = [0.0; LANES];
+    for (wide, h) in wide_h.iter_mut().zip(h) {
+        *wide = h.widen();
+    }
+    let h = wide_h;
+    let mut out = RotatedLanes {
+        rotation: [[0.0; LANES]; 4],
+        omega: [[0.0; LANES]; 3],
     };
-    let [h0, h1, h2, h3, h4, h5, h6, h7] = h.map(Widen::widen);
-    let hs = T::from_lanes([h0, h1, h2, h3, h4, h5, h6, h7]);
-    let (q, w) = symmetric_rotation::<T>(&input, hs);
+    let mut start = 0;
+    while start < LANES {
+        rotate_run::<T>(inputs, &h, start, &mut out);
+        start += T::WIDTH;
+    }
+    out
+}
+
+/// The kernel on bodies `start .. start + T::WIDTH` of the batch. Plain indexing, no closures:
+/// inside a `#[target_feature]` function every helper must inline, and a closure is compiled
+/// without the feature (its intrinsics then become calls, 1.8× slower).
+#[inline(always)]
+#[allow(clippy::needless_range_loop)]
+fn rotate_run<T: Run>(inputs: &LaneInputs, h: &[f64; LANES], start: usize, out: &mut RotatedLanes) {
+    let mut input = SymmetricInput::<T> {
+        rotation: [T::splat(0.0); 4],
+        omega: [T::splat(0.0); 3],
+        frame: [T::splat(0.0); 4],
+        relabel: [T::splat(0.0); 4],
+        inertia: [T::splat(0.0); 3],
+    };
+    for k in 0..4 {
+        input.rotation[k] = T::load(&inputs.rotation[k][start..]);
+        input.frame[k] = T::load(&inputs.frame[k][start..]);
+        input.relabel[k] = T::load(&inputs.relabel[k][start..]);
+    }
+    for k in 0..3 {
+        input.omega[k] = T::load(&inputs.omega[k][start..]);
+        input.inertia[k] = T::load(&inputs.inertia[k][start..]);
+    }
+    let (q, w) = symmetric_rotation::<T>(&input, T::load(&h[start..]));
     // Rounded lane-wise, exactly as `to_real` rounds one body (one conversion per value).
-    let narrow = |x: T| x.lanes().map(Narrow::narrow);
-    RotatedLanes {
-        rotation: [narrow(q[0]), narrow(q[1]), narrow(q[2]), narrow(q[3])],
-        omega: [narrow(w[0]), narrow(w[1]), narrow(w[2])],
+    let mut wide = [0.0; LANES];
+    for k in 0..4 {
+        q[k].store(&mut wide);
+        for i in 0..T::WIDTH {
+            out.rotation[k][start + i] = wide[i].narrow();
+        }
+    }
+    for k in 0..3 {
+        w[k].store(&mut wide);
+        for i in 0..T::WIDTH {
+            out.omega[k][start + i] = wide[i].narrow();
+        }
     }
 }
 
