@@ -21,6 +21,7 @@ pub mod integrate;
 pub mod invariants;
 pub mod mass;
 pub mod math;
+pub mod prefetch;
 pub mod reference;
 pub mod rotation;
 #[cfg(feature = "serde")]

@@ -9,6 +9,7 @@ use tumble_core::math::Vec3;
 
 use bevy_ecs::prelude::*;
 use tumble_core::math::Real;
+use tumble_core::prefetch::prefetch;
 use tumble_core::{BodyBatch, BodyState, Integrator, MassProperties, StepPhase, Wrench};
 
 use crate::components::{
@@ -164,6 +165,16 @@ impl BodyBatch for TableBatch<'_, '_> {
     #[inline(always)]
     fn mass(&self, i: usize) -> &MassProperties {
         &self.bodies.masses[i].0
+    }
+
+    #[inline(always)]
+    fn prefetch(&self, i: usize) {
+        let bodies = &self.bodies;
+        if i < bodies.len() {
+            prefetch(&bodies.transforms[i]);
+            prefetch(&bodies.velocities[i]);
+            prefetch(&bodies.masses[i]);
+        }
     }
 
     #[inline(always)]

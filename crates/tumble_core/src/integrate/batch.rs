@@ -19,6 +19,7 @@ use super::symmetric_kernel::{
     LaneInputs, SymmetricInput, rotate_symmetric_lanes, rotate_symmetric_one,
 };
 use crate::mass::MassProperties;
+use crate::prefetch::prefetch;
 use crate::rotation::rotate_exact;
 use crate::state::{BodyState, Wrench};
 
@@ -60,7 +61,19 @@ pub trait BodyBatch {
     fn write(&mut self, i: usize, state: &BodyState);
     /// Body `i`'s step did not give a finite state; it keeps its old one.
     fn diverged(&mut self, i: usize);
+    /// A hint: body `i` (possibly beyond the last) will be read soon; fetch its memory with
+    /// [`prefetch`](crate::prefetch::prefetch). The batch loops call it [`PREFETCH_AHEAD`]
+    /// bodies ahead. Default: nothing.
+    #[inline(always)]
+    fn prefetch(&self, i: usize) {
+        let _ = i;
+    }
 }
+
+/// How many bodies ahead of the one being read the batch loops call [`BodyBatch::prefetch`].
+/// Measured (`ecs_vs_raw` example, 10⁶ bodies, `splitting`): ECS 53 → 40 ns per body-step;
+/// no change at 10⁴ and 10⁵, where the hardware prefetchers keep up.
+pub const PREFETCH_AHEAD: usize = 32;
 
 /// Hands `next` to `bodies` as body `i`'s new state if it is finite, else reports divergence.
 #[inline(always)]
@@ -156,6 +169,7 @@ fn each_alone(
 ) {
     let mut next = BodyState::ZEROED;
     for i in 0..bodies.len() {
+        bodies.prefetch(i + PREFETCH_AHEAD);
         let Some(wrench) = bodies.read(i, &mut next) else {
             continue;
         };
@@ -176,6 +190,7 @@ fn batched(
     let mut pending = PendingRotations::new(h);
     let mut next = BodyState::ZEROED;
     for i in 0..bodies.len() {
+        bodies.prefetch(i + PREFETCH_AHEAD);
         let Some(wrench) = bodies.read(i, &mut next) else {
             continue;
         };
@@ -233,6 +248,17 @@ impl<M: Borrow<MassProperties>> BodyBatch for Slices<'_, M> {
     #[inline(always)]
     fn write(&mut self, i: usize, state: &BodyState) {
         self.states[i] = *state;
+    }
+
+    #[inline(always)]
+    fn prefetch(&self, i: usize) {
+        if i < self.states.len() {
+            prefetch(&self.states[i]);
+            prefetch(self.masses[i].borrow());
+            if let Some(wrenches) = self.wrenches {
+                prefetch(&wrenches[i]);
+            }
+        }
     }
 
     fn diverged(&mut self, i: usize) {

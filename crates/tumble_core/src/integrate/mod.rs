@@ -30,7 +30,7 @@ mod avx;
 #[cfg(target_arch = "x86_64")]
 mod avx512;
 mod batch;
-pub use batch::{BodyBatch, StepPhase};
+pub use batch::{BodyBatch, PREFETCH_AHEAD, StepPhase};
 mod frame;
 mod implicit_gyroscopic;
 pub mod lanes;
