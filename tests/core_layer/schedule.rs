@@ -211,3 +211,39 @@ fn user_force_system_in_forces_set_runs_before_integration() {
         Vec3::new(0.0, 0.0, 1.5)
     );
 }
+
+/// A world that needs every stage gets all of them, once each, in `Stage::ALL` order (so the
+/// plan's inline capacity, `Stage::COUNT`, always suffices).
+#[test]
+fn a_world_needing_everything_plans_every_stage_in_order() {
+    let mut world = world_with(0.01, Integrator::Splitting);
+    world.insert_resource(Gravity::EARTH_Y_DOWN);
+    let wall = world
+        .spawn((RigidBody, Static, ForceAccumulator::default()))
+        .id();
+    let pulled = world.spawn((RigidBody, ForceAccumulator::default())).id();
+    world.spawn(RigidBody);
+    world.spawn(Spring {
+        a: pulled,
+        anchor_a: Vec3::ZERO,
+        b: SpringEnd::Body {
+            body: wall,
+            anchor: Vec3::ZERO,
+        },
+        stiffness: 10.0,
+        damping: 0.0,
+        rest_length: 1.0,
+    });
+    world.spawn(ConstantForce {
+        body: pulled,
+        force: Vec3::X,
+        local_point: None,
+    });
+    world.spawn(ConstantTorque {
+        body: pulled,
+        torque: Vec3::Y,
+    });
+    let plan = PhysicsPlan::for_world(&mut world);
+    assert_eq!(plan.stages(), &Stage::ALL[..]);
+    assert_eq!(Stage::ALL.len(), Stage::COUNT);
+}

@@ -15,6 +15,7 @@
 
 use std::fmt;
 
+use arrayvec::ArrayVec;
 use bevy_ecs::prelude::*;
 use bevy_ecs::schedule::{ScheduleBuildSettings, ScheduleLabel};
 
@@ -69,6 +70,21 @@ pub enum Stage {
 }
 
 impl Stage {
+    /// Every stage, in the order a step runs them.
+    pub const ALL: [Stage; 8] = [
+        Stage::BeginStep,
+        Stage::Gravity,
+        Stage::ConstantForces,
+        Stage::ConstantTorques,
+        Stage::Springs,
+        Stage::IntegrateWithForces,
+        Stage::IntegrateWithoutForces,
+        Stage::DiscardFixedBodyForces,
+    ];
+
+    /// How many stages there are (a plan holds each at most once).
+    pub const COUNT: usize = Self::ALL.len();
+
     /// The system's name.
     pub fn name(self) -> &'static str {
         match self {
@@ -94,12 +110,12 @@ impl Stage {
 ///   / without an accumulator ([`Static`] and [`Kinematic`] bodies are never integrated);
 /// - `discard_fixed_body_forces` only if a static or kinematic body has an accumulator.
 ///
-/// [`PhysicsPlan::of`] is cheap (one pass over the archetypes, no allocation beyond the plan), so
-/// [`PhysicsRunner`](crate::runner::PhysicsRunner) re-plans every step and rebuilds the schedule
-/// only when the plan changes.
+/// [`PhysicsPlan::of`] is cheap (one pass over the archetypes, no allocation: the stages live
+/// inline), so [`PhysicsRunner`](crate::runner::PhysicsRunner) re-plans every step and rebuilds
+/// the schedule only when the plan changes.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct PhysicsPlan {
-    stages: Vec<Stage>,
+    stages: ArrayVec<Stage, { Stage::COUNT }>,
 }
 
 /// What the world holds, as far as planning cares.
@@ -169,7 +185,7 @@ impl PhysicsPlan {
             .integrator
             .samples_forces_at_midpoint();
         let c = Contents::of(world);
-        let mut stages = Vec::with_capacity(8);
+        let mut stages = ArrayVec::new();
         if midpoint && c.dynamic_with_accumulator {
             stages.push(Stage::BeginStep);
         }
