@@ -28,7 +28,8 @@ const PIO2_LO: f64 = 2.022_266_248_795_950_6e-21;
 /// lane by lane (still deterministic, as that path is the same for a lane alone or in a batch).
 const REDUCTION_LIMIT: f64 = 1.0e5;
 
-/// f64 lanes: `f64` itself (one body) or `F64x4` (four bodies).
+/// f64 lanes: `f64` itself (one body), or a SIMD type holding several bodies ([`F64x4`], and
+/// the AVX and AVX-512 types of the kernel).
 pub trait Lane:
     Copy
     + Add<Output = Self>

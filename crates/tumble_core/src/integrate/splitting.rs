@@ -157,7 +157,7 @@ pub fn drift(state: &mut BodyState, mass: &MassProperties, h: Real, rotation: Ro
 
 /// The free rotation of the `splitting` method over `h`: spherical bodies exactly about `ω`
 /// (`ω ∥ L` for them), the others through the lane kernel of
-/// [`symmetric_kernel`](super::symmetric_kernel) — the same code the batched step runs, so one
+/// the module `symmetric_kernel` — the same code the batched step runs, so one
 /// body gets the same bits alone or in a batch.
 #[inline]
 pub fn rotate_symmetric(state: &mut BodyState, mass: &MassProperties, h: Real) {
