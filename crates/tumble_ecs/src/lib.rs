@@ -24,6 +24,7 @@ pub mod snapshot;
 pub mod stability;
 pub mod stepper;
 pub mod systems;
+mod table;
 pub mod validate;
 
 /// Everything a game loop needs, in one import.
