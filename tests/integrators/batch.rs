@@ -173,11 +173,7 @@ impl BodyBatch for Recording {
         if i % 3 == 2 {
             return None;
         }
-        let from = self.states[i];
-        state.position = from.position;
-        state.rotation = from.rotation;
-        state.linear_velocity = from.linear_velocity;
-        state.angular_velocity = from.angular_velocity;
+        state.copy_fields_from(&self.states[i]);
         Some(self.wrenches[i])
     }
 

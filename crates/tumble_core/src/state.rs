@@ -41,6 +41,18 @@ impl BodyState {
         angular_velocity: Vec3::ZERO,
     };
 
+    /// Copies `from`'s fields into `self` one by one, leaving `self`'s padding bytes as they
+    /// are (zero in a [`ZEROED`](Self::ZEROED) scratch value). A whole-struct copy may carry
+    /// stale padding bytes along, and vectorized code reads them as a fourth lane: when they
+    /// form a subnormal float, every operation on that lane takes a microcode assist.
+    #[inline(always)]
+    pub fn copy_fields_from(&mut self, from: &BodyState) {
+        self.position = from.position;
+        self.rotation = from.rotation;
+        self.linear_velocity = from.linear_velocity;
+        self.angular_velocity = from.angular_velocity;
+    }
+
     /// True when every component is finite.
     #[inline]
     pub fn is_finite(&self) -> bool {

@@ -146,11 +146,7 @@ impl BodyBatch for TableBatch<'_, '_> {
         let mass = &bodies.masses[i];
         match check_body(transform, velocity, None).and_then(|()| bodies.loads.take(i, mass)) {
             Ok(wrench) => {
-                let read = body_state(transform, velocity, mass);
-                state.position = read.position;
-                state.rotation = read.rotation;
-                state.linear_velocity = read.linear_velocity;
-                state.angular_velocity = read.angular_velocity;
+                state.copy_fields_from(&body_state(transform, velocity, mass));
                 Some(wrench)
             }
             Err(kind) => {

@@ -57,10 +57,7 @@ pub enum StepPhase {
 ///     fn read(&mut self, i: usize, state: &mut BodyState) -> Option<Wrench> {
 ///         let c = &self.0[i];
 ///         if c.frozen { return None; }
-///         state.position = c.state.position;
-///         state.rotation = c.state.rotation;
-///         state.linear_velocity = c.state.linear_velocity;
-///         state.angular_velocity = c.state.angular_velocity;
+///         state.copy_fields_from(&c.state);
 ///         Some(Wrench { force: Vec3::new(0.0, -9.81, 0.0) * c.mass.mass(), torque: Vec3::ZERO })
 ///     }
 ///     fn mass(&self, i: usize) -> &MassProperties { &self.0[i].mass }
@@ -83,11 +80,10 @@ pub trait BodyBatch {
     fn is_empty(&self) -> bool {
         self.len() == 0
     }
-    /// Writes body `i`'s state into `state`, field by field, and returns its load; or returns
-    /// `None` when the body must not be stepped (the implementation records why). `state` is a
-    /// scratch value whose padding bytes are zero: vectorized code reads them along with the
-    /// fields, and stale bytes there can be subnormal patterns that cost a microcode assist per
-    /// operation, so assign the fields rather than the whole struct.
+    /// Writes body `i`'s state into `state` and returns its load; or returns `None` when the
+    /// body must not be stepped (the implementation records why). `state` is a scratch value
+    /// whose padding bytes are zero: assign it with
+    /// [`BodyState::copy_fields_from`], not as a whole struct (see there why).
     fn read(&mut self, i: usize, state: &mut BodyState) -> Option<Wrench>;
     /// Body `i`'s mass properties.
     fn mass(&self, i: usize) -> &MassProperties;
@@ -266,11 +262,7 @@ impl<M: Borrow<MassProperties>> BodyBatch for Slices<'_, M> {
 
     #[inline(always)]
     fn read(&mut self, i: usize, state: &mut BodyState) -> Option<Wrench> {
-        let from = &self.states[i];
-        state.position = from.position;
-        state.rotation = from.rotation;
-        state.linear_velocity = from.linear_velocity;
-        state.angular_velocity = from.angular_velocity;
+        state.copy_fields_from(&self.states[i]);
         Some(self.wrenches.map_or(Wrench::ZERO, |w| w[i]))
     }
 
