@@ -88,13 +88,9 @@ impl Lane for Avx4 {
         Self(unsafe { _mm256_blendv_pd(no.0, yes.0, mask) })
     }
     #[inline(always)]
-    fn any_beyond(self, limit: f64) -> bool {
-        // SAFETY: AVX is available (module contract). |x| > limit, or NaN (unordered).
-        unsafe {
-            let abs = _mm256_andnot_pd(_mm256_set1_pd(-0.0), self.0);
-            let beyond = _mm256_cmp_pd::<_CMP_NLE_UQ>(abs, _mm256_set1_pd(limit));
-            _mm256_movemask_pd(beyond) != 0
-        }
+    fn any(mask: __m256d) -> bool {
+        // SAFETY: AVX is available (module contract).
+        unsafe { _mm256_movemask_pd(mask) != 0 }
     }
     #[inline(always)]
     fn beyond(self, limit: f64) -> __m256d {

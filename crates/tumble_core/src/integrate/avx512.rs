@@ -94,8 +94,8 @@ impl Lane for Avx8 {
         Self(unsafe { _mm512_mask_blend_pd(mask, no.0, yes.0) })
     }
     #[inline(always)]
-    fn any_beyond(self, limit: f64) -> bool {
-        self.beyond(limit) != 0
+    fn any(mask: __mmask8) -> bool {
+        mask != 0
     }
     #[inline(always)]
     fn beyond(self, limit: f64) -> __mmask8 {

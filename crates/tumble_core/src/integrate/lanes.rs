@@ -48,10 +48,15 @@ pub trait Lane:
     fn gt(self, other: Self) -> Self::Mask;
     /// Lane-wise `if mask { yes } else { no }`.
     fn select(mask: Self::Mask, yes: Self, no: Self) -> Self;
-    /// True when any lane's magnitude exceeds `limit` or is NaN.
-    fn any_beyond(self, limit: f64) -> bool;
+    /// True when any lane of `mask` is set.
+    fn any(mask: Self::Mask) -> bool;
     /// Lane-wise: the magnitude exceeds `limit`, or the lane is NaN.
     fn beyond(self, limit: f64) -> Self::Mask;
+    /// True when any lane's magnitude exceeds `limit` or is NaN.
+    #[inline(always)]
+    fn any_beyond(self, limit: f64) -> bool {
+        Self::any(self.beyond(limit))
+    }
     /// The platform `(sin, cos)` applied lane by lane.
     fn platform_sin_cos(self) -> (Self, Self);
 }
@@ -75,8 +80,8 @@ impl Lane for f64 {
         if mask { yes } else { no }
     }
     #[inline(always)]
-    fn any_beyond(self, limit: f64) -> bool {
-        self.beyond(limit)
+    fn any(mask: bool) -> bool {
+        mask
     }
     #[inline(always)]
     fn beyond(self, limit: f64) -> bool {
@@ -148,8 +153,8 @@ impl Lane for F64x4 {
         Self(mask.bitselect(yes.0, no.0))
     }
     #[inline(always)]
-    fn any_beyond(self, limit: f64) -> bool {
-        self.to_array().iter().any(|x| x.any_beyond(limit))
+    fn any(mask: wide::f64x4) -> bool {
+        mask.any()
     }
     #[inline(always)]
     fn beyond(self, limit: f64) -> wide::f64x4 {

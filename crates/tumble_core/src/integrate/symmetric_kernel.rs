@@ -258,7 +258,7 @@ pub fn rotate_symmetric_one(input: &SymmetricInput, h: Real) -> (Quat, Vec3) {
 }
 
 /// The results of [`rotate_symmetric_lanes`], component by component (structure of arrays,
-/// already rounded to the engine precision): the kernel stores each component of the four
+/// already rounded to the engine precision): the kernel stores each component of a run of
 /// bodies with one vector store, and a reader that picks one body's scalars out of them is
 /// served by store forwarding (four scalar stores read back as one vector stall instead).
 #[derive(Debug, Clone, Copy)]
