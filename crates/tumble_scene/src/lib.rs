@@ -12,6 +12,7 @@
 mod build;
 mod error;
 mod format;
+pub mod text;
 mod trajectory;
 mod validate;
 
