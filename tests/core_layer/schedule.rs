@@ -69,9 +69,11 @@ fn each_generator_kind_adds_exactly_its_system() {
         torque: Vec3::Y,
     });
     let plan = PhysicsPlan::for_world(&mut world);
-    assert_eq!(plan.stages().len(), 5);
+    // Springs bring the energy audit along: its start, its load reading and its balance.
+    assert_eq!(plan.stages().len(), 5 + 3);
     assert!(plan.contains(Stage::Springs) && plan.contains(Stage::ConstantTorques));
-    assert_eq!(system_count(&mut world, &plan), 5);
+    assert!(plan.contains(Stage::AuditEnergy));
+    assert_eq!(system_count(&mut world, &plan), 5 + 3);
 }
 
 #[test]
@@ -108,8 +110,8 @@ fn static_and_kinematic_bodies_are_never_integrated() {
     let plan = PhysicsPlan::for_world(&mut world);
     assert_eq!(
         plan.to_string(),
-        "begin_step → apply_gravity → apply_springs → integrate_with_forces → \
-         discard_fixed_body_forces"
+        "audit_energy_start → begin_step → apply_gravity → apply_springs → \
+         audit_external_loads → integrate_with_forces → discard_fixed_body_forces → audit_energy"
     );
     let mut schedule = plan.build_schedule();
     for _ in 0..100 {

@@ -12,6 +12,7 @@
 // ECS queries name their filters inline, as bevy itself does.
 #![allow(clippy::type_complexity)]
 
+pub mod audit;
 pub mod components;
 pub mod forces;
 pub mod parallel;
@@ -29,6 +30,7 @@ pub mod validate;
 
 /// Everything a game loop needs, in one import.
 pub mod prelude {
+    pub use crate::audit::EnergyAudit;
     pub use crate::components::{
         Damping, ForceAccumulator, Gravity, GravityScale, Kinematic, MassProps, PhysicsSettings,
         RigidBody, Static, Transform, Velocity,

@@ -2,16 +2,19 @@
 //!
 //! One step runs these sets in order:
 //!
-//! 0. [`PhysicsSet::Prepare`] — only for drift–kick–drift integrators (`splitting`, `yoshida4`,
-//!    `rk4`): half a drift, so forces are sampled at the midpoint of the step.
+//! 0. [`PhysicsSet::Prepare`] — in audited worlds, the energy audit's start (see
+//!    [`crate::audit`]); for drift–kick–drift integrators (`splitting`, `yoshida4`, `rk4`), half
+//!    a drift, so forces are sampled at the midpoint of the step.
 //! 1. [`PhysicsSet::Gravity`] — `m g s` into each accumulator; only if a [`Gravity`] resource
 //!    exists.
 //! 2. [`PhysicsSet::Forces`] — force generators that exist in the world (constant forces,
-//!    torques, springs), and any game system placed in this set.
+//!    torques, springs), and any game system placed in this set (it runs after the half drift,
+//!    on the state the forces are sampled at).
 //! 3. [`PhysicsSet::Integrate`] — the selected integrator. It *consumes* each accumulator (reads
 //!    and zeroes it in the same pass, so there is no separate "clear forces" pass and a force
 //!    added before a step is applied exactly once) and renormalizes each quaternion as part of
-//!    the rotation update (so there is no separate "renormalize" pass either).
+//!    the rotation update (so there is no separate "renormalize" pass either). In audited
+//!    worlds the audit reads the loads just before and closes the energy balance just after.
 
 use std::fmt;
 
@@ -21,6 +24,9 @@ use bevy_ecs::schedule::{ScheduleBuildSettings, ScheduleLabel};
 
 use bevy_ecs::component::ComponentId;
 
+use crate::audit::{
+    EnergyAudit, EnergyLedger, audit_energy, audit_energy_start, audit_external_loads,
+};
 use crate::components::{ForceAccumulator, Gravity, Kinematic, PhysicsSettings, RigidBody, Static};
 use crate::forces::{
     ConstantForce, ConstantTorque, Spring, apply_constant_forces, apply_constant_torques,
@@ -51,6 +57,8 @@ pub enum PhysicsSet {
 /// One system of the physics step.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Stage {
+    /// [`audit_energy_start`].
+    AuditEnergyStart,
     /// [`begin_step`].
     BeginStep,
     /// [`apply_gravity`].
@@ -61,25 +69,32 @@ pub enum Stage {
     ConstantTorques,
     /// [`apply_springs`].
     Springs,
+    /// [`audit_external_loads`].
+    AuditExternalLoads,
     /// [`integrate_with_forces`].
     IntegrateWithForces,
     /// [`integrate_without_forces`].
     IntegrateWithoutForces,
     /// [`discard_fixed_body_forces`].
     DiscardFixedBodyForces,
+    /// [`audit_energy`].
+    AuditEnergy,
 }
 
 impl Stage {
     /// Every stage, in the order a step runs them.
-    pub const ALL: [Stage; 8] = [
+    pub const ALL: [Stage; 11] = [
+        Stage::AuditEnergyStart,
         Stage::BeginStep,
         Stage::Gravity,
         Stage::ConstantForces,
         Stage::ConstantTorques,
         Stage::Springs,
+        Stage::AuditExternalLoads,
         Stage::IntegrateWithForces,
         Stage::IntegrateWithoutForces,
         Stage::DiscardFixedBodyForces,
+        Stage::AuditEnergy,
     ];
 
     /// How many stages there are (a plan holds each at most once).
@@ -88,6 +103,9 @@ impl Stage {
     /// The system's name.
     pub fn name(self) -> &'static str {
         match self {
+            Stage::AuditEnergyStart => "audit_energy_start",
+            Stage::AuditExternalLoads => "audit_external_loads",
+            Stage::AuditEnergy => "audit_energy",
             Stage::BeginStep => "begin_step",
             Stage::Gravity => "apply_gravity",
             Stage::ConstantForces => "apply_constant_forces",
@@ -102,6 +120,8 @@ impl Stage {
 
 /// Which systems a world needs, decided from its resources and entities.
 ///
+/// - the energy audit's three systems only where [`EnergyAudit::applies`] (by default: worlds
+///   with springs), `audit_external_loads` only with dynamic bodies that have accumulators;
 /// - `begin_step` only for a drift–kick–drift integrator and dynamic bodies with accumulators;
 /// - `apply_gravity` only with a [`Gravity`] resource and dynamic bodies with accumulators
 ///   (bodies without one get gravity inside `integrate_without_forces`, at no extra pass);
@@ -173,19 +193,30 @@ impl PhysicsPlan {
             tracing::warn!("{warning}");
         }
         world.init_resource::<HalfDrifted>();
+        world.init_resource::<EnergyLedger>();
         Self::of(world)
     }
 
     /// The plan for `world` as it is now, without side effects.
     pub fn of(world: &World) -> Self {
-        let midpoint = world
+        let integrator = world
             .get_resource::<PhysicsSettings>()
             .copied()
             .unwrap_or_default()
-            .integrator
-            .samples_forces_at_midpoint();
+            .integrator;
+        let midpoint = integrator.samples_forces_at_midpoint();
         let c = Contents::of(world);
+        let dynamic = c.dynamic_with_accumulator || c.dynamic_without_accumulator;
+        let audit = dynamic
+            && world
+                .get_resource::<EnergyAudit>()
+                .copied()
+                .unwrap_or_default()
+                .applies(c.springs);
         let mut stages = ArrayVec::new();
+        if audit {
+            stages.push(Stage::AuditEnergyStart);
+        }
         if midpoint && c.dynamic_with_accumulator {
             stages.push(Stage::BeginStep);
         }
@@ -201,6 +232,9 @@ impl PhysicsPlan {
         if c.springs {
             stages.push(Stage::Springs);
         }
+        if audit && c.dynamic_with_accumulator {
+            stages.push(Stage::AuditExternalLoads);
+        }
         if c.dynamic_with_accumulator {
             stages.push(Stage::IntegrateWithForces);
         }
@@ -209,6 +243,9 @@ impl PhysicsPlan {
         }
         if c.fixed_with_accumulator {
             stages.push(Stage::DiscardFixedBodyForces);
+        }
+        if audit {
+            stages.push(Stage::AuditEnergy);
         }
         Self { stages }
     }
@@ -239,6 +276,7 @@ impl PhysicsPlan {
         });
         schedule.configure_sets(
             (
+                PhysicsSet::Prepare,
                 PhysicsSet::Gravity,
                 PhysicsSet::Forces,
                 PhysicsSet::Integrate,
@@ -248,9 +286,11 @@ impl PhysicsPlan {
         let mut previous: Option<Stage> = None;
         for &stage in &self.stages {
             let set = match stage {
-                Stage::BeginStep => PhysicsSet::Prepare,
+                Stage::AuditEnergyStart | Stage::BeginStep => PhysicsSet::Prepare,
                 Stage::Gravity => PhysicsSet::Gravity,
-                Stage::IntegrateWithForces
+                Stage::AuditExternalLoads
+                | Stage::AuditEnergy
+                | Stage::IntegrateWithForces
                 | Stage::IntegrateWithoutForces
                 | Stage::DiscardFixedBodyForces => PhysicsSet::Integrate,
                 _ => PhysicsSet::Forces,
@@ -268,6 +308,9 @@ struct StageSet(Stage);
 
 fn add_stage(schedule: &mut Schedule, stage: Stage, set: PhysicsSet, after: Option<Stage>) {
     let config = match stage {
+        Stage::AuditEnergyStart => audit_energy_start.into_configs(),
+        Stage::AuditExternalLoads => audit_external_loads.into_configs(),
+        Stage::AuditEnergy => audit_energy.into_configs(),
         Stage::BeginStep => begin_step.into_configs(),
         Stage::Gravity => apply_gravity.into_configs(),
         Stage::ConstantForces => apply_constant_forces.into_configs(),

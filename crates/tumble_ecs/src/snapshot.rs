@@ -257,10 +257,18 @@ impl Snapshot {
         }
         // Accumulators were inserted by the generators' hooks where missing; put back the saved
         // values (a snapshot between steps holds zeros or what game code added).
+        // Written in place, not inserted: an insert re-runs the body check, and valid data
+        // lifts a quarantine, which must survive the round trip.
         world.flush();
         for b in &self.bodies {
             if let Some(acc) = b.accumulator {
-                world.entity_mut(map[&b.entity]).insert(acc);
+                let id = map[&b.entity];
+                match world.get_mut::<ForceAccumulator>(id) {
+                    Some(mut slot) => *slot = acc,
+                    None => {
+                        world.entity_mut(id).insert(acc);
+                    }
+                }
             }
         }
         if !self.errors.is_empty() {

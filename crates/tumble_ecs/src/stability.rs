@@ -14,12 +14,25 @@
 //!   `Ω²Δt/2` per second. Round-off (1e-7) reaches order one after `t* = 2 ln(10⁷)/(Ω²Δt)`
 //!   (≈ 32/(Ω²Δt)): I = (1, 2, 3) at 20 rad/s and 60 Hz gives 4.8 s (measured: 3.5 s). A warning
 //!   is raised when `t*` is shorter than [`EXPLICIT_GYROSCOPIC_HORIZON`].
+//!
+//! And one limit of the precision, not of the method:
+//!
+//! - **Positions far from the origin.** A stored coordinate `r` is rounded to the spacing of
+//!   the precision there, at most `r ε` (`ε` = 1.2e-7 in `f32`). A body whose origin moves
+//!   `s Δt` per step (`s = |v| + |ω| |R c| + |g s_g| Δt`: translation, the origin's swing about an
+//!   off-centre centre of mass, one step of gravity) loses up to `½ r ε` of it every step, a
+//!   relative error `r ε / (2 s Δt)` that does not shrink with time and *grows* as `Δt`
+//!   shrinks. A warning is raised when it exceeds [`POSITION_RESOLUTION_LIMIT`] (in `f32`:
+//!   1 m/s at 60 Hz from about 280 m out); the cure is the `f64` feature.
 
 use bevy_ecs::prelude::*;
 use tumble_core::Integrator;
-use tumble_core::math::{Real, Vec3};
+use tumble_core::math::{DOUBLE_PRECISION, REAL_NAME, Real, Vec3};
 
-use crate::components::{MassProps, PhysicsSettings, RigidBody, Velocity};
+use crate::components::{
+    Gravity, GravityScale, Kinematic, MassProps, PhysicsSettings, RigidBody, Static, Transform,
+    Velocity,
+};
 use crate::forces::{Spring, SpringEnd};
 
 /// `ω Δt` above which the symplectic position update of a spring diverges.
@@ -29,7 +42,12 @@ pub const SPRING_LIMIT: Real = 2.0;
 /// seconds are reported (s).
 pub const EXPLICIT_GYROSCOPIC_HORIZON: Real = 600.0;
 
-/// A setting outside the selected integrator's stable region.
+/// Largest relative error `r ε / (2 s Δt)` of one step's motion, from position rounding, that
+/// passes without a warning.
+pub const POSITION_RESOLUTION_LIMIT: Real = 1e-3;
+
+/// A setting outside the selected integrator's stable region, or beyond what the precision can
+/// resolve.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum StabilityWarning {
     /// A spring too stiff for the time step.
@@ -48,6 +66,26 @@ pub enum StabilityWarning {
         /// Predicted time for round-off to grow to order one (s).
         seconds: Real,
     },
+    /// A body so far from the origin that rounding of its stored position eats a visible part
+    /// of each step's motion (not an instability: the motion stays bounded, but wrong).
+    CoarsePosition {
+        /// The body.
+        body: Entity,
+        /// Its distance from the origin (m).
+        distance: Real,
+        /// Its motion in one step, `s Δt` (m).
+        step_motion: Real,
+        /// `r ε / (2 s Δt)`, compared with [`POSITION_RESOLUTION_LIMIT`].
+        relative_error: Real,
+    },
+}
+
+impl StabilityWarning {
+    /// True for settings that make the integration diverge (stiff springs, explicit gyroscopic
+    /// blow-ups); false for a precision limit.
+    pub fn is_instability(&self) -> bool {
+        !matches!(self, StabilityWarning::CoarsePosition { .. })
+    }
 }
 
 impl std::fmt::Display for StabilityWarning {
@@ -66,6 +104,24 @@ impl std::fmt::Display for StabilityWarning {
                 f,
                 "rigid body {body}: integrator `{integrator}` amplifies its spin's round-off to \
                  order one in about {seconds:.1} s (explicit gyroscopic term); use `splitting`"
+            ),
+            StabilityWarning::CoarsePosition {
+                body,
+                distance,
+                step_motion,
+                relative_error,
+            } => write!(
+                f,
+                "rigid body {body}: {distance:.3e} m from the origin, {REAL_NAME} positions are \
+                 spaced up to {:.1e} m there, and it moves {step_motion:.1e} m per step: up to \
+                 {:.2} % of every step is lost to rounding{}",
+                distance * Real::EPSILON,
+                100.0 * relative_error,
+                if DOUBLE_PRECISION {
+                    "; move the origin closer"
+                } else {
+                    "; build with the `f64` feature (or move the origin closer)"
+                }
             ),
         }
     }
@@ -116,6 +172,31 @@ pub fn check_stability(world: &mut World) -> Vec<StabilityWarning> {
                 spring: entity,
                 omega_dt,
             });
+        }
+    }
+    let gravity = world.get_resource::<Gravity>().map_or(Vec3::ZERO, |g| g.0);
+    let mut moving = world.query_filtered::<(
+        Entity,
+        &Transform,
+        &Velocity,
+        &MassProps,
+        Option<&GravityScale>,
+    ), (With<RigidBody>, Without<Static>, Without<Kinematic>)>();
+    for (body, t, v, m, scale) in moving.iter(world) {
+        let distance = t.translation.length();
+        let swing = v.angular.length() * (t.rotation * m.local_center_of_mass()).length();
+        let fall = (gravity * scale.map_or(1.0, |s| s.0)).length() * dt;
+        let step_motion = (v.linear.length() + swing + fall) * dt;
+        if step_motion > 0.0 {
+            let relative_error = distance * Real::EPSILON / (2.0 * step_motion);
+            if relative_error > POSITION_RESOLUTION_LIMIT {
+                warnings.push(StabilityWarning::CoarsePosition {
+                    body,
+                    distance,
+                    step_motion,
+                    relative_error,
+                });
+            }
         }
     }
     if matches!(

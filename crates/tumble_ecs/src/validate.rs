@@ -35,6 +35,25 @@ pub enum BodyErrorKind {
     /// The integrator produced a non-finite state; the body keeps its last finite state.
     #[error(transparent)]
     Diverged(#[from] StepError),
+    /// The integrator created energy: the body's spring group (see [`crate::audit`]) gained more
+    /// than the work of its external loads allows. The body was put back to its state at the
+    /// start of the step.
+    #[error(
+        "energy grew: the integrator created {created:.3e} J in a group of {group} bodies that \
+         should hold {should:.3e} J (allowed {bound:.3e} J); the step is outside the method's \
+         stable region"
+    )]
+    EnergyGrew {
+        /// Energy the group should hold (J): at the start of the step, less what the integrator
+        /// created before.
+        should: f64,
+        /// Energy the integrator created in the group so far, this step included (J).
+        created: f64,
+        /// The largest creation the audit allows (J).
+        bound: f64,
+        /// Bodies in the group.
+        group: usize,
+    },
     /// The body was already quarantined in a restored snapshot, for this reason.
     #[error("quarantined before the snapshot: {0}")]
     Restored(String),

@@ -30,18 +30,21 @@ fn every_bundled_scene_has_exactly_the_systems_it_needs() {
         ("principal_spins", free),
         ("projectile", free),
         ("thin_rod", free),
-        // A force at a point on the top; springs between bodies.
+        // A force at a point on the top; springs between bodies (with the energy audit that
+        // every spring network gets).
         (
             "spinning_top",
             "begin_step → apply_constant_forces → integrate_with_forces",
         ),
         (
             "spring_chain",
-            "begin_step → apply_springs → integrate_with_forces",
+            "audit_energy_start → begin_step → apply_springs → audit_external_loads → \
+             integrate_with_forces → audit_energy",
         ),
         (
             "mass_ratio",
-            "begin_step → apply_springs → integrate_with_forces",
+            "audit_energy_start → begin_step → apply_springs → audit_external_loads → \
+             integrate_with_forces → audit_energy",
         ),
     ];
     for (scene, systems) in expected {

@@ -1,0 +1,524 @@
+//! The energy audit: a step that creates energy out of nothing is a divergence, even while every
+//! number is still finite.
+//!
+//! An integrator outside its stable region (a spring with `√(k/μ)Δt ≥ 2`, an explicit
+//! gyroscopic term on a fast asymmetric spin) grows the energy geometrically; the state stays
+//! finite for many steps, long enough to write positions of 10²⁰ m as if they were state. The
+//! audit catches that at the step where it happens, quarantines the bodies involved and puts
+//! them back to the state they had before that step.
+//!
+//! ## The balance
+//!
+//! Bodies joined by springs share their energy, so the audit works on *groups*: the connected
+//! components of the spring graph (a lone body is its own group). For a group, with `T` the
+//! kinetic energy `Σ ½m|v|² + ½ωᵀIω` and `V` the elastic energy `Σ ½k(|d| − L₀)²` of its
+//! springs, each step must satisfy
+//!
+//! ```text
+//! (T + V)_end − (T + V)_start = W_ext + e_step
+//! W_ext = Δt Σ_bodies ( F·(v_start + v_end)/2 + τ·(ω_start + ω_end)/2 )
+//! ```
+//!
+//! where `F`, `τ` are every load on the body except the springs (gravity, constant forces and
+//! torques, forces game code or its own systems added) and `e_step` is the integrator's energy
+//! error. The `(v_start + v_end)/2` form is the drift–kick–drift displacement exactly, so a
+//! constant force credits exactly the work the step did. Spring damping and [`Damping`] only
+//! remove energy and are not credited. The audit keeps the running sum `D = Σ e_step` per group
+//! (the energy the integrator made up; changes game code makes between steps are not part of
+//! it) and rejects the group when
+//!
+//! ```text
+//! D > (A − 1) · E + ε,      E = (T + V)_start − D    (the energy the group should have)
+//! ```
+//!
+//! `A` is twice the largest ratio of energies on one orbit of a *stable* linear spring under the
+//! method's position update, with `x = min(ω_max Δt, 1.99)/2`:
+//!
+//! - drift–kick–drift (Störmer–Verlet, the midpoint methods): the step conserves
+//!   `½(1 − x²)|v|² + ½ω²|d|²` exactly, so the energy swings within `[1, 1/(1 − x²)]` times it;
+//!   `A = 2/(1 − x²)`;
+//! - kick–drift (symplectic Euler and the other start-of-step methods): it conserves
+//!   `½(|v|² + ω²|d|² − ωΔt ω d·v)`, a swing of `(1 + x)/(1 − x)`; `A = 2(1 + x)/(1 − x)`.
+//!
+//! A stable spring's energy swings up to that factor and comes back, and must never be flagged.
+//! `ω_max` is the stiffest spring of the group (`√(k/μ)`, `μ` the reduced mass of its ends); the
+//! factor 2 covers the extra compliance of off-centre anchors and the O(Δt²) error of the
+//! rotation. A group without springs has `A = 2`: a free body may not double its energy on its
+//! own. `ε` is round-off: `64 ε_Real` times the energy and work magnitudes of the step.
+//!
+//! Unstable integration grows `D` geometrically, so it crosses the bound within a few periods;
+//! the group is then rejected *before* its state is garbage, and keeps the last state that
+//! passed.
+//!
+//! ## What is audited, and what it costs
+//!
+//! [`EnergyAudit::Auto`] (the default) audits a world with springs: whether a spring network is
+//! inside the stable region depends on the state (off-centre anchors change the effective mass
+//! as the bodies turn), so only a check of what happened is safe. Other worlds pay nothing: the
+//! audit's systems are not in their plan. The other divergence the planner knows, an explicit
+//! gyroscopic term on a fast asymmetric spin (`symplectic-euler`, `symplectic-euler-linear`), is
+//! predicted from the spins at planning time ([`check_stability`](crate::stability)); insert
+//! [`EnergyAudit::Always`] to have such a run audited as well (the `tumble` CLI does when it runs
+//! a world despite a warning). [`EnergyAudit::Never`] turns the audit off. The audit costs one pass over the bodies and the springs at
+//! the start of the step, one before the integration (to separate spring forces from the other
+//! loads) and one at the end; it allocates only when the world grows.
+//!
+//! Not audited: a group holding a [`Kinematic`] body (game code moves it and does work the
+//! audit cannot see). [`Static`] bodies are fixed anchors.
+
+use bevy_ecs::entity::EntityHashMap;
+use bevy_ecs::prelude::*;
+use std::collections::HashMap;
+use tumble_core::math::{Real, Vec3, Widen};
+
+use crate::components::{
+    ForceAccumulator, Gravity, GravityScale, Kinematic, MassProps, PhysicsSettings, RigidBody,
+    Static, Transform, Velocity,
+};
+use crate::forces::{Spring, SpringEnd, spring_force};
+use crate::systems::Dynamic;
+use crate::validate::{BodyError, BodyErrorKind, Rejected, reject};
+
+/// Whether a world's steps are audited for energy created by the integrator (see the module
+/// docs). Insert it as a resource to override the default, [`EnergyAudit::Auto`].
+#[derive(Resource, Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub enum EnergyAudit {
+    /// Audit worlds with springs.
+    #[default]
+    Auto,
+    /// Audit every world with dynamic bodies.
+    Always,
+    /// Never audit.
+    Never,
+}
+
+impl EnergyAudit {
+    /// Whether a world with (or without) springs is audited.
+    pub fn applies(self, has_springs: bool) -> bool {
+        match self {
+            EnergyAudit::Always => true,
+            EnergyAudit::Never => false,
+            EnergyAudit::Auto => has_springs,
+        }
+    }
+}
+
+/// The audit's largest `ωΔt` in the stable-spring factor: at 2 the factor is infinite, and
+/// beyond it the spring is unstable and grows geometrically past any finite bound anyway.
+const OMEGA_DT_CAP: f64 = 1.99;
+
+/// Round-off allowance, in units of the precision's epsilon, on the step's energy magnitudes.
+const ROUND_OFF_ULPS: f64 = 64.0;
+
+/// What the audit remembers of one body during a step.
+#[derive(Debug, Clone, Copy)]
+struct Audited {
+    entity: Entity,
+    start: (Transform, Velocity),
+    /// Every load except the springs: force and torque (world frame).
+    load: (Vec3, Vec3),
+    /// Union–find parent.
+    parent: usize,
+}
+
+/// One group's running account, keyed by its smallest entity.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Account {
+    /// Members and springs when the account was opened: a group that changes starts afresh.
+    signature: (usize, usize),
+    /// `D`: energy the integrator created so far (J).
+    created: f64,
+    /// Seen in the current step (stale accounts are dropped).
+    seen: bool,
+}
+
+/// Per-group sums of one step.
+#[derive(Debug, Clone, Copy, Default)]
+struct GroupStep {
+    members: usize,
+    springs: usize,
+    key: Option<Entity>,
+    kinematic: bool,
+    /// `(T + V)` at the start.
+    start: f64,
+    /// `(T + V)` at the end.
+    end: f64,
+    /// `W_ext`.
+    work: f64,
+    /// Magnitudes for the round-off allowance.
+    magnitude: f64,
+    /// Stiffest spring's `ωΔt`.
+    omega_dt: f64,
+}
+
+/// The audit's bookkeeping (reused every step so that steps do not allocate).
+#[derive(Resource, Debug, Default)]
+pub struct EnergyLedger {
+    bodies: Vec<Audited>,
+    index: EntityHashMap<usize>,
+    groups: Vec<GroupStep>,
+    accounts: HashMap<Entity, Account>,
+    dt: f64,
+    /// Whether the integrator drifts–kicks–drifts (else it kicks, then drifts).
+    midpoint: bool,
+}
+
+impl EnergyLedger {
+    fn find(&mut self, mut i: usize) -> usize {
+        while self.bodies[i].parent != i {
+            let grand = self.bodies[self.bodies[i].parent].parent;
+            self.bodies[i].parent = grand;
+            i = grand;
+        }
+        i
+    }
+
+    fn union(&mut self, a: usize, b: usize) {
+        let (ra, rb) = (self.find(a), self.find(b));
+        if ra != rb {
+            // Attach to the smaller index so that the root does not depend on spring order.
+            let (lo, hi) = if ra < rb { (ra, rb) } else { (rb, ra) };
+            self.bodies[hi].parent = lo;
+        }
+    }
+
+    /// The energy the integrator created so far in the group whose smallest entity is `key`.
+    pub fn created_energy(&self, key: Entity) -> Option<f64> {
+        self.accounts.get(&key).map(|a| a.created)
+    }
+}
+
+/// Kinetic energy `½m|v|² + ½ωᵀIω` in f64.
+fn kinetic(velocity: &Velocity, transform: &Transform, mass: &MassProps) -> f64 {
+    let v = velocity.linear.widen();
+    let w = velocity.angular;
+    let iw = mass.world_inertia_mul(transform.rotation, w).widen();
+    0.5 * mass.mass().widen() * v.length_squared() + 0.5 * w.widen().dot(iw)
+}
+
+/// One end of a spring as the audit sees it.
+#[derive(Clone, Copy)]
+enum End {
+    Audited(usize),
+    /// A fixed point (world anchor or static body), in world coordinates.
+    Fixed(Vec3),
+    Kinematic,
+    /// Missing or rejected: the spring exerts nothing this step.
+    Inactive,
+}
+
+type BodyView<'a> = (
+    &'a Transform,
+    &'a Velocity,
+    &'a MassProps,
+    Has<Static>,
+    Has<Kinematic>,
+);
+
+fn end_of(
+    ledger: &EnergyLedger,
+    all: &Query<BodyView, (With<RigidBody>, Without<Rejected>)>,
+    body: Entity,
+    anchor: Vec3,
+) -> End {
+    if let Some(&i) = ledger.index.get(&body) {
+        return End::Audited(i);
+    }
+    match all.get(body) {
+        Ok((_, _, _, _, true)) => End::Kinematic,
+        Ok((t, _, _, true, _)) => End::Fixed(t.transform_point(anchor)),
+        _ => End::Inactive,
+    }
+}
+
+fn spring_ends(
+    ledger: &EnergyLedger,
+    all: &Query<BodyView, (With<RigidBody>, Without<Rejected>)>,
+    spring: &Spring,
+) -> (End, End) {
+    let a = end_of(ledger, all, spring.a, spring.anchor_a);
+    let b = match spring.b {
+        SpringEnd::World(p) => End::Fixed(p),
+        SpringEnd::Body { body, anchor } => end_of(ledger, all, body, anchor),
+    };
+    (a, b)
+}
+
+/// World anchor point of audited body `i`.
+fn anchor_of(
+    ledger: &EnergyLedger,
+    all: &Query<BodyView, (With<RigidBody>, Without<Rejected>)>,
+    end: End,
+    local: Vec3,
+) -> Option<Vec3> {
+    match end {
+        End::Audited(i) => all
+            .get(ledger.bodies[i].entity)
+            .ok()
+            .map(|(t, ..)| t.transform_point(local)),
+        End::Fixed(p) => Some(p),
+        End::Kinematic | End::Inactive => None,
+    }
+}
+
+/// Elastic energy `½k(|d| − L₀)²` of a spring whose anchors are at `pa`, `pb`.
+fn elastic(spring: &Spring, pa: Vec3, pb: Vec3) -> f64 {
+    let stretch = (pa - pb).widen().length() - spring.rest_length.widen();
+    0.5 * spring.stiffness.widen() * stretch * stretch
+}
+
+fn local_b(spring: &Spring) -> Vec3 {
+    match spring.b {
+        SpringEnd::World(_) => Vec3::ZERO,
+        SpringEnd::Body { anchor, .. } => anchor,
+    }
+}
+
+/// Start of an audited step (first in the plan): remembers each dynamic body's state, forms
+/// the spring groups and measures each group's `T + V`.
+pub fn audit_energy_start(
+    settings: Res<PhysicsSettings>,
+    mut ledger: ResMut<EnergyLedger>,
+    bodies: Query<(Entity, &Transform, &Velocity, &MassProps), Dynamic>,
+    all: Query<BodyView, (With<RigidBody>, Without<Rejected>)>,
+    springs: Query<&Spring>,
+) {
+    let ledger = &mut *ledger;
+    ledger.dt = settings.dt().widen();
+    ledger.midpoint = settings.integrator.samples_forces_at_midpoint();
+    ledger.bodies.clear();
+    ledger.index.clear();
+    for (entity, t, v, _) in &bodies {
+        let i = ledger.bodies.len();
+        ledger.index.insert(entity, i);
+        ledger.bodies.push(Audited {
+            entity,
+            start: (*t, *v),
+            load: (Vec3::ZERO, Vec3::ZERO),
+            parent: i,
+        });
+    }
+    for spring in &springs {
+        if let (End::Audited(a), End::Audited(b)) = spring_ends(ledger, &all, spring) {
+            ledger.union(a, b);
+        }
+    }
+    ledger.groups.clear();
+    ledger
+        .groups
+        .resize(ledger.bodies.len(), GroupStep::default());
+    for i in 0..ledger.bodies.len() {
+        let root = ledger.find(i);
+        let entity = ledger.bodies[i].entity;
+        let (t, v, m, ..) = all.get(entity).expect("audited bodies are rigid bodies");
+        let energy = kinetic(v, t, m);
+        let g = &mut ledger.groups[root];
+        g.members += 1;
+        g.key = Some(g.key.map_or(entity, |k| k.min(entity)));
+        g.start += energy;
+        g.magnitude += energy;
+    }
+    for spring in &springs {
+        let (a, b) = spring_ends(ledger, &all, spring);
+        let root = match (a, b) {
+            (End::Audited(i), _) | (_, End::Audited(i)) => ledger.find(i),
+            _ => continue,
+        };
+        let kinematic = matches!(a, End::Kinematic) || matches!(b, End::Kinematic);
+        let ends = (
+            anchor_of(ledger, &all, a, spring.anchor_a),
+            anchor_of(ledger, &all, b, local_b(spring)),
+        );
+        let mass = |end: End| match end {
+            End::Audited(i) => all
+                .get(ledger.bodies[i].entity)
+                .map_or(f64::INFINITY, |(_, _, m, ..)| m.mass().widen()),
+            _ => f64::INFINITY,
+        };
+        let (ma, mb) = (mass(a), mass(b));
+        let reduced = if mb.is_infinite() {
+            ma
+        } else if ma.is_infinite() {
+            mb
+        } else {
+            ma * mb / (ma + mb)
+        };
+        let omega_dt = (spring.stiffness.widen() / reduced).sqrt() * ledger.dt;
+        let g = &mut ledger.groups[root];
+        g.springs += 1;
+        g.kinematic |= kinematic;
+        g.omega_dt = g.omega_dt.max(omega_dt);
+        if let (Some(pa), Some(pb)) = ends {
+            let v = elastic(spring, pa, pb);
+            g.start += v;
+            g.magnitude += v;
+        }
+    }
+}
+
+/// Before the integration (after every force system): records each audited body's load
+/// without the springs, `F = ΣF − F_springs`, `τ = Στ − τ_springs`, with the spring forces
+/// evaluated exactly as [`apply_springs`](crate::forces::apply_springs) did on the same state.
+pub fn audit_external_loads(
+    mut ledger: ResMut<EnergyLedger>,
+    accumulators: Query<&ForceAccumulator, Dynamic>,
+    all: Query<BodyView, (With<RigidBody>, Without<Rejected>)>,
+    springs: Query<&Spring>,
+) {
+    let ledger = &mut *ledger;
+    for body in &mut ledger.bodies {
+        if let Ok(acc) = accumulators.get(body.entity) {
+            body.load = (acc.force, acc.torque);
+        }
+    }
+    let state = |end: End, ledger: &EnergyLedger, local: Vec3| match end {
+        End::Audited(i) => all.get(ledger.bodies[i].entity).ok().map(|(t, v, m, ..)| {
+            let com = t.center_of_mass(m);
+            let p = t.transform_point(local);
+            (p, v.linear + v.angular.cross(p - com), com)
+        }),
+        End::Fixed(p) => Some((p, Vec3::ZERO, p)),
+        End::Kinematic | End::Inactive => None,
+    };
+    for spring in &springs {
+        let (a, b) = spring_ends(ledger, &all, spring);
+        let (Some((pa, ua, ca)), Some((pb, ub, cb))) = (
+            state(a, ledger, spring.anchor_a),
+            state(b, ledger, local_b(spring)),
+        ) else {
+            continue;
+        };
+        // A world anchor has no velocity; a static body's anchor neither.
+        let f = spring_force(spring, pa - pb, ua - ub);
+        if let End::Audited(i) = a {
+            let load = &mut ledger.bodies[i].load;
+            load.0 -= f;
+            load.1 -= (pa - ca).cross(f);
+        }
+        if let End::Audited(i) = b {
+            let load = &mut ledger.bodies[i].load;
+            load.0 += f;
+            load.1 += (pb - cb).cross(f);
+        }
+    }
+}
+
+/// End of an audited step (last in the plan): closes each group's balance and quarantines the
+/// groups whose integrator created more energy than the bound allows, putting them back to
+/// their state at the start of the step.
+#[allow(clippy::too_many_arguments)]
+pub fn audit_energy(
+    mut ledger: ResMut<EnergyLedger>,
+    gravity: Option<Res<Gravity>>,
+    field_bodies: Query<Option<&GravityScale>, (Dynamic, Without<ForceAccumulator>)>,
+    all: Query<BodyView, (With<RigidBody>, Without<Rejected>)>,
+    springs: Query<&Spring>,
+    mut commands: Commands,
+) {
+    let ledger = &mut *ledger;
+    let dt = ledger.dt;
+    let gravity = gravity.map(|g| g.0);
+    for i in 0..ledger.bodies.len() {
+        let root = ledger.find(i);
+        let body = ledger.bodies[i];
+        let Ok((t, v, m, ..)) = all.get(body.entity) else {
+            continue;
+        };
+        let (force, torque) = match (field_bodies.get(body.entity), gravity) {
+            // Bodies without an accumulator take gravity inside the integration.
+            (Ok(scale), Some(g)) => (m.mass() * scale.map_or(1.0, |s| s.0) * g, Vec3::ZERO),
+            _ => body.load,
+        };
+        let v0 = body.start.1;
+        let v_mean = 0.5 * (v0.linear.widen() + v.linear.widen());
+        let w_mean = 0.5 * (v0.angular.widen() + v.angular.widen());
+        let work = dt * (force.widen().dot(v_mean) + torque.widen().dot(w_mean));
+        let energy = kinetic(v, t, m);
+        let g = &mut ledger.groups[root];
+        g.end += energy;
+        g.work += work;
+        g.magnitude += energy + work.abs();
+    }
+    for spring in &springs {
+        let (a, b) = spring_ends(ledger, &all, spring);
+        let root = match (a, b) {
+            (End::Audited(i), _) | (_, End::Audited(i)) => ledger.find(i),
+            _ => continue,
+        };
+        if let (Some(pa), Some(pb)) = (
+            anchor_of(ledger, &all, a, spring.anchor_a),
+            anchor_of(ledger, &all, b, local_b(spring)),
+        ) {
+            let v = elastic(spring, pa, pb);
+            ledger.groups[root].end += v;
+            ledger.groups[root].magnitude += v;
+        }
+    }
+    for account in ledger.accounts.values_mut() {
+        account.seen = false;
+    }
+    let eps = ROUND_OFF_ULPS * Real::EPSILON.widen();
+    for root in 0..ledger.groups.len() {
+        let g = ledger.groups[root];
+        let Some(key) = g.key else { continue };
+        if g.kinematic {
+            continue;
+        }
+        let signature = (g.members, g.springs);
+        let account = ledger.accounts.entry(key).or_insert(Account {
+            signature,
+            created: 0.0,
+            seen: true,
+        });
+        if account.signature != signature {
+            *account = Account {
+                signature,
+                created: 0.0,
+                seen: true,
+            };
+        }
+        account.seen = true;
+        let before = account.created;
+        let should = (g.start - before).max(0.0);
+        account.created += g.end - g.start - g.work;
+        let x = OMEGA_DT_CAP.min(g.omega_dt) / 2.0;
+        let factor = if ledger.midpoint {
+            2.0 / (1.0 - x * x)
+        } else {
+            2.0 * (1.0 + x) / (1.0 - x)
+        };
+        let bound = (factor - 1.0) * should + eps * g.magnitude + f64::MIN_POSITIVE;
+        let created = account.created;
+        if !(g.end.is_finite() && g.work.is_finite() && created.is_finite()) {
+            // A member with non-finite data was rejected by the integrate systems' own checks
+            // this step; the group's balance is meaningless until then, so start it afresh.
+            account.created = 0.0;
+            continue;
+        }
+        if created <= bound {
+            continue;
+        }
+        account.created = before;
+        for i in 0..ledger.bodies.len() {
+            if ledger.find(i) != root {
+                continue;
+            }
+            let body = ledger.bodies[i];
+            commands.entity(body.entity).insert(body.start);
+            reject(
+                &mut commands,
+                BodyError {
+                    entity: body.entity,
+                    kind: BodyErrorKind::EnergyGrew {
+                        should,
+                        created,
+                        bound,
+                        group: g.members,
+                    },
+                },
+            );
+        }
+    }
+    ledger.accounts.retain(|_, a| a.seen);
+}

@@ -1,0 +1,275 @@
+//! The energy audit: divergence is caught while the state is still finite, the quarantined
+//! bodies keep the last state that passed, and honest physics (stable springs near the limit,
+//! work done by gravity, forces, torques and game code) is never flagged.
+
+use bevy_ecs::prelude::*;
+use tumble_core::math::{Quat, Real, Vec3};
+use tumble_core::{Integrator, Mass, MassProperties};
+use tumble_ecs::prelude::*;
+
+const DT: Real = 1.0 / 60.0;
+
+fn world(integrator: Integrator) -> World {
+    let mut world = World::new();
+    world.insert_resource(PhysicsSettings::new(DT, integrator).unwrap());
+    world.insert_resource(Parallelism::SINGLE_THREAD);
+    world
+}
+
+fn body(world: &mut World, x: Real, inertia: Vec3, omega: Vec3) -> Entity {
+    let mass = MassProperties::new(Mass::new(1.0).unwrap(), inertia).unwrap();
+    world
+        .spawn((
+            RigidBody,
+            MassProps(mass),
+            Transform {
+                translation: Vec3::new(x, 0.0, 0.0),
+                rotation: Quat::from_rotation_z(0.3 * x),
+            },
+            Velocity {
+                linear: Vec3::ZERO,
+                angular: omega,
+            },
+        ))
+        .id()
+}
+
+/// A chain of `n` asymmetric bodies joined by springs at off-centre anchors, the first one tied
+/// to the world; stiffness chosen so that the nominal `√(k/μ)Δt` of a body-body spring is
+/// `omega_dt`. Returns the bodies.
+fn chain(world: &mut World, n: usize, x0: Real, omega_dt: Real) -> Vec<Entity> {
+    // μ = ½ for two unit masses.
+    let k = 0.5 * (omega_dt / DT).powi(2);
+    let inertia = Vec3::new(0.02, 0.03, 0.04);
+    let bodies: Vec<Entity> = (0..n)
+        .map(|i| body(world, x0 + i as Real, inertia, Vec3::new(0.1, 0.2, 0.3)))
+        .collect();
+    world.spawn(Spring {
+        a: bodies[0],
+        anchor_a: Vec3::new(-0.1, 0.05, 0.0),
+        b: SpringEnd::World(Vec3::new(x0 - 1.0, 0.1, 0.0)),
+        stiffness: k,
+        damping: 0.0,
+        rest_length: 0.8,
+    });
+    for pair in bodies.windows(2) {
+        world.spawn(Spring {
+            a: pair[0],
+            anchor_a: Vec3::new(0.1, 0.05, 0.0),
+            b: SpringEnd::Body {
+                body: pair[1],
+                anchor: Vec3::new(-0.1, 0.0, 0.05),
+            },
+            stiffness: k,
+            damping: 0.0,
+            rest_length: 0.7,
+        });
+    }
+    bodies
+}
+
+fn run(world: &mut World, steps: usize) -> Schedule {
+    let mut schedule = PhysicsPlan::for_world(world).build_schedule();
+    for _ in 0..steps {
+        schedule.run(world);
+        world.clear_trackers();
+    }
+    schedule
+}
+
+fn errors(world: &World) -> Vec<BodyError> {
+    world
+        .get_resource::<PhysicsErrors>()
+        .map(|e| e.0.clone())
+        .unwrap_or_default()
+}
+
+#[test]
+fn an_unstable_spring_chain_is_quarantined_before_its_state_is_garbage() {
+    let mut w = world(Integrator::Splitting);
+    let bodies = chain(&mut w, 4, 0.0, 2.5);
+    run(&mut w, 600);
+    let errors = errors(&w);
+    assert!(!errors.is_empty(), "a spring at ωΔt = 2.5 diverges");
+    assert!(
+        errors
+            .iter()
+            .all(|e| matches!(e.kind, BodyErrorKind::EnergyGrew { .. })),
+        "{errors:?}"
+    );
+    for &b in &bodies {
+        assert!(
+            w.get::<Rejected>(b).is_some(),
+            "the whole group is quarantined"
+        );
+        // The chain starts within a few metres of the origin: the kept state is sane, not
+        // the 1e19 m an unchecked run reaches.
+        let t = w.get::<Transform>(b).unwrap();
+        assert!(t.translation.length() < 1e3, "{:?}", t.translation);
+        assert!(w.get::<Velocity>(b).unwrap().linear.length() < 1e4);
+    }
+}
+
+#[test]
+fn stable_springs_near_the_limit_and_soft_chains_are_never_flagged() {
+    for omega_dt in [0.5, 1.0, 1.9] {
+        let mut w = world(Integrator::Splitting);
+        // One world-anchored body: its spring's ωΔt is exactly the nominal one (μ = m).
+        let b = body(&mut w, 0.0, Vec3::ONE, Vec3::ZERO);
+        w.spawn(Spring {
+            a: b,
+            anchor_a: Vec3::ZERO,
+            b: SpringEnd::World(Vec3::new(-1.0, 0.0, 0.0)),
+            stiffness: (omega_dt / DT).powi(2),
+            damping: 0.0,
+            rest_length: 0.5,
+        });
+        run(&mut w, 10_000);
+        assert!(errors(&w).is_empty(), "ωΔt = {omega_dt}: {:?}", errors(&w));
+    }
+    let mut w = world(Integrator::Splitting);
+    chain(&mut w, 10, 0.0, 0.5);
+    run(&mut w, 10_000);
+    assert!(errors(&w).is_empty(), "{:?}", errors(&w));
+}
+
+#[derive(Component)]
+struct Thruster;
+
+/// Game code's own force system, inside `PhysicsSet::Forces`: positive work every step.
+fn thrust(mut bodies: Query<&mut ForceAccumulator, With<Thruster>>) {
+    for mut acc in &mut bodies {
+        acc.add_force(Vec3::new(3.0, 0.0, 0.0));
+        acc.add_torque(Vec3::new(0.0, 0.0, 0.2));
+    }
+}
+
+#[test]
+fn work_of_gravity_forces_torques_and_game_code_is_credited() {
+    for integrator in [
+        Integrator::Splitting,
+        Integrator::SymplecticEuler,
+        Integrator::Yoshida4,
+    ] {
+        let mut w = world(integrator);
+        w.insert_resource(Gravity(Vec3::new(0.0, -9.81, 0.0)));
+        w.insert_resource(EnergyAudit::Always);
+        let a = body(
+            &mut w,
+            0.0,
+            Vec3::new(1.0, 2.0, 3.0),
+            Vec3::new(0.0, 0.0, 2.0),
+        );
+        let b = body(&mut w, 1.0, Vec3::new(1.0, 2.0, 3.0), Vec3::ZERO);
+        let free = body(&mut w, 5.0, Vec3::ONE, Vec3::ZERO);
+        w.entity_mut(a).insert(Thruster);
+        w.spawn(Spring {
+            a,
+            anchor_a: Vec3::new(0.2, 0.0, 0.0),
+            b: SpringEnd::Body {
+                body: b,
+                anchor: Vec3::ZERO,
+            },
+            stiffness: 50.0,
+            damping: 0.5,
+            rest_length: 1.0,
+        });
+        w.spawn(ConstantForce {
+            body: b,
+            force: Vec3::new(0.0, 12.0, 1.0),
+            local_point: Some(Vec3::new(0.0, 0.1, 0.2)),
+        });
+        w.spawn(ConstantTorque {
+            body: b,
+            torque: Vec3::new(0.1, 0.0, 0.0),
+        });
+        let mut schedule = PhysicsPlan::for_world(&mut w).build_schedule();
+        schedule.add_systems(thrust.in_set(PhysicsSet::Forces));
+        for step in 0..3000 {
+            // Game code kicks a body between steps, and adds a force before one.
+            if step % 500 == 0 {
+                w.get_mut::<Velocity>(free).unwrap().linear += Vec3::new(0.0, 30.0, 0.0);
+                w.entity_mut(free).insert(ForceAccumulator {
+                    force: Vec3::new(100.0, 0.0, 0.0),
+                    torque: Vec3::new(0.0, 5.0, 0.0),
+                });
+            }
+            schedule.run(&mut w);
+            w.clear_trackers();
+        }
+        assert!(errors(&w).is_empty(), "{integrator}: {:?}", errors(&w));
+        let v = w.get::<Velocity>(a).unwrap().linear;
+        assert!(v.x > 50.0, "the thruster did work: {v:?}");
+    }
+}
+
+#[test]
+fn an_exploding_explicit_spin_is_caught_before_it_is_non_finite() {
+    let mut w = world(Integrator::SymplecticEuler);
+    w.insert_resource(EnergyAudit::Always);
+    let spinning = body(
+        &mut w,
+        0.0,
+        Vec3::new(1.0, 2.0, 3.0),
+        Vec3::new(0.5, 20.0, 0.5),
+    );
+    run(&mut w, 2000);
+    let errors = errors(&w);
+    assert_eq!(errors.len(), 1, "{errors:?}");
+    assert!(matches!(errors[0].kind, BodyErrorKind::EnergyGrew { .. }));
+    let omega = w.get::<Velocity>(spinning).unwrap().angular;
+    assert!(omega.length() < 100.0, "kept a sane state: {omega:?}");
+}
+
+#[test]
+fn a_diverging_group_harms_no_other_body() {
+    let stepped = |with_stiff: bool| {
+        let mut w = world(Integrator::Splitting);
+        let soft = chain(&mut w, 3, 0.0, 0.4);
+        if with_stiff {
+            chain(&mut w, 3, 50.0, 3.0);
+        }
+        run(&mut w, 800);
+        let rejected = w.query::<&Rejected>().iter(&w).count();
+        let poses: Vec<Transform> = soft
+            .iter()
+            .map(|&e| *w.get::<Transform>(e).unwrap())
+            .collect();
+        (rejected, poses)
+    };
+    let (none, alone) = stepped(false);
+    let (three, beside) = stepped(true);
+    assert_eq!((none, three), (0, 3));
+    assert_eq!(alone, beside, "bit-identical next to a quarantined group");
+}
+
+#[test]
+fn the_audit_is_planned_only_where_energy_can_blow_up() {
+    let plan = |integrator, springs: bool, mode: Option<EnergyAudit>| {
+        let mut w = world(integrator);
+        if let Some(mode) = mode {
+            w.insert_resource(mode);
+        }
+        if springs {
+            chain(&mut w, 2, 0.0, 0.5);
+        } else {
+            body(&mut w, 0.0, Vec3::new(1.0, 2.0, 3.0), Vec3::Y);
+        }
+        PhysicsPlan::for_world(&mut w).contains(Stage::AuditEnergy)
+    };
+    assert!(
+        !plan(Integrator::Splitting, false, None),
+        "free bodies, bounded method"
+    );
+    assert!(plan(Integrator::Splitting, true, None), "springs");
+    assert!(
+        !plan(Integrator::SymplecticEuler, false, None),
+        "predicted, not audited"
+    );
+    assert!(!plan(Integrator::Splitting, true, Some(EnergyAudit::Never)));
+    assert!(plan(
+        Integrator::Splitting,
+        false,
+        Some(EnergyAudit::Always)
+    ));
+}
