@@ -1,0 +1,66 @@
+//! The planner warns when a body is so far from the origin that rounding of its stored position
+//! eats a visible part of each step's motion, and the warning matches what a run measures.
+
+use bevy_ecs::prelude::*;
+use tumble_core::Integrator;
+use tumble_core::math::{DOUBLE_PRECISION, Real, Vec3, Widen};
+use tumble_ecs::prelude::*;
+
+const DT: Real = 1.0 / 60.0;
+const STEPS: usize = 600;
+
+fn moving_body_at(distance: Real) -> (World, Entity) {
+    let mut world = World::new();
+    world.insert_resource(PhysicsSettings::new(DT, Integrator::Splitting).unwrap());
+    let body = world
+        .spawn((
+            RigidBody,
+            Transform::from_translation(Vec3::new(distance, 0.0, 0.0)),
+            Velocity::linear(Vec3::new(1.0, 0.0, 0.0)),
+        ))
+        .id();
+    (world, body)
+}
+
+fn warned(world: &mut World) -> bool {
+    check_stability(world)
+        .iter()
+        .any(|w| matches!(w, StabilityWarning::CoarsePosition { .. }) && !w.is_instability())
+}
+
+/// Relative error of the distance travelled in `STEPS` steps at 1 m/s.
+fn measured_error(world: &mut World, body: Entity, distance: Real) -> f64 {
+    let mut schedule = PhysicsPlan::for_world(world).build_schedule();
+    for _ in 0..STEPS {
+        schedule.run(world);
+        world.clear_trackers();
+    }
+    let x = world.get::<Transform>(body).unwrap().translation.x.widen();
+    let travelled = x - distance.widen();
+    let exact = STEPS as f64 * DT.widen();
+    (travelled / exact - 1.0).abs()
+}
+
+#[test]
+fn far_bodies_are_warned_about_exactly_where_rounding_shows() {
+    for distance in [10.0 as Real, 100.0, 1e4, 1e5] {
+        let (mut world, body) = moving_body_at(distance);
+        let warned = warned(&mut world);
+        let error = measured_error(&mut world, body, distance);
+        // The rule: r ε / (2 s Δt) > 1e-3, i.e. beyond ~280 m at 1 m/s and 60 Hz in f32.
+        let expected = !DOUBLE_PRECISION && distance > 280.0;
+        assert_eq!(warned, expected, "{distance} m: warned {warned}");
+        if warned {
+            assert!(error > 1e-3, "{distance} m: warned, but the error is {error:e}");
+        } else {
+            assert!(error < 1e-3, "{distance} m: not warned, but the error is {error:e}");
+        }
+    }
+}
+
+#[test]
+fn a_body_at_rest_far_away_loses_nothing_and_is_not_warned() {
+    let (mut world, body) = moving_body_at(1e6);
+    world.get_mut::<Velocity>(body).unwrap().linear = Vec3::ZERO;
+    assert!(!warned(&mut world));
+}
