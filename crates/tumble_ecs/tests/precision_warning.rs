@@ -51,9 +51,15 @@ fn far_bodies_are_warned_about_exactly_where_rounding_shows() {
         let expected = !DOUBLE_PRECISION && distance > 280.0;
         assert_eq!(warned, expected, "{distance} m: warned {warned}");
         if warned {
-            assert!(error > 1e-3, "{distance} m: warned, but the error is {error:e}");
+            assert!(
+                error > 1e-3,
+                "{distance} m: warned, but the error is {error:e}"
+            );
         } else {
-            assert!(error < 1e-3, "{distance} m: not warned, but the error is {error:e}");
+            assert!(
+                error < 1e-3,
+                "{distance} m: not warned, but the error is {error:e}"
+            );
         }
     }
 }

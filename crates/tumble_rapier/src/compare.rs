@@ -51,6 +51,31 @@ pub struct BodyDifference {
     pub exact_position: Option<(f64, f64)>,
     /// Against the exact solution: (tumble, rapier) max orientation error (rad).
     pub exact_angle: Option<(f64, f64)>,
+    /// The first step after which tumble had quarantined the body (its state is then frozen,
+    /// so the differences above stop meaning anything from that step on).
+    pub tumble_rejected_at: Option<usize>,
+    /// The first step after which either engine's state of the body was not finite (the
+    /// differences are then NaN, never silently dropped by `max`).
+    pub non_finite_at: Option<usize>,
+}
+
+impl BodyDifference {
+    /// True when the run of this body is trustworthy: never quarantined, always finite.
+    pub fn is_clean(&self) -> bool {
+        self.tumble_rejected_at.is_none() && self.non_finite_at.is_none()
+    }
+}
+
+/// `max` that keeps a NaN: `f64::max` and `f32::max` return the other operand when one is NaN,
+/// which would report 0 for a body whose state went bad.
+fn max_keep_nan<T: PartialOrd + Copy>(current: T, next: T) -> T {
+    #[allow(clippy::eq_op)]
+    let next_is_nan = next != next;
+    if next_is_nan || next > current {
+        next
+    } else {
+        current
+    }
 }
 
 /// The result of [`compare`].
@@ -102,22 +127,30 @@ pub fn compare(
         let t = to_f64(scene.dt) * step as f64;
         for (i, diff) in bodies.iter_mut().enumerate() {
             let (a, b) = (tumble.state(i), rapier.state(i));
-            diff.position = diff.position.max((a.position - b.position).length());
-            diff.angle = diff.angle.max(angle_between(a.rotation, b.rotation));
-            diff.linear_velocity = diff
-                .linear_velocity
-                .max((a.linear_velocity - b.linear_velocity).length());
-            diff.angular_velocity = diff
-                .angular_velocity
-                .max((a.angular_velocity - b.angular_velocity).length());
+            if diff.tumble_rejected_at.is_none() && tumble.is_rejected(i) {
+                diff.tumble_rejected_at = Some(step);
+            }
+            if diff.non_finite_at.is_none() && !(a.is_finite() && b.is_finite()) {
+                diff.non_finite_at = Some(step);
+            }
+            diff.position = max_keep_nan(diff.position, (a.position - b.position).length());
+            diff.angle = max_keep_nan(diff.angle, angle_between(a.rotation, b.rotation));
+            diff.linear_velocity = max_keep_nan(
+                diff.linear_velocity,
+                (a.linear_velocity - b.linear_velocity).length(),
+            );
+            diff.angular_velocity = max_keep_nan(
+                diff.angular_velocity,
+                (a.angular_velocity - b.angular_velocity).length(),
+            );
             if let Some(reference) = exact.and_then(|f| f(i, t)) {
                 let pos = |s: &BodyState| to_f64((s.position - reference.position).length());
                 let (pt, pr) = diff.exact_position.unwrap_or((0.0, 0.0));
-                diff.exact_position = Some((pt.max(pos(&a)), pr.max(pos(&b))));
+                diff.exact_position = Some((max_keep_nan(pt, pos(&a)), max_keep_nan(pr, pos(&b))));
                 let (at, ar) = diff.exact_angle.unwrap_or((0.0, 0.0));
                 diff.exact_angle = Some((
-                    at.max(angle_between(a.rotation, reference.rotation)),
-                    ar.max(angle_between(b.rotation, reference.rotation)),
+                    max_keep_nan(at, angle_between(a.rotation, reference.rotation)),
+                    max_keep_nan(ar, angle_between(b.rotation, reference.rotation)),
                 ));
             }
         }

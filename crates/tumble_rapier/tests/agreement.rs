@@ -237,3 +237,34 @@ fn default_tumble_build_does_not_link_rapier() {
         "rapier leaked into tumble's default tree:\n{tree}"
     );
 }
+
+/// A body tumble quarantines never reads as agreement: the comparison names the step, and a
+/// non-finite state shows as NaN instead of being dropped by `max`.
+#[test]
+fn a_quarantined_body_is_reported_not_hidden() {
+    let state = BodyState {
+        angular_velocity: Vec3::new(1.0, 60.0, 1.0),
+        ..Default::default()
+    };
+    let scene = ComparisonScene {
+        dt: 1.0 / 60.0,
+        gravity: None,
+        bodies: vec![
+            ComparisonBody::new("thin", mass(1.0, [0.01, 1.0, 1.005]), state),
+            ComparisonBody::new("calm", mass(1.0, [1.0, 1.0, 1.0]), BodyState::default()),
+        ],
+    };
+    let options = ComparisonOptions {
+        integrator: Integrator::SymplecticEuler,
+        steps: 2000,
+        ..Default::default()
+    };
+    let result = compare(&scene, &options, None);
+    let (thin, calm) = (&result.bodies[0], &result.bodies[1]);
+    assert!(
+        thin.tumble_rejected_at.is_some(),
+        "the explicit step diverges and is quarantined"
+    );
+    assert!(!thin.is_clean());
+    assert!(calm.is_clean(), "{calm:?}");
+}
