@@ -72,18 +72,6 @@ fn run_to(out: &Path, extra: &[&str]) -> Output {
 fn devices_fifos_and_directories_are_refused_and_left_alone() {
     use std::os::unix::fs::FileTypeExt;
     let dir = tempfile::tempdir().unwrap();
-    let output = run_to(Path::new("/dev/null"), &[]);
-    assert_eq!(output.status.code(), Some(1));
-    assert_eq!(
-        error_line(&output),
-        "error: /dev/null: is not a regular file (a device, FIFO or socket); tumble writes only regular files"
-    );
-    assert!(
-        std::fs::metadata("/dev/null")
-            .unwrap()
-            .file_type()
-            .is_char_device()
-    );
     let fifo = dir.path().join("fifo.csv");
     assert!(
         Command::new("mkfifo")
@@ -100,6 +88,19 @@ fn devices_fifos_and_directories_are_refused_and_left_alone() {
     std::fs::create_dir(&sub).unwrap();
     let output = run_to(&sub, &[]);
     assert!(error_line(&output).ends_with("sub: is a directory, expected a file"));
+    // /dev/null last: a build that replaced devices fails on the FIFO before it gets here.
+    let output = run_to(Path::new("/dev/null"), &[]);
+    assert_eq!(output.status.code(), Some(1));
+    assert_eq!(
+        error_line(&output),
+        "error: /dev/null: is not a regular file (a device, FIFO or socket); tumble writes only regular files"
+    );
+    assert!(
+        std::fs::metadata("/dev/null")
+            .unwrap()
+            .file_type()
+            .is_char_device()
+    );
     assert_eq!(listing(dir.path()), ["fifo.csv", "sub"]);
     assert!(listing(&sub).is_empty());
     // `gen` follows the same rules.
