@@ -12,7 +12,11 @@ use tumble_ecs::prelude::*;
 
 use crate::build::BuiltScene;
 
-/// The CSV header, exactly.
+/// The CSV header, exactly: one row per body per recorded step, `step` and `time` (s), the body
+/// name (see [`csv_text_cell`]), position `px..pz`, rotation `qx..qw` (glam order), linear
+/// velocity `vx..vz` and world-frame angular velocity `wx..wz`. A body quarantined with
+/// [`Rejected`] has no rows from the step it was rejected on: its state is the last valid one,
+/// not that step's.
 pub const CSV_HEADER: &str = "step,time,body,px,py,pz,qx,qy,qz,qw,vx,vy,vz,wx,wy,wz";
 
 /// Why [`write_trajectory`] did not write the whole trajectory.
