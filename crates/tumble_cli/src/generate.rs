@@ -1,7 +1,11 @@
 //! `tumble gen`: generated scenes, within the limits `tumble run` accepts.
 
 use std::fmt::Write as _;
+use std::io::Write as _;
+use std::path::Path;
 
+use tumble_scene::output::{OutputError, OutputFile};
+use tumble_scene::text::path_for_terminal;
 use tumble_scene::{MAX_SCENE_BYTES, MAX_STEPS};
 
 use crate::exit::{self, Failure};
@@ -72,4 +76,48 @@ pub fn many_bodies(n: u64, steps: u64, guard: &interrupt::Guard) -> Option<Strin
         );
     }
     Some(text)
+}
+
+/// `tumble gen many`: the scene to `out` (a file, or stdout for `None` and `-`).
+pub fn run(n: i64, steps: i64, out: Option<&Path>) -> Result<(), Failure> {
+    let (n, steps) = check_many(n, steps)?;
+    // Polling starts first so that it ends last, after the temporary file is removed.
+    let guard = interrupt::Guard::poll();
+    // The output is checked (and its temporary file made) before the work.
+    let file = match out {
+        Some(path) if !crate::is_stdout(path) => Some(OutputFile::create(path, &[])?),
+        _ => None,
+    };
+    let text = many_bodies(n, steps, &guard).ok_or_else(|| {
+        let unchanged = out
+            .filter(|p| !crate::is_stdout(p))
+            .map(|p| format!("; {} was not written", path_for_terminal(p)))
+            .unwrap_or_default();
+        Failure::new(exit::INTERRUPTED, format!("interrupted{unchanged}"))
+    })?;
+    // Cannot happen below the caps; checked so that a change of the generator cannot slip by.
+    if text.len() as u64 > MAX_SCENE_BYTES {
+        return Err(Failure::new(
+            exit::ERROR,
+            format!(
+                "the generated scene is {} bytes, over the {MAX_SCENE_BYTES} bytes `run` reads",
+                text.len()
+            ),
+        ));
+    }
+    match file {
+        Some(mut file) => {
+            file.write_all(text.as_bytes())
+                .map_err(|e| OutputError::io(file.path(), e))?;
+            file.commit()?;
+        }
+        None => {
+            let mut stdout = std::io::stdout().lock();
+            stdout
+                .write_all(text.as_bytes())
+                .and_then(|()| stdout.flush())
+                .map_err(|e| format!("standard output: {e}"))?;
+        }
+    }
+    Ok(())
 }

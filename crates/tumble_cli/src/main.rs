@@ -11,15 +11,13 @@ mod logging;
 mod run;
 
 use std::ffi::OsString;
-use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::Parser;
 use clap::error::ErrorKind;
-use tumble_scene::output::OutputFile;
 use tumble_scene::text::terminal_safe;
-use tumble_scene::{MAX_SCENE_BYTES, Scene, read_scene_text};
+use tumble_scene::{Scene, read_scene_text};
 
 use crate::cli::{Cli, Command, GenKind};
 use crate::exit::Failure;
@@ -175,43 +173,7 @@ fn dispatch(cli: Cli) -> Result<(), Failure> {
     match cli.command {
         Command::Gen {
             kind: GenKind::Many { n, steps, out },
-        } => {
-            let (n, steps) = generate::check_many(n, steps)?;
-            // Polling starts first so that it ends last, after the temporary file is removed.
-            let guard = interrupt::Guard::poll();
-            // The output is checked (and its temporary file made) before the work.
-            let mut file = match &out {
-                Some(path) if !is_stdout(path) => Some(OutputFile::create(path, &[])?),
-                _ => None,
-            };
-            let text = generate::many_bodies(n, steps, &guard)
-                .ok_or_else(|| Failure::new(exit::INTERRUPTED, "interrupted"))?;
-            if text.len() as u64 > MAX_SCENE_BYTES {
-                return Err(Failure::new(
-                    exit::ERROR,
-                    format!(
-                        "the generated scene is {} bytes, over the {MAX_SCENE_BYTES} bytes `run` reads",
-                        text.len()
-                    ),
-                ));
-            }
-            match file.take() {
-                Some(mut file) => {
-                    let path = file.path().to_owned();
-                    file.write_all(text.as_bytes())
-                        .map_err(|e| tumble_scene::output::OutputError::io(&path, e))?;
-                    file.commit()?;
-                }
-                None => {
-                    let mut stdout = std::io::stdout().lock();
-                    stdout
-                        .write_all(text.as_bytes())
-                        .and_then(|()| stdout.flush())
-                        .map_err(|e| format!("standard output: {e}"))?;
-                }
-            }
-            Ok(())
-        }
+        } => generate::run(n, steps, out.as_deref()),
         Command::Scenes => {
             for (name, text) in BUNDLED {
                 let first = text.lines().find(|l| l.starts_with("name")).unwrap_or("");

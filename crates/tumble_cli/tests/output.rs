@@ -430,6 +430,19 @@ fn out_dash_writes_the_csv_to_stdout_and_the_summary_to_stderr() {
     assert_eq!(lines.count(), 4, "{csv}");
     assert!(stderr(&output).contains("scene      projectile"));
     assert!(!Path::new("-").exists());
+    let generated = tumble()
+        .args(["gen", "many", "--n", "3", "--out", "-"])
+        .output()
+        .unwrap();
+    assert!(generated.status.success());
+    assert!(generated.stdout.starts_with(b"name = \"many-3\""));
+    // An empty path is no file name.
+    let output = tumble()
+        .args(["run", "projectile", "--out", ""])
+        .output()
+        .unwrap();
+    assert_eq!(output.status.code(), Some(2));
+    assert!(error_line(&output).contains("'--out <OUT>'"));
 }
 
 #[test]

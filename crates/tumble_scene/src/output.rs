@@ -81,6 +81,9 @@ pub enum OutputError {
         /// The path the caller gave.
         path: PathBuf,
     },
+    /// The output path is empty.
+    #[error("the output path is empty")]
+    EmptyPath,
     /// An I/O error while checking, writing or renaming.
     #[error("{}: {source}", path_for_terminal(.path))]
     Io {
@@ -110,6 +113,7 @@ impl OutputError {
             | Self::IsInput { path, .. }
             | Self::SymlinkLoop { path }
             | Self::Io { path, .. } => path,
+            Self::EmptyPath => Path::new(""),
         }
     }
 }
@@ -127,6 +131,9 @@ impl OutputFile {
     /// Checks `path` and opens the temporary file that will replace it. `inputs` are the files
     /// the run reads (e.g. the scene file); `path` may not resolve to any of them.
     pub fn create(path: &Path, inputs: &[&Path]) -> Result<Self, OutputError> {
+        if path.as_os_str().is_empty() {
+            return Err(OutputError::EmptyPath);
+        }
         let target = resolve_links(path)?;
         let existing = metadata_if_exists(path, &target)?;
         if let Some(meta) = &existing {
@@ -344,5 +351,19 @@ mod tests {
         assert!(err.to_string().contains("scene\\u{1b}.toml"), "{err}");
         let err = create_directory(&input).unwrap_err();
         assert!(matches!(err, OutputError::NotDirectory { .. }), "{err}");
+        let err = OutputFile::create(Path::new(""), &[]).unwrap_err();
+        assert_eq!(err.to_string(), "the output path is empty");
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_symlink_loop_is_an_error() {
+        let dir = tempfile::tempdir().unwrap();
+        let (a, b) = (dir.path().join("a"), dir.path().join("b"));
+        std::os::unix::fs::symlink(&b, &a).unwrap();
+        std::os::unix::fs::symlink(&a, &b).unwrap();
+        let err = OutputFile::create(&a, &[]).unwrap_err();
+        assert!(matches!(err, OutputError::SymlinkLoop { .. }), "{err}");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 2);
     }
 }
