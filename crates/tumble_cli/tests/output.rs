@@ -208,9 +208,16 @@ fn a_read_only_output_is_an_error_and_a_writable_one_keeps_its_mode() {
     assert_eq!(mode(&out), 0o444);
     let rw = dir.path().join("rw.csv");
     std::fs::write(&rw, "old").unwrap();
+    // Giving the file away works only as root (as CI runs); the owner then stays too.
+    let given_away = std::os::unix::fs::chown(&rw, Some(65534), Some(65534)).is_ok();
     std::fs::set_permissions(&rw, std::fs::Permissions::from_mode(0o640)).unwrap();
     assert!(run_to(&rw, &[]).status.success());
     assert_eq!(mode(&rw), 0o640);
+    if given_away {
+        use std::os::unix::fs::MetadataExt;
+        let meta = std::fs::metadata(&rw).unwrap();
+        assert_eq!((meta.uid(), meta.gid()), (65534, 65534));
+    }
     assert!(
         std::fs::read_to_string(&rw)
             .unwrap()

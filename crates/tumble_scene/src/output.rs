@@ -15,7 +15,8 @@
 //!   or absent: the target is replaced (or created), the link stays;
 //! - an existing file without write permission is refused, as a shell redirect would refuse it
 //!   (also for root, who could write it: read-only is taken as the owner's intent);
-//! - an existing file keeps its permission bits; a new one gets `0o666` less the umask;
+//! - an existing file keeps its permission bits (and its owner and group where the process may
+//!   set them); a new one gets `0o666` less the umask;
 //! - a path that is one of the run's input files (same device and inode) is refused.
 //!
 //! Every error names the path the caller gave, made safe for a terminal
@@ -167,6 +168,15 @@ impl OutputFile {
             .tempfile_in(dir)
             .map_err(|e| OutputError::io(path, without_temp_path(e)))?;
         if let Some(meta) = &existing {
+            #[cfg(unix)]
+            {
+                use std::os::unix::fs::MetadataExt;
+                // Best effort: the owner and group stay when we may set them (root may; others
+                // only to a group of theirs). Before the mode, since a change of owner clears
+                // the set-id bits.
+                let _ =
+                    std::os::unix::fs::fchown(temp.as_file(), Some(meta.uid()), Some(meta.gid()));
+            }
             // Set explicitly: the mode given at creation is reduced by the umask.
             temp.as_file()
                 .set_permissions(meta.permissions())
