@@ -71,8 +71,12 @@ pub enum Command {
         allow_unstable: bool,
     },
     /// The accuracy report: work–precision, stability matrix, plots.
+    #[command(allow_negative_numbers = true)]
     Report(tumble_report::run::ReportOptions),
     /// Throughput: ECS vs raw loop vs rapier, 1 and 2 threads, N = 1 … 10⁶, memory bandwidth.
+    // A negative size is then clap's "invalid value '-1' for '--max-bodies'", not "unexpected
+    // argument '-1'".
+    #[command(allow_negative_numbers = true)]
     Bench(tumble_bench::BenchOptions),
 }
 

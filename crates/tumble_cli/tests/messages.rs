@@ -71,6 +71,13 @@ fn usage_errors_are_one_line_with_exit_code_2() {
         .unwrap();
     assert_eq!(output.status.code(), Some(2));
     assert!(error_line(&output).contains("'--dt <DT>'"));
+    // A negative size for the benchmark is a bad value of its flag, not an unknown argument.
+    let output = tumble()
+        .args(["bench", "--max-bodies", "-1"])
+        .output()
+        .unwrap();
+    assert_eq!(output.status.code(), Some(2));
+    assert!(error_line(&output).starts_with("error: invalid value '-1' for '--max-bodies"));
     // Help is not an error.
     assert!(tumble().arg("--help").output().unwrap().status.success());
 }
