@@ -21,6 +21,8 @@ use tumble_core::math::Vec3;
 use serde::Serialize;
 use tumble_core::Integrator;
 use tumble_ecs::parallel::{Parallelism, pool_threads};
+use tumble_scene::output::{OutputError, create_directory, write_atomically};
+use tumble_scene::text::path_for_terminal;
 
 use crate::engines::{Ecs, Engine, Rapier, RawLoop};
 use crate::measure::{Effort, compare};
@@ -247,28 +249,36 @@ fn unused_gravity(n: usize, effort: &Effort) -> UnusedFeature {
 }
 
 /// Runs the benchmark, prints the table, and writes the files the options ask for.
+///
+/// The output directory is checked before the measurements (an existing non-directory is an
+/// error naming it); every file is written through [`tumble_scene::output::OutputFile`]
+/// (temporary file, rename as the last step).
 pub fn run_and_write(options: &BenchOptions) -> Result<(), Box<dyn std::error::Error>> {
+    if let Some(dir) = &options.out {
+        create_directory(dir)?;
+    }
     let results = run_bench(options, |line| eprintln!("… {line}"));
     let table = output::markdown(&results);
     println!("{table}");
     if let Some(dir) = &options.out {
-        std::fs::create_dir_all(dir)?;
-        std::fs::write(dir.join("bench.md"), &table)?;
-        std::fs::write(
-            dir.join("bench.json"),
-            serde_json::to_string_pretty(&results)? + "\n",
+        create_directory(dir)?;
+        write_atomically(&dir.join("bench.md"), table.as_bytes(), &[])?;
+        write_atomically(
+            &dir.join("bench.json"),
+            (serde_json::to_string_pretty(&results)? + "\n").as_bytes(),
+            &[],
         )?;
     }
     if let Some(readme) = &options.readme {
-        let text = std::fs::read_to_string(readme)?;
+        let text = std::fs::read_to_string(readme).map_err(|e| OutputError::io(readme, e))?;
         let section = output::readme_section(&results);
         let updated = output::replace_between_markers(&text, &section).ok_or_else(|| {
             format!(
                 "{}: no <!-- bench:begin --> … <!-- bench:end --> markers",
-                readme.display()
+                path_for_terminal(readme)
             )
         })?;
-        std::fs::write(readme, updated)?;
+        write_atomically(readme, updated.as_bytes(), &[])?;
     }
     Ok(())
 }

@@ -7,22 +7,20 @@ use tumble_ecs::prelude::*;
 use tumble_scene::{CSV_HEADER, load_scene};
 
 fn tumble() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_tumble"))
+    let mut command = Command::new(env!("CARGO_BIN_EXE_tumble"));
+    // Messages are compared line by line: the caller's log settings must not add any.
+    command.env_remove("RUST_LOG");
+    command
 }
 
 fn scene_path(name: &str) -> String {
     format!("{}/../../scenes/{name}.toml", env!("CARGO_MANIFEST_DIR"))
 }
 
-fn temp(name: &str) -> std::path::PathBuf {
-    let dir = std::env::temp_dir().join(format!("tumble-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
-}
-
 #[test]
 fn run_writes_the_specified_csv_bit_identical_to_the_library() {
-    let out = temp("chain.csv");
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("chain.csv");
     let status = tumble()
         .args([
             "run",
@@ -80,9 +78,10 @@ fn run_writes_the_specified_csv_bit_identical_to_the_library() {
 
 #[test]
 fn bad_scene_exits_non_zero_with_file_and_line_and_writes_nothing() {
-    let bad = temp("bad.toml");
+    let dir = tempfile::tempdir().unwrap();
+    let bad = dir.path().join("bad.toml");
     std::fs::write(&bad, "name = \"x\"\n[world]\ndt = -1.0\nsteps = 5\n").unwrap();
-    let out = temp("never.csv");
+    let out = dir.path().join("never.csv");
     let output = tumble()
         .args(["run"])
         .arg(&bad)
@@ -188,7 +187,8 @@ fn compare_reports_rapier_and_exact_differences() {
 
 #[test]
 fn gen_many_writes_a_valid_scene() {
-    let out = temp("many.toml");
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("many.toml");
     let status = tumble()
         .args(["gen", "many", "--n", "1000", "--steps", "5", "--out"])
         .arg(&out)

@@ -3,6 +3,8 @@
 use std::path::{Path, PathBuf};
 
 use indicatif::{ProgressBar, ProgressStyle};
+use tumble_scene::output::{OutputError, create_directory, write_atomically};
+use tumble_scene::text::path_for_terminal;
 
 use crate::energy::{spins, traces};
 use crate::output::{Machine, Results, headline_table, markdown, plot_energy, plot_scene};
@@ -28,7 +30,12 @@ pub struct ReportOptions {
 
 /// Runs the work–precision study, the stability matrix and the energy traces; writes
 /// `report.md`, `results.json` and the SVG plots; prints the headline table.
+///
+/// The output directory is checked first (an existing non-directory is an error naming it,
+/// before minutes of work); every file is written through
+/// [`tumble_scene::output::OutputFile`] (temporary file, rename as the last step).
 pub fn run_report(options: &ReportOptions) -> Result<(), Box<dyn std::error::Error>> {
+    create_directory(&options.out)?;
     let dts: Vec<f64> = if options.quick {
         [15.0, 30.0, 60.0, 120.0, 240.0, 480.0]
             .iter()
@@ -80,31 +87,62 @@ pub fn run_report(options: &ReportOptions) -> Result<(), Box<dyn std::error::Err
 
     let results = Results::new(Machine::detect(options.quick), points, cells, energy);
     let out: &Path = &options.out;
-    std::fs::create_dir_all(out)?;
+    create_directory(out)?;
+    // The plots are drawn into a private directory (plotters opens its path as it is), then
+    // each is written into `out` by the same safe route as the other files.
+    let staging = tempfile::Builder::new()
+        .prefix(".tumble-plots-")
+        .tempdir_in(out)
+        .map_err(|e| OutputError::io(out, e))?;
     let mut plots = Vec::new();
     for case in &cases {
-        plots.push(plot_scene(out, case.name, &results.work_precision)?);
+        plots.push(plot_scene(
+            staging.path(),
+            case.name,
+            &results.work_precision,
+        )?);
     }
     for (spin, _) in spins() {
-        plots.push(plot_energy(out, spin, &results.energy)?);
+        plots.push(plot_energy(staging.path(), spin, &results.energy)?);
     }
-    std::fs::write(
-        out.join("results.json"),
-        serde_json::to_string_pretty(&results)?,
+    for plot in &plots {
+        let drawn = staging.path().join(plot);
+        // A scene without finite points gets no plot file (see `plot_scene`).
+        if drawn.exists() {
+            let bytes = std::fs::read(&drawn).map_err(|e| OutputError::io(&drawn, e))?;
+            write_atomically(&out.join(plot), &bytes, &[])?;
+        }
+    }
+    write_atomically(
+        &out.join("results.json"),
+        serde_json::to_string_pretty(&results)?.as_bytes(),
+        &[],
     )?;
-    std::fs::write(out.join("report.md"), markdown(&results, &plots))?;
+    write_atomically(
+        &out.join("report.md"),
+        markdown(&results, &plots).as_bytes(),
+        &[],
+    )?;
     let headline = headline_table(&results.work_precision);
     println!("{headline}");
     if let Some(readme) = &options.readme {
-        let text = std::fs::read_to_string(readme)?;
-        let updated = crate::output::replace_between_markers(&text, &headline)
-            .ok_or("README has no <!-- report:begin --> … <!-- report:end --> markers")?;
-        std::fs::write(readme, updated)?;
-        println!("updated the headline table in {}", readme.display());
+        let text = std::fs::read_to_string(readme).map_err(|e| OutputError::io(readme, e))?;
+        let updated =
+            crate::output::replace_between_markers(&text, &headline).ok_or_else(|| {
+                format!(
+                    "{}: no <!-- report:begin --> … <!-- report:end --> markers",
+                    path_for_terminal(readme)
+                )
+            })?;
+        write_atomically(readme, updated.as_bytes(), &[])?;
+        println!(
+            "updated the headline table in {}",
+            path_for_terminal(readme)
+        );
     }
     println!(
         "wrote {}/report.md, results.json and {} plots",
-        out.display(),
+        path_for_terminal(out),
         plots.len()
     );
     Ok(())

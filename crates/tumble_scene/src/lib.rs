@@ -12,14 +12,15 @@
 mod build;
 mod error;
 mod format;
+pub mod output;
 pub mod text;
 mod trajectory;
 mod validate;
 
-pub use build::{BuiltScene, Scene};
+pub use build::{BuiltScene, MAX_STEPS, Scene};
 pub use error::SceneError;
 pub use format::{BodyDef, ForceDef, SceneFile, ShapeDef, WorldDef};
-pub use trajectory::{CSV_HEADER, write_trajectory};
+pub use trajectory::{CSV_HEADER, TrajectoryError, csv_text_cell, write_trajectory};
 
 /// Largest scene file accepted (bytes); anything bigger is rejected before it is read whole.
 /// Room for `tumble gen many --n 100000` (about 20 MB), far below the 100 MB of the bad-input

@@ -1,55 +1,141 @@
 //! Trajectory recording as CSV.
 
+use std::borrow::Cow;
 use std::io::Write;
-use std::path::Path;
+use std::num::NonZeroU64;
+use std::ops::ControlFlow;
 use tumble_core::math::{Real, to_f64};
 
 use bevy_ecs::prelude::*;
+use thiserror::Error;
 use tumble_ecs::prelude::*;
 
 use crate::build::BuiltScene;
 
-/// The CSV header, exactly.
+/// The CSV header, exactly: one row per body per recorded step, `step` and `time` (s), the body
+/// name (see [`csv_text_cell`]), position `px..pz`, rotation `qx..qw` (glam order), linear
+/// velocity `vx..vz` and world-frame angular velocity `wx..wz`. A body quarantined with
+/// [`Rejected`] has no rows from the step it was rejected on: its state is the last valid one,
+/// not that step's.
 pub const CSV_HEADER: &str = "step,time,body,px,py,pz,qx,qy,qz,qw,vx,vy,vz,wx,wy,wz";
 
-/// Runs `steps` steps of a built scene, writing step 0 and then every `every`-th step to `out`
-/// (`px..pz` is `Transform::translation`, `w*` the world-frame angular velocity). The file is
-/// written to a temporary name and renamed only when complete.
-pub fn write_trajectory(
-    scene: &mut BuiltScene,
-    dt: Real,
-    steps: u64,
-    every: u64,
-    out: &Path,
-) -> std::io::Result<()> {
-    let tmp = out.with_extension("csv.partial");
-    let result = (|| {
-        let mut w = std::io::BufWriter::new(std::fs::File::create(&tmp)?);
-        writeln!(w, "{CSV_HEADER}")?;
-        write_rows(&mut w, scene, 0, dt)?;
-        for step in 1..=steps {
-            scene.schedule.run(&mut scene.world);
-            scene.world.clear_trackers();
-            if step % every.max(1) == 0 {
-                write_rows(&mut w, scene, step, dt)?;
-            }
-        }
-        w.flush()
-    })();
-    match result {
-        Ok(()) => std::fs::rename(&tmp, out),
-        Err(e) => {
-            let _ = std::fs::remove_file(&tmp);
-            Err(e)
-        }
-    }
+/// Why [`write_trajectory`] did not write the whole trajectory.
+#[derive(Debug, Error)]
+pub enum TrajectoryError {
+    /// Writing failed (disk full, closed pipe, …).
+    #[error(transparent)]
+    Io(#[from] std::io::Error),
+    /// The per-step callback asked to stop after this step (e.g. on Ctrl-C).
+    #[error("stopped after step {step}")]
+    Stopped {
+        /// The last step that was run.
+        step: u64,
+    },
+    /// The world has no [`PhysicsSettings`] resource, so there is no time step to label rows
+    /// with (a [`BuiltScene`] from [`Scene::build`](crate::Scene::build) always has one).
+    #[error("the world has no PhysicsSettings resource (no time step)")]
+    NoSettings,
 }
 
-fn write_rows(w: &mut impl Write, scene: &BuiltScene, step: u64, dt: Real) -> std::io::Result<()> {
+/// Runs `steps` steps of a built scene and writes its trajectory as CSV to `out`: the
+/// [`CSV_HEADER`] line, then one row per body for step 0 and for every `every`-th step.
+///
+/// - `px..pz` is `Transform::translation`, `q*` the rotation (glam order), `v*` the linear and
+///   `w*` the world-frame angular velocity; `time` is `step × dt`, with `dt` read from the
+///   world's [`PhysicsSettings`] when the call starts (so it cannot disagree with the step the
+///   schedule takes, nor be NaN).
+/// - A body that carries [`Rejected`] when a step is recorded gets no row for that step: its
+///   state is the last valid one, not the state of that step. Its rows stop from the first
+///   recorded step at or after the step it was rejected on (and resume if game code lifts the
+///   quarantine by inserting valid data).
+/// - Body names are written so that a spreadsheet reads them as text (OWASP's rule for CSV
+///   injection): a name beginning with `=`, `+`, `-`, `@`, a tab or a carriage return gets a
+///   leading `'`; a name holding `,`, `"`, a line feed or a carriage return is quoted as in
+///   RFC 4180. Scene files reject such names anyway; library users may name bodies freely.
+///
+/// `on_step(step)` is called after each step (1 ..= `steps`) has been run and its rows written:
+/// report progress there, and return [`ControlFlow::Break`] to stop (the result is then
+/// [`TrajectoryError::Stopped`]). `out` is buffered here; pass it unbuffered. Rows already
+/// written stay in `out` on error: write to a temporary file and rename it only on success
+/// (see [`crate::output::OutputFile`]).
+pub fn write_trajectory(
+    scene: &mut BuiltScene,
+    steps: u64,
+    every: NonZeroU64,
+    out: impl Write,
+    mut on_step: impl FnMut(u64) -> ControlFlow<()>,
+) -> Result<(), TrajectoryError> {
+    let dt = scene
+        .world
+        .get_resource::<PhysicsSettings>()
+        .ok_or(TrajectoryError::NoSettings)?
+        .dt();
+    // The cells of the names are computed once: a run writes them millions of times.
+    let names: Vec<String> = scene
+        .bodies
+        .iter()
+        .map(|(name, _)| csv_text_cell(name).into_owned())
+        .collect();
+    let mut w = std::io::BufWriter::with_capacity(1 << 16, out);
+    writeln!(w, "{CSV_HEADER}")?;
+    write_rows(&mut w, scene, &names, 0, dt)?;
+    for step in 1..=steps {
+        scene.schedule.run(&mut scene.world);
+        scene.world.clear_trackers();
+        if step.is_multiple_of(every.get()) {
+            write_rows(&mut w, scene, &names, step, dt)?;
+        }
+        if on_step(step).is_break() {
+            w.flush()?;
+            return Err(TrajectoryError::Stopped { step });
+        }
+    }
+    w.flush()?;
+    Ok(())
+}
+
+/// `text` as a CSV cell that a spreadsheet shows as text: a leading `'` before a formula
+/// trigger (`=`, `+`, `-`, `@`, tab, carriage return), and RFC 4180 quotes around a cell that
+/// holds a separator, a quote or a line break.
+pub fn csv_text_cell(text: &str) -> Cow<'_, str> {
+    let formula = text.starts_with(['=', '+', '-', '@', '\t', '\r']);
+    let quoted = text.contains([',', '"', '\n', '\r']);
+    if !formula && !quoted {
+        return Cow::Borrowed(text);
+    }
+    let mut cell = String::with_capacity(text.len() + 3);
+    if quoted {
+        cell.push('"');
+    }
+    if formula {
+        cell.push('\'');
+    }
+    if quoted {
+        cell.push_str(&text.replace('"', "\"\""));
+        cell.push('"');
+    } else {
+        cell.push_str(text);
+    }
+    Cow::Owned(cell)
+}
+
+fn write_rows(
+    w: &mut impl Write,
+    scene: &BuiltScene,
+    names: &[String],
+    step: u64,
+    dt: Real,
+) -> std::io::Result<()> {
     let time = to_f64(dt) * step as f64;
-    for (name, e) in &scene.bodies {
-        let world: &World = &scene.world;
-        let (Some(t), Some(v)) = (world.get::<Transform>(*e), world.get::<Velocity>(*e)) else {
+    let world: &World = &scene.world;
+    for ((_, e), name) in scene.bodies.iter().zip(names) {
+        let Ok(body) = world.get_entity(*e) else {
+            continue;
+        };
+        if body.contains::<Rejected>() {
+            continue;
+        }
+        let (Some(t), Some(v)) = (body.get::<Transform>(), body.get::<Velocity>()) else {
             continue;
         };
         let q = t.rotation;
@@ -72,4 +158,109 @@ fn write_rows(w: &mut impl Write, scene: &BuiltScene, step: u64, dt: Real) -> st
         )?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Scene;
+    use tumble_ecs::validate::{BodyError, BodyErrorKind};
+
+    fn chain() -> BuiltScene {
+        let text = include_str!("../../../scenes/spring_chain.toml");
+        Scene::parse("spring_chain.toml", text).unwrap().build()
+    }
+
+    fn write(built: &mut BuiltScene, steps: u64, every: u64) -> String {
+        let mut out = Vec::new();
+        write_trajectory(
+            built,
+            steps,
+            NonZeroU64::new(every).unwrap(),
+            &mut out,
+            |_| ControlFlow::Continue(()),
+        )
+        .unwrap();
+        String::from_utf8(out).unwrap()
+    }
+
+    #[test]
+    fn time_comes_from_the_worlds_settings_and_rows_follow_every() {
+        let mut built = chain();
+        built
+            .world
+            .resource_mut::<PhysicsSettings>()
+            .set_dt(0.125)
+            .unwrap();
+        let csv = write(&mut built, 6, 3);
+        let rows: Vec<Vec<&str>> = csv
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').collect())
+            .collect();
+        assert_eq!(csv.lines().next(), Some(CSV_HEADER));
+        assert_eq!(rows.len(), 3 * 3);
+        assert_eq!((rows[8][0], rows[8][1], rows[8][2]), ("6", "0.75", "m3"));
+        built.world.remove_resource::<PhysicsSettings>();
+        let err = write_trajectory(&mut built, 1, NonZeroU64::MIN, std::io::sink(), |_| {
+            ControlFlow::Continue(())
+        })
+        .unwrap_err();
+        assert!(matches!(err, TrajectoryError::NoSettings), "{err}");
+    }
+
+    #[test]
+    fn the_callback_sees_every_step_and_can_stop_the_run() {
+        let mut built = chain();
+        let mut seen = Vec::new();
+        let err = write_trajectory(&mut built, 10, NonZeroU64::MIN, std::io::sink(), |step| {
+            seen.push(step);
+            if step == 3 {
+                ControlFlow::Break(())
+            } else {
+                ControlFlow::Continue(())
+            }
+        })
+        .unwrap_err();
+        assert!(matches!(err, TrajectoryError::Stopped { step: 3 }), "{err}");
+        assert_eq!(seen, [1, 2, 3]);
+    }
+
+    #[test]
+    fn rejected_bodies_get_no_rows_and_names_are_neutralised() {
+        let mut built = chain();
+        let m2 = built.bodies[1].1;
+        built.world.entity_mut(m2).insert(Rejected(BodyError {
+            entity: m2,
+            kind: BodyErrorKind::Restored("test".into()),
+        }));
+        built.bodies[0].0 = "=HYPERLINK(\"x\")".into();
+        let csv = write(&mut built, 2, 1);
+        let names: Vec<&str> = csv
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').nth(2).unwrap())
+            .collect();
+        assert_eq!(names.len(), 2 * 3, "{csv}");
+        assert!(!names.contains(&"m2"), "{csv}");
+        assert!(csv.contains(",\"'=HYPERLINK(\"\"x\"\")\","), "{csv}");
+    }
+
+    #[test]
+    fn formula_triggers_get_a_leading_quote_and_separators_are_quoted() {
+        for (name, cell) in [
+            ("plain", "plain"),
+            ("=1+2", "'=1+2"),
+            ("+x", "'+x"),
+            ("-x", "'-x"),
+            ("@SUM(A1)", "'@SUM(A1)"),
+            ("\tx", "'\tx"),
+            ("a,b", "\"a,b\""),
+            ("say \"hi\"", "\"say \"\"hi\"\"\""),
+            ("\ra", "\"'\ra\""),
+            ("x=1", "x=1"),
+        ] {
+            assert_eq!(csv_text_cell(name), cell, "{name:?}");
+        }
+    }
 }

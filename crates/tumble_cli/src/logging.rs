@@ -1,0 +1,33 @@
+//! Log output: `tracing` events (stability predictions, quarantined bodies, …) on stderr.
+
+use std::io::IsTerminal;
+
+use tracing_subscriber::EnvFilter;
+use tracing_subscriber::filter::LevelFilter;
+
+/// The level `-v`/`-q` ask for: warnings by default, `-v` info, `-vv` debug, `-vvv` trace,
+/// `-q` errors only.
+pub fn level(verbose: u8, quiet: bool) -> LevelFilter {
+    match (quiet, verbose) {
+        (true, _) => LevelFilter::ERROR,
+        (false, 0) => LevelFilter::WARN,
+        (false, 1) => LevelFilter::INFO,
+        (false, 2) => LevelFilter::DEBUG,
+        (false, _) => LevelFilter::TRACE,
+    }
+}
+
+/// Installs a `fmt` subscriber on stderr: `RUST_LOG` directives (ignored where malformed) over
+/// the default level from the flags; colour only on a terminal.
+pub fn init(verbose: u8, quiet: bool) {
+    let filter = EnvFilter::builder()
+        .with_default_directive(level(verbose, quiet).into())
+        .from_env_lossy();
+    // `try_init`: a second subscriber (none today) must not make the CLI panic.
+    let _ = tracing_subscriber::fmt()
+        .with_env_filter(filter)
+        .with_writer(std::io::stderr)
+        .with_ansi(std::io::stderr().is_terminal())
+        .without_time()
+        .try_init();
+}

@@ -1,0 +1,335 @@
+//! `tumble run`: a scene stepped headless, its trajectory written safely, and a summary.
+
+use std::io::{IsTerminal, Write};
+use std::num::NonZeroU64;
+use std::ops::ControlFlow;
+use std::path::Path;
+use std::time::Instant;
+
+use bevy_ecs::prelude::*;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressFinish, ProgressStyle};
+use tumble_core::invariants::{angular_momentum, kinetic_energy};
+use tumble_core::math::{Real, Vec3, Widen, to_f64};
+use tumble_ecs::components::body_state;
+use tumble_ecs::prelude::*;
+use tumble_scene::output::{OutputError, OutputFile};
+use tumble_scene::text::{path_for_terminal, terminal_safe};
+use tumble_scene::{BuiltScene, MAX_STEPS, Scene, SceneError, TrajectoryError, csv_text_cell};
+
+use crate::cli::RunArgs;
+use crate::exit::{self, Failure};
+use crate::interrupt;
+
+/// Runs longer than this many body-steps show a progress bar (when stderr is a terminal).
+pub const PROGRESS_BODY_STEPS: f64 = 1e6;
+
+/// Steps between two updates of the progress bar: its cost stays invisible even for one body.
+const PROGRESS_EVERY: u64 = 1024;
+
+/// Bytes of one written number, bound: `Display` of an `f32` needs at most 16 characters for a
+/// magnitude in [1e-6, 1e15) (a sign, 9 significant digits, the point, leading zeros), of an
+/// `f64` at most 25 in [1e-6, 1e24). Rarer magnitudes print longer; the estimate is a guide, and
+/// a full disk while writing is still an error that removes the temporary file.
+const VALUE_BYTES: u64 = if size_of::<Real>() == 4 { 16 } else { 25 };
+
+/// Names the command-line flag behind an error in an overridden world setting, so the message
+/// does not point at a line of a file the user never wrote.
+fn override_error(e: SceneError, dt: Option<f64>, steps: Option<u64>, integrator: bool) -> Failure {
+    let flag = match e.field.as_str() {
+        "world.dt" if dt.is_some() => "--dt",
+        "world.steps" if steps.is_some() => "--steps",
+        "world.integrator" if integrator => "--integrator",
+        _ => return e.into(),
+    };
+    Failure::new(exit::ERROR, format!("{flag}: {}", e.message))
+}
+
+/// `tumble run`.
+pub fn run(args: RunArgs) -> Result<(), Failure> {
+    let every = u64::try_from(args.every)
+        .ok()
+        .and_then(NonZeroU64::new)
+        .ok_or_else(|| {
+            Failure::new(
+                exit::ERROR,
+                format!("--every: expected a value >= 1, got {}", args.every),
+            )
+        })?;
+    let steps = match args.steps {
+        Some(s) if !(1..=MAX_STEPS as i64).contains(&s) => {
+            return Err(Failure::new(
+                exit::ERROR,
+                format!("--steps: expected 1 to {MAX_STEPS} steps, got {s}"),
+            ));
+        }
+        other => other.map(|s| s as u64),
+    };
+    let integrator = args
+        .integrator
+        .map(|v| crate::utf8("--integrator", v))
+        .transpose()?;
+    let loaded = crate::load(&args.scene)?;
+    let mut scene = Scene::parse(&loaded.file, &loaded.text)?;
+    if steps.is_some() || args.dt.is_some() || integrator.is_some() {
+        // Overrides are applied to the file model, then validated like the file itself.
+        let mut model = scene.file.clone();
+        model.world.steps = steps.unwrap_or(model.world.steps);
+        model.world.dt = args.dt.unwrap_or(model.world.dt);
+        let overridden = integrator.is_some();
+        model.world.integrator = integrator.or(model.world.integrator);
+        let text = tumble_scene::to_toml_string(&model);
+        scene = Scene::parse(&loaded.file, &text)
+            .map_err(|e| override_error(e, args.dt, steps, overridden))?;
+    }
+    let mut built = scene.build();
+    if args.plan {
+        println!("{}", PhysicsPlan::for_world(&mut built.world));
+        return Ok(());
+    }
+    // For the stability gate (exit::UNSTABLE unless allowed), to come with the planning-time
+    // predictions.
+    let _allow_unstable = args.allow_unstable;
+    let steps = scene.steps;
+    let to_stdout = args.out.as_deref().is_some_and(crate::is_stdout);
+
+    // Energy and angular momentum are invariants only of free, undamped bodies.
+    let invariant = scene.gravity.is_none()
+        && scene.file.forces.is_empty()
+        && scene
+            .file
+            .bodies
+            .iter()
+            .all(|b| b.linear_damping == 0.0 && b.angular_damping == 0.0);
+    let before = totals(&mut built.world);
+    let start = Instant::now();
+    // Created before the output file, dropped after it: a second signal while the temporary
+    // file is being removed cannot cut that short.
+    let guard = interrupt::Guard::poll();
+    let bar = progress_bar(steps, built.bodies.len());
+    let mut on_step = |step: u64| {
+        if step.is_multiple_of(PROGRESS_EVERY) {
+            bar.set_position(step);
+        }
+        if guard.interrupted() {
+            ControlFlow::Break(())
+        } else {
+            ControlFlow::Continue(())
+        }
+    };
+    let interrupted = |step: u64, path: Option<&Path>| {
+        let unchanged = match path {
+            Some(path) => format!("; {} was not written", path_for_terminal(path)),
+            None => String::new(),
+        };
+        Failure::new(
+            exit::INTERRUPTED,
+            format!("interrupted after step {step}{unchanged}"),
+        )
+    };
+    match args.out.as_deref() {
+        Some(_) if to_stdout => {
+            let stdout = std::io::stdout().lock();
+            tumble_scene::write_trajectory(&mut built, steps, every, stdout, &mut on_step)
+                .map_err(|e| match e {
+                    TrajectoryError::Stopped { step } => interrupted(step, None),
+                    e => Failure::new(exit::ERROR, format!("standard output: {e}")),
+                })?;
+        }
+        Some(path) => {
+            let inputs: Vec<&Path> = loaded.path.as_deref().into_iter().collect();
+            let mut file = OutputFile::create(path, &inputs)?;
+            if !args.force {
+                check_free_space(&file, &built, steps, every)?;
+            }
+            tumble_scene::write_trajectory(&mut built, steps, every, &mut file, &mut on_step)
+                .map_err(|e| match e {
+                    TrajectoryError::Stopped { step } => interrupted(step, Some(path)),
+                    TrajectoryError::Io(e) => OutputError::io(path, e).into(),
+                    e => Failure::from(e),
+                })?;
+            file.commit()?;
+        }
+        None => {
+            for step in 1..=steps {
+                built.schedule.run(&mut built.world);
+                built.world.clear_trackers();
+                if on_step(step).is_break() {
+                    return Err(interrupted(step, None));
+                }
+            }
+        }
+    }
+    bar.finish_and_clear();
+    let wall = start.elapsed();
+    let after = totals(&mut built.world);
+    let body_steps = (steps as f64) * built.bodies.len().max(1) as f64;
+    let (dt, integrator) = {
+        let settings = built.world.resource::<PhysicsSettings>();
+        (settings.dt(), settings.integrator)
+    };
+    let rejected = built.world.query::<&Rejected>().iter(&built.world).count();
+    // With the trajectory on stdout, the summary goes to stderr so that the CSV stays clean.
+    let mut summary: Box<dyn Write> = if to_stdout {
+        Box::new(std::io::stderr().lock())
+    } else {
+        Box::new(std::io::stdout().lock())
+    };
+    let mut lines = vec![
+        format!("scene      {}", terminal_safe(&scene.file.name)),
+        format!("bodies     {}", built.bodies.len()),
+        format!("steps      {steps} × {dt} s ({integrator})"),
+        format!(
+            "wall time  {:.3} s, {:.1} ns per body-step",
+            wall.as_secs_f64(),
+            wall.as_nanos() as f64 / body_steps
+        ),
+    ];
+    if invariant {
+        lines.push(format!("energy     {}", drift(before.0, after.0)));
+        lines.push(format!("|L|        {}", drift(before.1, after.1)));
+    }
+    if rejected > 0 {
+        lines.push(format!("rejected   {rejected} bodies (see warnings)"));
+    }
+    for line in lines {
+        // A closed stdout (`| head`) must not turn a finished run into a panic.
+        let _ = writeln!(summary, "{line}");
+    }
+    let _ = summary.flush();
+    if rejected > 0 {
+        return Err(Failure::new(
+            exit::REJECTED,
+            format!(
+                "{rejected} of {} bodies were rejected; their CSV rows stop at the step they were rejected on",
+                built.bodies.len()
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// A progress bar on stderr for long runs when stderr is a terminal, hidden otherwise.
+fn progress_bar(steps: u64, bodies: usize) -> ProgressBar {
+    let long = steps as f64 * bodies as f64 > PROGRESS_BODY_STEPS;
+    if !long || !std::io::stderr().is_terminal() {
+        return ProgressBar::hidden();
+    }
+    // Cleared when dropped on an error, so the error line starts on a line of its own.
+    let bar = ProgressBar::with_draw_target(Some(steps), ProgressDrawTarget::stderr())
+        .with_finish(ProgressFinish::AndClear);
+    if let Ok(style) =
+        ProgressStyle::with_template("{bar:40} {human_pos}/{human_len} steps [{elapsed} < {eta}]")
+    {
+        bar.set_style(style);
+    }
+    bar
+}
+
+/// The estimated CSV size: `(rows, bytes per row)`, the row size a bound for the usual
+/// magnitudes (see [`VALUE_BYTES`]).
+pub fn csv_estimate(built: &BuiltScene, steps: u64, every: NonZeroU64) -> (u64, u64) {
+    let recorded = steps / every.get() + 1;
+    let rows = recorded.saturating_mul(built.bodies.len() as u64);
+    let name = built
+        .bodies
+        .iter()
+        .map(|(n, _)| csv_text_cell(n).len() as u64)
+        .max()
+        .unwrap_or(0);
+    let dt = built
+        .world
+        .get_resource::<PhysicsSettings>()
+        .map_or(0.0, |s| to_f64(s.dt()));
+    // `time` is an f64 of up to 17 significant digits: 25 characters cover it from 1e-6 s on.
+    let time = (format!("{}", dt * steps as f64).len() as u64).max(25);
+    let step = steps.to_string().len() as u64;
+    let row = step + time + name + 13 * VALUE_BYTES + 15 + 1;
+    (rows, row)
+}
+
+/// Refuses a trajectory whose estimated size exceeds the free space where it is written.
+fn check_free_space(
+    file: &OutputFile,
+    built: &BuiltScene,
+    steps: u64,
+    every: NonZeroU64,
+) -> Result<(), Failure> {
+    let (rows, row) = csv_estimate(built, steps, every);
+    let bytes = rows.saturating_mul(row).saturating_add(CSV_HEADER_BYTES);
+    let dir = match file.target().parent() {
+        Some(dir) if !dir.as_os_str().is_empty() => dir,
+        _ => Path::new("."),
+    };
+    let free = match fs4::available_space(dir) {
+        Ok(free) => free,
+        Err(e) => {
+            tracing::warn!(
+                "{}: cannot tell the free space ({e}); writing without the size check",
+                path_for_terminal(file.path())
+            );
+            return Ok(());
+        }
+    };
+    if bytes > free {
+        return Err(Failure::new(
+            exit::ERROR,
+            format!(
+                "{}: the trajectory would take up to {} ({rows} rows of up to {row} bytes), more than the {} free there; record fewer steps with --every, or pass --force",
+                path_for_terminal(file.path()),
+                human_bytes(bytes),
+                human_bytes(free)
+            ),
+        ));
+    }
+    Ok(())
+}
+
+const CSV_HEADER_BYTES: u64 = tumble_scene::CSV_HEADER.len() as u64 + 1;
+
+/// `bytes` with a binary unit, e.g. `1.5 GiB`.
+fn human_bytes(bytes: u64) -> String {
+    const UNITS: [&str; 6] = ["bytes", "KiB", "MiB", "GiB", "TiB", "PiB"];
+    let mut value = bytes as f64;
+    let mut unit = 0;
+    while value >= 1024.0 && unit + 1 < UNITS.len() {
+        value /= 1024.0;
+        unit += 1;
+    }
+    if unit == 0 {
+        format!("{bytes} bytes")
+    } else {
+        format!("{value:.1} {}", UNITS[unit])
+    }
+}
+
+/// The relative drift `after/before − 1`, or the absolute change when `before` is zero.
+fn drift(before: f64, after: f64) -> String {
+    if before == 0.0 {
+        format!("absolute change {:.3e} (zero at the start)", after - before)
+    } else {
+        format!("relative drift {:.3e}", after / before - 1.0)
+    }
+}
+
+/// Total kinetic energy and |ΣL| of the bodies.
+fn totals(world: &mut World) -> (f64, f64) {
+    let mut q = world.query_filtered::<(&Transform, &Velocity, &MassProps), With<RigidBody>>();
+    let (mut e, mut l) = (0.0, Vec3::ZERO.widen());
+    for (t, v, m) in q.iter(world) {
+        let s = body_state(t, v, m);
+        e += to_f64(kinetic_energy(&s, m));
+        l += angular_momentum(&s, m).widen();
+    }
+    (e, l.length())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sizes_read_with_binary_units() {
+        assert_eq!(human_bytes(512), "512 bytes");
+        assert_eq!(human_bytes(3 << 29), "1.5 GiB");
+    }
+}

@@ -1,0 +1,244 @@
+//! The CLI talks: tumble's own messages for bad numbers, one line per error, named arguments,
+//! log output on stderr (`RUST_LOG`, `-v`, `-q`), documented exit codes, a progress bar on a
+//! terminal.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+use tumble_scene::CSV_HEADER;
+
+fn tumble() -> Command {
+    let mut command = Command::new(env!("CARGO_BIN_EXE_tumble"));
+    command.env_remove("RUST_LOG");
+    command
+}
+
+fn stderr(output: &Output) -> String {
+    String::from_utf8_lossy(&output.stderr).into_owned()
+}
+
+fn error_line(output: &Output) -> String {
+    let text = stderr(output);
+    assert_eq!(text.lines().count(), 1, "one line: {text}");
+    text.trim_end().to_owned()
+}
+
+#[test]
+fn negative_numbers_reach_tumbles_own_checks() {
+    for (args, expected) in [
+        (
+            vec!["--dt", "-1"],
+            "error: --dt: expected a time step > 0, got -1",
+        ),
+        (
+            vec!["--steps", "-5"],
+            "error: --steps: expected 1 to 1000000000 steps, got -5",
+        ),
+        (
+            vec!["--every", "-2"],
+            "error: --every: expected a value >= 1, got -2",
+        ),
+        (
+            vec!["--every", "0"],
+            "error: --every: expected a value >= 1, got 0",
+        ),
+    ] {
+        let output = tumble()
+            .args(["run", "projectile"])
+            .args(&args)
+            .output()
+            .unwrap();
+        assert_eq!(output.status.code(), Some(1), "{args:?}");
+        assert_eq!(error_line(&output), expected);
+    }
+}
+
+#[test]
+fn usage_errors_are_one_line_with_exit_code_2() {
+    let output = tumble()
+        .args(["run", "projectile", "--bogus"])
+        .output()
+        .unwrap();
+    assert_eq!(output.status.code(), Some(2));
+    assert_eq!(
+        error_line(&output),
+        "error: unexpected argument '--bogus' found (see --help)"
+    );
+    // A value that is not a number: clap's message, on one line, naming the flag.
+    let output = tumble()
+        .args(["run", "projectile", "--dt", "fast"])
+        .output()
+        .unwrap();
+    assert_eq!(output.status.code(), Some(2));
+    assert!(error_line(&output).contains("'--dt <DT>'"));
+    // A negative size for the benchmark is a bad value of its flag, not an unknown argument.
+    let output = tumble()
+        .args(["bench", "--max-bodies", "-1"])
+        .output()
+        .unwrap();
+    assert_eq!(output.status.code(), Some(2));
+    assert!(error_line(&output).starts_with("error: invalid value '-1' for '--max-bodies"));
+    // Help is not an error.
+    assert!(tumble().arg("--help").output().unwrap().status.success());
+}
+
+#[cfg(unix)]
+#[test]
+fn non_utf8_arguments_are_named_and_non_utf8_paths_work() {
+    use std::ffi::OsString;
+    use std::os::unix::ffi::OsStringExt;
+    let dir = tempfile::tempdir().unwrap();
+    let bad = |prefix: &str, suffix: &str| {
+        let mut bytes = prefix.as_bytes().to_vec();
+        bytes.push(0xff);
+        bytes.extend_from_slice(suffix.as_bytes());
+        OsString::from_vec(bytes)
+    };
+    // A scene file and an output whose names are not UTF-8 are ordinary files.
+    let scene = dir.path().join(bad("scene", ".toml"));
+    std::fs::copy(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/projectile.toml"),
+        &scene,
+    )
+    .unwrap();
+    let out = dir.path().join(bad("out", ".csv"));
+    let output = tumble()
+        .arg("run")
+        .arg(&scene)
+        .args(["--steps", "3", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(output.status.success(), "{}", stderr(&output));
+    assert!(
+        std::fs::read_to_string(&out)
+            .unwrap()
+            .starts_with(CSV_HEADER)
+    );
+    // A missing one is named (lossily) on one line.
+    let missing = dir.path().join(bad("missing", ".toml"));
+    let output = tumble().arg("run").arg(&missing).output().unwrap();
+    assert_eq!(output.status.code(), Some(1));
+    assert!(error_line(&output).contains("missing\u{fffd}.toml"));
+    // Values that must be text say which flag they belong to.
+    let output = tumble()
+        .args(["run", "projectile", "--integrator"])
+        .arg(bad("rk", ""))
+        .output()
+        .unwrap();
+    assert_eq!(output.status.code(), Some(1));
+    assert_eq!(
+        error_line(&output),
+        "error: --integrator: the value rk\u{fffd} is not valid UTF-8"
+    );
+    let output = tumble()
+        .args(["run", "projectile", "--steps"])
+        .arg(bad("1", ""))
+        .output()
+        .unwrap();
+    assert_eq!(output.status.code(), Some(2));
+    assert_eq!(
+        error_line(&output),
+        "error: --steps: the value 1\u{fffd} is not valid UTF-8"
+    );
+}
+
+#[test]
+fn warnings_reach_stderr_and_follow_rust_log_and_the_flags() {
+    // √(k/μ)Δt ≈ 9 for this chain: the planner warns before the run.
+    let args = ["run", "spring_chain", "--dt", "0.2", "--steps", "3"];
+    let output = tumble().args(args).output().unwrap();
+    let text = stderr(&output);
+    assert!(
+        text.contains("WARN") && text.contains("outside the stable region"),
+        "{text}"
+    );
+    let quiet = tumble().arg("-q").args(args).output().unwrap();
+    assert!(!stderr(&quiet).contains("WARN"), "{}", stderr(&quiet));
+    let off = tumble().args(args).env("RUST_LOG", "off").output().unwrap();
+    assert!(!stderr(&off).contains("WARN"), "{}", stderr(&off));
+    // -vv lowers the level: the warnings stay; -q and -v together are a usage error.
+    let verbose = tumble().arg("-vv").args(args).output().unwrap();
+    assert!(stderr(&verbose).contains("WARN"));
+    let both = tumble().args(["-q", "-v"]).args(args).output().unwrap();
+    assert_eq!(both.status.code(), Some(2));
+}
+
+#[test]
+fn a_rejected_body_exits_3_and_its_rows_stop() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("chain.csv");
+    let output = tumble()
+        .args([
+            "-q",
+            "run",
+            "spring_chain",
+            "--dt",
+            "0.2",
+            "--steps",
+            "50",
+            "--out",
+        ])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_eq!(output.status.code(), Some(3), "{}", stderr(&output));
+    assert_eq!(
+        error_line(&output),
+        "error: 3 of 3 bodies were rejected; their CSV rows stop at the step they were rejected on"
+    );
+    assert!(String::from_utf8_lossy(&output.stdout).contains("rejected   3 bodies"));
+    let csv = std::fs::read_to_string(&out).unwrap();
+    let last_step: u64 = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').next().unwrap().parse().unwrap())
+        .max()
+        .unwrap();
+    assert!(last_step < 50, "rows up to step {last_step}");
+    for line in csv.lines().skip(1) {
+        assert!(
+            line.split(',')
+                .skip(3)
+                .all(|x| x.parse::<f64>().unwrap().is_finite()),
+            "{line}"
+        );
+    }
+}
+
+#[cfg(target_os = "linux")]
+#[test]
+fn long_runs_show_a_progress_bar_on_a_terminal_only() {
+    let args = "run projectile --steps 2000000";
+    // `script` (util-linux) gives the run a pseudo-terminal.
+    let on_terminal = Command::new("script")
+        .args([
+            "-qec",
+            &format!("{} {args}", env!("CARGO_BIN_EXE_tumble")),
+            "/dev/null",
+        ])
+        .env_remove("RUST_LOG")
+        .stdin(std::process::Stdio::null())
+        .output()
+        .unwrap();
+    assert!(on_terminal.status.success());
+    let shown = String::from_utf8_lossy(&on_terminal.stdout);
+    assert!(shown.contains("/2,000,000 steps ["), "{shown}");
+    let piped = tumble().args(args.split(' ')).output().unwrap();
+    assert!(piped.status.success());
+    assert!(piped.stderr.is_empty(), "{}", stderr(&piped));
+    // A short run shows none, even on a terminal.
+    let short = Command::new("script")
+        .args([
+            "-qec",
+            &format!(
+                "{} run projectile --steps 1000",
+                env!("CARGO_BIN_EXE_tumble")
+            ),
+            "/dev/null",
+        ])
+        .stdin(std::process::Stdio::null())
+        .output()
+        .unwrap();
+    assert!(!String::from_utf8_lossy(&short.stdout).contains("steps ["));
+}

@@ -1,0 +1,520 @@
+//! Output files are safe (temporary file beside the output, exclusive, removed on every error and
+//! on SIGINT/SIGTERM, rename last; no device, FIFO, directory, read-only file or input file is
+//! replaced), big work shows itself, and every message is one line that names what the user gave.
+
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, ExitStatus, Output, Stdio};
+use std::time::{Duration, Instant};
+
+use tumble_scene::{CSV_HEADER, MAX_SCENE_BYTES};
+
+fn tumble() -> Command {
+    let mut command = Command::new(env!("CARGO_BIN_EXE_tumble"));
+    // Tests that look at stderr must not see the caller's log settings.
+    command.env_remove("RUST_LOG");
+    command
+}
+
+fn scene_path(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("../../scenes/{name}.toml"))
+}
+
+fn stderr(output: &Output) -> String {
+    String::from_utf8_lossy(&output.stderr).into_owned()
+}
+
+/// The one line on stderr of a failed command.
+fn error_line(output: &Output) -> String {
+    let text = stderr(output);
+    assert_eq!(text.lines().count(), 1, "one line: {text}");
+    text.trim_end().to_owned()
+}
+
+/// Names in `dir`, sorted.
+fn listing(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
+}
+
+/// Waits for `child`, killing it after `limit` (so that a test of a refusal fails, rather than
+/// hangs, on a build that starts the work instead).
+fn wait_at_most(child: &mut Child, limit: Duration) -> ExitStatus {
+    let start = Instant::now();
+    loop {
+        if let Some(status) = child.try_wait().unwrap() {
+            return status;
+        }
+        if start.elapsed() > limit {
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!("still running after {limit:?}");
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}
+
+fn run_to(out: &Path, extra: &[&str]) -> Output {
+    tumble()
+        .args(["run", "spring_chain", "--steps", "20"])
+        .args(extra)
+        .arg("--out")
+        .arg(out)
+        .output()
+        .unwrap()
+}
+
+#[cfg(unix)]
+#[test]
+fn devices_fifos_and_directories_are_refused_and_left_alone() {
+    use std::os::unix::fs::FileTypeExt;
+    let dir = tempfile::tempdir().unwrap();
+    let fifo = dir.path().join("fifo.csv");
+    assert!(
+        Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .unwrap()
+            .success()
+    );
+    let output = run_to(&fifo, &[]);
+    assert_eq!(output.status.code(), Some(1));
+    assert!(error_line(&output).contains("fifo.csv: is not a regular file"));
+    assert!(std::fs::metadata(&fifo).unwrap().file_type().is_fifo());
+    let sub = dir.path().join("sub");
+    std::fs::create_dir(&sub).unwrap();
+    let output = run_to(&sub, &[]);
+    assert!(error_line(&output).ends_with("sub: is a directory, expected a file"));
+    // /dev/null last: a build that replaced devices fails on the FIFO before it gets here.
+    let output = run_to(Path::new("/dev/null"), &[]);
+    assert_eq!(output.status.code(), Some(1));
+    assert_eq!(
+        error_line(&output),
+        "error: /dev/null: is not a regular file (a device, FIFO or socket); tumble writes only regular files"
+    );
+    assert!(
+        std::fs::metadata("/dev/null")
+            .unwrap()
+            .file_type()
+            .is_char_device()
+    );
+    assert_eq!(listing(dir.path()), ["fifo.csv", "sub"]);
+    assert!(listing(&sub).is_empty());
+    // `gen` follows the same rules.
+    let output = tumble()
+        .args(["gen", "many", "--n", "10", "--out", "/dev/null"])
+        .output()
+        .unwrap();
+    assert!(error_line(&output).contains("/dev/null: is not a regular file"));
+}
+
+#[cfg(unix)]
+#[test]
+fn nothing_planted_beside_the_output_is_followed_and_a_symlink_out_keeps_its_link() {
+    let dir = tempfile::tempdir().unwrap();
+    let victim = dir.path().join("victim.txt");
+    std::fs::write(&victim, "precious").unwrap();
+    // The temporary name of old builds, planted as a link to another file.
+    let out = dir.path().join("out.csv");
+    std::os::unix::fs::symlink(&victim, dir.path().join("out.csv.partial")).unwrap();
+    let output = run_to(&out, &[]);
+    assert!(output.status.success(), "{}", stderr(&output));
+    assert_eq!(std::fs::read_to_string(&victim).unwrap(), "precious");
+    assert!(
+        std::fs::read_to_string(&out)
+            .unwrap()
+            .starts_with(CSV_HEADER)
+    );
+    // A symlink `--out` replaces its target (a regular file) and stays a link.
+    let target = dir.path().join("target.csv");
+    std::fs::write(&target, "old").unwrap();
+    let link = dir.path().join("link.csv");
+    std::os::unix::fs::symlink("target.csv", &link).unwrap();
+    let output = run_to(&link, &[]);
+    assert!(output.status.success(), "{}", stderr(&output));
+    assert!(
+        std::fs::symlink_metadata(&link)
+            .unwrap()
+            .file_type()
+            .is_symlink()
+    );
+    assert_eq!(
+        std::fs::read_to_string(&target).unwrap(),
+        std::fs::read_to_string(&out).unwrap()
+    );
+    // A dangling link creates its target.
+    let dangling = dir.path().join("dangling.csv");
+    std::os::unix::fs::symlink("created.csv", &dangling).unwrap();
+    assert!(run_to(&dangling, &[]).status.success());
+    assert!(dir.path().join("created.csv").is_file());
+    // A link to a device is still a device.
+    let to_null = dir.path().join("null.csv");
+    std::os::unix::fs::symlink("/dev/null", &to_null).unwrap();
+    let output = run_to(&to_null, &[]);
+    assert!(error_line(&output).contains("null.csv: is not a regular file"));
+}
+
+#[test]
+fn the_scene_file_is_never_the_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("chain.toml");
+    let text = std::fs::read_to_string(scene_path("spring_chain")).unwrap();
+    std::fs::write(&scene, &text).unwrap();
+    let output = tumble()
+        .arg("run")
+        .arg(&scene)
+        .arg("--out")
+        .arg(&scene)
+        .output()
+        .unwrap();
+    assert_eq!(output.status.code(), Some(1));
+    assert!(
+        error_line(&output).contains("chain.toml: is the input file"),
+        "{}",
+        stderr(&output)
+    );
+    assert_eq!(std::fs::read_to_string(&scene).unwrap(), text);
+    // Another name for the same file (a hard link) is the same file.
+    let other = dir.path().join("other.csv");
+    std::fs::hard_link(&scene, &other).unwrap();
+    let output = tumble()
+        .arg("run")
+        .arg(&scene)
+        .arg("--out")
+        .arg(&other)
+        .output()
+        .unwrap();
+    assert_eq!(output.status.code(), Some(1));
+    assert_eq!(std::fs::read_to_string(&scene).unwrap(), text);
+    assert_eq!(listing(dir.path()), ["chain.toml", "other.csv"]);
+}
+
+#[cfg(unix)]
+#[test]
+fn a_read_only_output_is_an_error_and_a_writable_one_keeps_its_mode() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("ro.csv");
+    std::fs::write(&out, "keep").unwrap();
+    std::fs::set_permissions(&out, std::fs::Permissions::from_mode(0o444)).unwrap();
+    let output = run_to(&out, &[]);
+    assert_eq!(output.status.code(), Some(1));
+    assert!(error_line(&output).ends_with("ro.csv: is read-only"));
+    assert_eq!(std::fs::read_to_string(&out).unwrap(), "keep");
+    let mode = |p: &Path| std::fs::metadata(p).unwrap().permissions().mode() & 0o7777;
+    assert_eq!(mode(&out), 0o444);
+    let rw = dir.path().join("rw.csv");
+    std::fs::write(&rw, "old").unwrap();
+    // Giving the file away works only as root (as CI runs); the owner then stays too.
+    let given_away = std::os::unix::fs::chown(&rw, Some(65534), Some(65534)).is_ok();
+    std::fs::set_permissions(&rw, std::fs::Permissions::from_mode(0o640)).unwrap();
+    assert!(run_to(&rw, &[]).status.success());
+    assert_eq!(mode(&rw), 0o640);
+    if given_away {
+        use std::os::unix::fs::MetadataExt;
+        let meta = std::fs::metadata(&rw).unwrap();
+        assert_eq!((meta.uid(), meta.gid()), (65534, 65534));
+    }
+    assert!(
+        std::fs::read_to_string(&rw)
+            .unwrap()
+            .starts_with(CSV_HEADER)
+    );
+    assert_eq!(listing(dir.path()), ["ro.csv", "rw.csv"]);
+}
+
+#[test]
+fn names_up_to_255_bytes_work() {
+    let dir = tempfile::tempdir().unwrap();
+    let name = format!("{}.csv", "n".repeat(251));
+    assert_eq!(name.len(), 255);
+    let out = dir.path().join(&name);
+    let output = run_to(&out, &[]);
+    assert!(output.status.success(), "{}", stderr(&output));
+    assert_eq!(listing(dir.path()), [name]);
+}
+
+#[test]
+fn errors_name_the_given_path_escaped_on_one_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("no such dir").join("a\u{1b}[2Jb\nc.csv");
+    let output = run_to(&out, &[]);
+    assert_eq!(output.status.code(), Some(1));
+    let line = error_line(&output);
+    assert!(
+        line.contains("no such dir/a\\u{1b}[2Jb\\nc.csv: "),
+        "{line}"
+    );
+    assert!(
+        !line.contains(".tumble-") && !line.contains("partial"),
+        "{line}"
+    );
+}
+
+/// A run of 1e9 steps: 3e9 rows with `--every 1` (over 700 GB: refused without `--force`),
+/// 3e6 rows with `--every 1000`.
+const LONG_RUN: [&str; 4] = ["run", "spring_chain", "--steps", "1000000000"];
+
+/// Starts a long run writing to `out` and waits until its temporary file exists.
+fn start_long_run(dir: &Path, out: &Path, extra: &[&str]) -> Child {
+    let child = tumble()
+        .args(LONG_RUN)
+        .args(extra)
+        .arg("--out")
+        .arg(out)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    while listing(dir).iter().all(|n| !n.starts_with(".tumble-")) {
+        assert!(
+            start.elapsed() < Duration::from_secs(20),
+            "no temporary file"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    child
+}
+
+#[cfg(unix)]
+#[test]
+fn sigint_and_sigterm_remove_the_temporary_file_and_exit_130() {
+    for signal in ["-INT", "-TERM"] {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("long.csv");
+        let mut child = start_long_run(dir.path(), &out, &["--every", "1000"]);
+        assert!(
+            Command::new("kill")
+                .arg(signal)
+                .arg(child.id().to_string())
+                .status()
+                .unwrap()
+                .success()
+        );
+        let status = wait_at_most(&mut child, Duration::from_secs(20));
+        assert_eq!(status.code(), Some(130), "{signal}");
+        let mut message = String::new();
+        std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut message).unwrap();
+        assert!(
+            message.starts_with("error: interrupted after step ")
+                && message.trim_end().ends_with("long.csv was not written"),
+            "{message}"
+        );
+        assert!(listing(dir.path()).is_empty(), "{:?}", listing(dir.path()));
+    }
+}
+
+#[test]
+fn two_concurrent_runs_never_mix_their_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("shared.csv");
+    let args = |scene: &'static str| ["run", scene, "--steps", "40000"];
+    // Each run alone, for reference.
+    let mut alone = Vec::new();
+    for scene in ["spring_chain", "principal_spins"] {
+        let reference = dir.path().join(format!("{scene}.csv"));
+        let status = tumble()
+            .args(args(scene))
+            .arg("--out")
+            .arg(&reference)
+            .stdout(Stdio::null())
+            .status()
+            .unwrap();
+        assert!(status.success());
+        alone.push(std::fs::read(&reference).unwrap());
+    }
+    assert!(alone[0].len() > 1 << 20 && alone[1].len() > 1 << 20);
+    for _ in 0..3 {
+        let children: Vec<Child> = ["spring_chain", "principal_spins"]
+            .into_iter()
+            .map(|scene| {
+                tumble()
+                    .args(args(scene))
+                    .arg("--out")
+                    .arg(&out)
+                    .stdout(Stdio::null())
+                    .spawn()
+                    .unwrap()
+            })
+            .collect();
+        for mut child in children {
+            assert!(wait_at_most(&mut child, Duration::from_secs(60)).success());
+        }
+        let written = std::fs::read(&out).unwrap();
+        assert!(
+            written == alone[0] || written == alone[1],
+            "a mixed file of {} bytes",
+            written.len()
+        );
+    }
+    assert_eq!(
+        listing(dir.path()),
+        ["principal_spins.csv", "shared.csv", "spring_chain.csv"]
+    );
+}
+
+#[test]
+fn a_trajectory_bigger_than_the_free_space_is_refused_before_the_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("many.toml");
+    let status = tumble()
+        .args([
+            "gen",
+            "many",
+            "--n",
+            "1000",
+            "--steps",
+            "1000000000",
+            "--out",
+        ])
+        .arg(&scene)
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let out = dir.path().join("huge.csv");
+    let mut child = tumble()
+        .arg("run")
+        .arg(&scene)
+        .arg("--out")
+        .arg(&out)
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let status = wait_at_most(&mut child, Duration::from_secs(30));
+    assert_eq!(status.code(), Some(1));
+    let mut message = String::new();
+    std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut message).unwrap();
+    assert!(
+        message.starts_with("error: ")
+            && message.contains("huge.csv: the trajectory would take up to ")
+            && message.contains("(1000000001000 rows of up to ")
+            && message.contains(" free there")
+            && message.contains("--force"),
+        "{message}"
+    );
+    assert_eq!(listing(dir.path()), ["many.toml"]);
+}
+
+#[cfg(unix)]
+#[test]
+fn force_skips_the_free_space_check() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("forced.csv");
+    let refused = tumble()
+        .args(LONG_RUN)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(error_line(&refused).contains("more than the"));
+    // With --force it starts writing, and Ctrl-C stops it cleanly.
+    let mut child = start_long_run(dir.path(), &out, &["--force"]);
+    let _ = Command::new("kill")
+        .arg("-INT")
+        .arg(child.id().to_string())
+        .status();
+    assert_eq!(
+        wait_at_most(&mut child, Duration::from_secs(20)).code(),
+        Some(130)
+    );
+    assert!(listing(dir.path()).is_empty());
+}
+
+#[test]
+fn out_dash_writes_the_csv_to_stdout_and_the_summary_to_stderr() {
+    let output = tumble()
+        .args(["run", "projectile", "--steps", "3", "--out", "-"])
+        .output()
+        .unwrap();
+    assert!(output.status.success(), "{}", stderr(&output));
+    let csv = String::from_utf8(output.stdout.clone()).unwrap();
+    let mut lines = csv.lines();
+    assert_eq!(lines.next(), Some(CSV_HEADER));
+    assert_eq!(lines.count(), 4, "{csv}");
+    assert!(stderr(&output).contains("scene      projectile"));
+    assert!(!Path::new("-").exists());
+    let generated = tumble()
+        .args(["gen", "many", "--n", "3", "--out", "-"])
+        .output()
+        .unwrap();
+    assert!(generated.status.success());
+    assert!(generated.stdout.starts_with(b"name = \"many-3\""));
+    // An empty path is no file name.
+    let output = tumble()
+        .args(["run", "projectile", "--out", ""])
+        .output()
+        .unwrap();
+    assert_eq!(output.status.code(), Some(2));
+    assert!(error_line(&output).contains("'--out <OUT>'"));
+}
+
+#[test]
+fn gen_writes_only_what_run_accepts() {
+    for (args, expected) in [
+        (
+            vec!["--steps", "0"],
+            "error: --steps: expected 1 to 1000000000 steps, got 0",
+        ),
+        (
+            vec!["--steps", "1000000001"],
+            "error: --steps: expected 1 to 1000000000 steps, got 1000000001",
+        ),
+        (
+            vec!["--n", "0"],
+            "error: --n: expected 1 to 200000 bodies, got 0",
+        ),
+        (
+            vec!["--n", "200001"],
+            "error: --n: expected 1 to 200000 bodies, got 200001",
+        ),
+        (
+            vec!["--n", "-3"],
+            "error: --n: expected 1 to 200000 bodies, got -3",
+        ),
+    ] {
+        let output = tumble().args(["gen", "many"]).args(&args).output().unwrap();
+        assert_eq!(output.status.code(), Some(1), "{args:?}");
+        assert!(error_line(&output).starts_with(expected), "{args:?}");
+        assert!(output.stdout.is_empty());
+    }
+    // The cap fits under the loader's size limit.
+    let at_cap = tumble()
+        .args(["gen", "many", "--n", "200000", "--steps", "1000000000"])
+        .output()
+        .unwrap();
+    assert!(at_cap.status.success());
+    assert!((at_cap.stdout.len() as u64) < MAX_SCENE_BYTES);
+}
+
+#[test]
+fn report_and_bench_name_an_output_that_is_not_a_directory_before_working() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("taken");
+    std::fs::write(&file, "x").unwrap();
+    for command in ["report", "bench"] {
+        let mut child = tumble()
+            .args([command, "--quick", "--out"])
+            .arg(&file)
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        let status = wait_at_most(&mut child, Duration::from_secs(60));
+        assert_eq!(status.code(), Some(1), "{command}");
+        let mut message = String::new();
+        std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut message).unwrap();
+        assert_eq!(
+            message.trim_end(),
+            format!(
+                "error: {}: exists and is not a directory",
+                file.to_string_lossy()
+            ),
+            "{command}"
+        );
+    }
+    assert_eq!(std::fs::read_to_string(&file).unwrap(), "x");
+}

@@ -1,0 +1,379 @@
+//! Output files written safely: one rule for every file tumble writes (trajectories, generated
+//! scenes, the report's and the benchmark's files).
+//!
+//! [`OutputFile::create`] checks the output path, then opens a temporary file in the output's
+//! directory with a unique, unpredictable name, exclusively (`O_EXCL`: never through a planted
+//! file or symlink). The caller writes into it; [`OutputFile::commit`] renames it over the output
+//! as the last step. Dropped without a commit (an error, Ctrl-C), the temporary file is removed.
+//! So the output is either the old file or the complete new one, never a mix; two writers to the
+//! same output each have their own temporary file, and the last rename wins.
+//!
+//! The output path must name a regular file or nothing:
+//! - a directory, a device (`/dev/null`), a FIFO or a socket is refused: replacing it by a
+//!   regular file would destroy it;
+//! - a symbolic link is resolved (up to 40 links), and its final target must be a regular file
+//!   or absent: the target is replaced (or created), the link stays;
+//! - an existing file without write permission is refused, as a shell redirect would refuse it
+//!   (also for root, who could write it: read-only is taken as the owner's intent);
+//! - an existing file keeps its permission bits (and its owner and group where the process may
+//!   set them); a new one gets `0o666` less the umask;
+//! - a path that is one of the run's input files (same device and inode) is refused.
+//!
+//! Every error names the path the caller gave, made safe for a terminal
+//! ([`path_for_terminal`]).
+
+use std::fs::{File, Metadata, OpenOptions};
+use std::io::{self, Write};
+use std::path::{Path, PathBuf};
+
+use tempfile::NamedTempFile;
+use thiserror::Error;
+
+use crate::text::path_for_terminal;
+
+/// Most symbolic links followed when resolving an output path (Linux's `MAXSYMLINKS`).
+pub const MAX_SYMLINKS: usize = 40;
+
+/// Why an output file or directory cannot be written.
+#[derive(Debug, Error)]
+pub enum OutputError {
+    /// The output names a directory.
+    #[error("{}: is a directory, expected a file", path_for_terminal(.path))]
+    IsDirectory {
+        /// The path the caller gave.
+        path: PathBuf,
+    },
+    /// The output names something else that is not a regular file.
+    #[error(
+        "{}: is not a regular file (a device, FIFO or socket); tumble writes only regular files",
+        path_for_terminal(.path)
+    )]
+    NotRegularFile {
+        /// The path the caller gave.
+        path: PathBuf,
+    },
+    /// An output directory names an existing file that is not a directory.
+    #[error("{}: exists and is not a directory", path_for_terminal(.path))]
+    NotDirectory {
+        /// The path the caller gave.
+        path: PathBuf,
+    },
+    /// The output exists and has no write permission.
+    #[error("{}: is read-only", path_for_terminal(.path))]
+    ReadOnly {
+        /// The path the caller gave.
+        path: PathBuf,
+    },
+    /// The output is one of the run's input files.
+    #[error(
+        "{}: is the input file {}; refusing to overwrite it",
+        path_for_terminal(.path),
+        path_for_terminal(.input)
+    )]
+    IsInput {
+        /// The path the caller gave.
+        path: PathBuf,
+        /// The input it resolves to.
+        input: PathBuf,
+    },
+    /// More than [`MAX_SYMLINKS`] symbolic links, or a loop.
+    #[error("{}: too many levels of symbolic links", path_for_terminal(.path))]
+    SymlinkLoop {
+        /// The path the caller gave.
+        path: PathBuf,
+    },
+    /// The output path is empty.
+    #[error("the output path is empty")]
+    EmptyPath,
+    /// An I/O error while checking, writing or renaming.
+    #[error("{}: {source}", path_for_terminal(.path))]
+    Io {
+        /// The path the caller gave.
+        path: PathBuf,
+        /// What the operating system said.
+        source: io::Error,
+    },
+}
+
+impl OutputError {
+    /// An I/O error on the output `path`.
+    pub fn io(path: &Path, source: io::Error) -> Self {
+        Self::Io {
+            path: path.to_owned(),
+            source,
+        }
+    }
+
+    /// The path the caller gave.
+    pub fn path(&self) -> &Path {
+        match self {
+            Self::IsDirectory { path }
+            | Self::NotRegularFile { path }
+            | Self::NotDirectory { path }
+            | Self::ReadOnly { path }
+            | Self::IsInput { path, .. }
+            | Self::SymlinkLoop { path }
+            | Self::Io { path, .. } => path,
+            Self::EmptyPath => Path::new(""),
+        }
+    }
+}
+
+/// A file being written: a temporary file beside the output, renamed over it by
+/// [`commit`](Self::commit) (see the [module](self) documentation for the rules).
+#[derive(Debug)]
+pub struct OutputFile {
+    temp: NamedTempFile,
+    target: PathBuf,
+    path: PathBuf,
+}
+
+impl OutputFile {
+    /// Checks `path` and opens the temporary file that will replace it. `inputs` are the files
+    /// the run reads (e.g. the scene file); `path` may not resolve to any of them.
+    pub fn create(path: &Path, inputs: &[&Path]) -> Result<Self, OutputError> {
+        if path.as_os_str().is_empty() {
+            return Err(OutputError::EmptyPath);
+        }
+        let target = resolve_links(path)?;
+        let existing = metadata_if_exists(path, &target)?;
+        if let Some(meta) = &existing {
+            check_replaceable(path, &target, meta)?;
+            for input in inputs {
+                // An input that cannot be examined cannot be the same file as an existing output.
+                if same_file::is_same_file(&target, input).unwrap_or(false) {
+                    return Err(OutputError::IsInput {
+                        path: path.to_owned(),
+                        input: input.to_path_buf(),
+                    });
+                }
+            }
+        }
+        let dir = match target.parent() {
+            Some(dir) if !dir.as_os_str().is_empty() => dir,
+            _ => Path::new("."),
+        };
+        // A short fixed-length name: an output name at the file system's limit (255 bytes)
+        // still works, which `<name>.partial` would not. The random part makes it unpredictable
+        // and `tempfile` creates it with O_EXCL, so nothing planted there is ever opened.
+        let mut builder = tempfile::Builder::new();
+        builder.prefix(".tumble-").suffix(".tmp");
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::PermissionsExt;
+            // What a shell redirect would create; the umask applies.
+            builder.permissions(std::fs::Permissions::from_mode(0o666));
+        }
+        let temp = builder
+            .tempfile_in(dir)
+            .map_err(|e| OutputError::io(path, without_temp_path(e)))?;
+        if let Some(meta) = &existing {
+            #[cfg(unix)]
+            {
+                use std::os::unix::fs::MetadataExt;
+                // Best effort: the owner and group stay when we may set them (root may; others
+                // only to a group of theirs). Before the mode, since a change of owner clears
+                // the set-id bits.
+                let _ =
+                    std::os::unix::fs::fchown(temp.as_file(), Some(meta.uid()), Some(meta.gid()));
+            }
+            // Set explicitly: the mode given at creation is reduced by the umask.
+            temp.as_file()
+                .set_permissions(meta.permissions())
+                .map_err(|e| OutputError::io(path, e))?;
+        }
+        Ok(Self {
+            temp,
+            target,
+            path: path.to_owned(),
+        })
+    }
+
+    /// The path the caller gave.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// The file that will be replaced: the path with its symbolic links resolved.
+    pub fn target(&self) -> &Path {
+        &self.target
+    }
+
+    /// The temporary file (to write into, or to query its file system).
+    pub fn file(&self) -> &File {
+        self.temp.as_file()
+    }
+
+    /// Flushes the data to disk and renames the temporary file over the output. On error the
+    /// temporary file is removed and the output is left as it was.
+    pub fn commit(self) -> Result<(), OutputError> {
+        let Self { temp, target, path } = self;
+        // Durable before visible: after a crash the output is the old file or the whole new one.
+        temp.as_file()
+            .sync_all()
+            .map_err(|e| OutputError::io(&path, e))?;
+        // The output may have been replaced while we wrote: check again just before the rename.
+        if let Some(meta) = metadata_if_exists(&path, &target)? {
+            check_replaceable(&path, &target, &meta)?;
+        }
+        temp.persist(&target)
+            .map_err(|e| OutputError::io(&path, without_temp_path(e.error)))?;
+        Ok(())
+    }
+}
+
+impl Write for OutputFile {
+    fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+        self.temp.write(buf)
+    }
+
+    fn flush(&mut self) -> io::Result<()> {
+        self.temp.flush()
+    }
+}
+
+/// Writes `bytes` to `path` through an [`OutputFile`] (checked, atomic).
+pub fn write_atomically(path: &Path, bytes: &[u8], inputs: &[&Path]) -> Result<(), OutputError> {
+    let mut file = OutputFile::create(path, inputs)?;
+    file.write_all(bytes)
+        .map_err(|e| OutputError::io(path, e))?;
+    file.commit()
+}
+
+/// Makes sure `path` is a directory, creating it (and its parents) if absent; an existing
+/// non-directory is an error that names it.
+pub fn create_directory(path: &Path) -> Result<(), OutputError> {
+    match std::fs::metadata(path) {
+        Ok(meta) if meta.is_dir() => Ok(()),
+        Ok(_) => Err(OutputError::NotDirectory {
+            path: path.to_owned(),
+        }),
+        Err(e) if e.kind() == io::ErrorKind::NotFound => {
+            std::fs::create_dir_all(path).map_err(|e| OutputError::io(path, e))
+        }
+        Err(e) => Err(OutputError::io(path, e)),
+    }
+}
+
+/// The operating system's error without the temporary path `tempfile` adds to it (`… at path
+/// "…"`): messages name the output the user gave, not a random name they never saw.
+fn without_temp_path(e: io::Error) -> io::Error {
+    if e.raw_os_error().is_some() {
+        return e;
+    }
+    match e.to_string().split_once(" at path ") {
+        Some((message, _)) => io::Error::new(e.kind(), message.to_owned()),
+        None => e,
+    }
+}
+
+/// `path` with the symbolic links of its last component followed; links in the directories
+/// above are left to the operating system (they lead the temporary file and the rename to the
+/// same directory).
+fn resolve_links(path: &Path) -> Result<PathBuf, OutputError> {
+    let mut current = path.to_path_buf();
+    for _ in 0..=MAX_SYMLINKS {
+        match std::fs::symlink_metadata(&current) {
+            Ok(meta) if meta.file_type().is_symlink() => {
+                let link = std::fs::read_link(&current).map_err(|e| OutputError::io(path, e))?;
+                current = match current.parent() {
+                    Some(parent) if link.is_relative() => parent.join(link),
+                    _ => link,
+                };
+            }
+            Ok(_) => return Ok(current),
+            Err(e) if e.kind() == io::ErrorKind::NotFound => return Ok(current),
+            Err(e) => return Err(OutputError::io(path, e)),
+        }
+    }
+    Err(OutputError::SymlinkLoop {
+        path: path.to_owned(),
+    })
+}
+
+fn metadata_if_exists(path: &Path, target: &Path) -> Result<Option<Metadata>, OutputError> {
+    match std::fs::symlink_metadata(target) {
+        Ok(meta) => Ok(Some(meta)),
+        Err(e) if e.kind() == io::ErrorKind::NotFound => Ok(None),
+        Err(e) => Err(OutputError::io(path, e)),
+    }
+}
+
+fn check_replaceable(path: &Path, target: &Path, meta: &Metadata) -> Result<(), OutputError> {
+    let path = path.to_owned();
+    if meta.is_dir() {
+        return Err(OutputError::IsDirectory { path });
+    }
+    if meta.file_type().is_symlink() {
+        // Replaced by a link since it was resolved: resolve again rather than guess.
+        return Err(OutputError::io(
+            &path,
+            io::Error::other("changed into a symbolic link while being written"),
+        ));
+    }
+    if !meta.is_file() {
+        return Err(OutputError::NotRegularFile { path });
+    }
+    if meta.permissions().readonly() {
+        return Err(OutputError::ReadOnly { path });
+    }
+    // Write permission as the kernel sees it (owner, group, ACLs); nothing is truncated.
+    OpenOptions::new()
+        .write(true)
+        .open(target)
+        .map(drop)
+        .map_err(|e| match e.kind() {
+            io::ErrorKind::PermissionDenied => OutputError::ReadOnly { path: path.clone() },
+            _ => OutputError::io(&path, e),
+        })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn commit_replaces_the_output_and_a_dropped_file_leaves_nothing() {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("out.csv");
+        std::fs::write(&out, "old").unwrap();
+        let mut file = OutputFile::create(&out, &[]).unwrap();
+        file.write_all(b"new").unwrap();
+        assert_eq!(std::fs::read_to_string(&out).unwrap(), "old");
+        file.commit().unwrap();
+        assert_eq!(std::fs::read_to_string(&out).unwrap(), "new");
+        let mut file = OutputFile::create(&out, &[]).unwrap();
+        file.write_all(b"partial").unwrap();
+        drop(file);
+        assert_eq!(std::fs::read_to_string(&out).unwrap(), "new");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
+
+    #[test]
+    fn directories_and_inputs_are_refused_naming_the_given_path() {
+        let dir = tempfile::tempdir().unwrap();
+        let err = OutputFile::create(dir.path(), &[]).unwrap_err();
+        assert!(matches!(err, OutputError::IsDirectory { .. }), "{err}");
+        let input = dir.path().join("scene\u{1b}.toml");
+        std::fs::write(&input, "x").unwrap();
+        let err = OutputFile::create(&input, &[&input]).unwrap_err();
+        assert!(matches!(err, OutputError::IsInput { .. }), "{err}");
+        assert!(err.to_string().contains("scene\\u{1b}.toml"), "{err}");
+        let err = create_directory(&input).unwrap_err();
+        assert!(matches!(err, OutputError::NotDirectory { .. }), "{err}");
+        let err = OutputFile::create(Path::new(""), &[]).unwrap_err();
+        assert_eq!(err.to_string(), "the output path is empty");
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_symlink_loop_is_an_error() {
+        let dir = tempfile::tempdir().unwrap();
+        let (a, b) = (dir.path().join("a"), dir.path().join("b"));
+        std::os::unix::fs::symlink(&b, &a).unwrap();
+        std::os::unix::fs::symlink(&a, &b).unwrap();
+        let err = OutputFile::create(&a, &[]).unwrap_err();
+        assert!(matches!(err, OutputError::SymlinkLoop { .. }), "{err}");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 2);
+    }
+}
