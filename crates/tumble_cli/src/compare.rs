@@ -5,11 +5,17 @@ use tumble_core::exact::TorqueFreeTop;
 use tumble_core::math::{Narrow, Quat, Real, Vec3, Widen, to_f64};
 use tumble_core::{BodyState, Integrator};
 use tumble_rapier::{ComparisonBody, ComparisonOptions, ComparisonScene, Load, compare};
+use tumble_scene::text::terminal_safe;
 use tumble_scene::{ForceDef, Scene};
+
+use crate::exit::{self, Failure};
 
 /// Builds the comparison and prints, per body, the largest difference to rapier and to the
 /// exact solution where one exists, and the speed ratio.
-pub fn run(scene: &Scene, integrator: Integrator, gyroscopic: bool) -> Result<(), String> {
+///
+/// A body that tumble quarantined, or whose state went non-finite in either engine, is named on
+/// stderr and the command fails with [`exit::REJECTED`]: its differences are not a comparison.
+pub fn run(scene: &Scene, integrator: Integrator, gyroscopic: bool) -> Result<(), Failure> {
     let states = scene.body_states();
     let mut bodies: Vec<ComparisonBody> = states
         .iter()
@@ -25,7 +31,7 @@ pub fn run(scene: &Scene, integrator: Integrator, gyroscopic: bool) -> Result<()
     for force in &scene.file.forces {
         match force {
             ForceDef::Constant { body, force, point } => {
-                let i = index(body).ok_or("unknown body")?;
+                let i = index(body).ok_or_else(|| Failure::from("unknown body"))?;
                 let f = glam::DVec3::from_array(*force).narrow();
                 let p = point.map(|p| glam::DVec3::from_array(p).narrow());
                 bodies[i].loads.push(Load::Force {
@@ -34,18 +40,18 @@ pub fn run(scene: &Scene, integrator: Integrator, gyroscopic: bool) -> Result<()
                 });
             }
             ForceDef::Torque { body, torque } => {
-                let i = index(body).ok_or("unknown body")?;
+                let i = index(body).ok_or_else(|| Failure::from("unknown body"))?;
                 bodies[i]
                     .loads
                     .push(Load::Torque(glam::DVec3::from_array(*torque).narrow()));
             }
             ForceDef::Spring { .. } => {
-                return Err(format!(
+                return Err(Failure::from(format!(
                     "scene `{}` has springs, which the rapier comparison does not model (rapier \
                      has no spring force generator); supported: free bodies, gravity, gravity \
                      scale, constant forces (at points) and torques, damping",
-                    scene.file.name
-                ));
+                    terminal_safe(&scene.file.name)
+                )));
             }
         }
     }
@@ -111,7 +117,7 @@ pub fn run(scene: &Scene, integrator: Integrator, gyroscopic: bool) -> Result<()
     let result = compare(&comparison, &options, Some(&exact));
     println!(
         "scene {} · tumble `{integrator}` vs rapier 0.36 (gyroscopic {}, 4 substeps) · {} steps of {} s",
-        scene.file.name,
+        terminal_safe(&scene.file.name),
         if gyroscopic { "on" } else { "off" },
         options.steps,
         scene.dt
@@ -146,5 +152,25 @@ pub fn run(scene: &Scene, integrator: Integrator, gyroscopic: bool) -> Result<()
         result.rapier_ns_per_step,
         result.speed_ratio()
     );
+    let unclean: Vec<_> = result.bodies.iter().filter(|d| !d.is_clean()).collect();
+    for d in &unclean {
+        let name = terminal_safe(&d.name);
+        if let Some(step) = d.tumble_rejected_at {
+            tracing::error!(target: "tumble", "body `{name}`: tumble quarantined it at step {step}; its differences after that step compare a frozen state");
+        }
+        if let Some(step) = d.non_finite_at {
+            tracing::error!(target: "tumble", "body `{name}`: a state went non-finite at step {step} (NaN in the table)");
+        }
+    }
+    if !unclean.is_empty() {
+        return Err(Failure::new(
+            exit::REJECTED,
+            format!(
+                "{} of {} bodies did not run cleanly (named above); the comparison is not valid for them",
+                unclean.len(),
+                result.bodies.len()
+            ),
+        ));
+    }
     Ok(())
 }

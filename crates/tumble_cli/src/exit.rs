@@ -13,10 +13,6 @@ pub const USAGE: u8 = 2;
 /// The run finished, but a body was rejected (quarantined) or diverged.
 pub const REJECTED: u8 = 3;
 /// tumble predicts the step unstable for the scene: refused unless `--allow-unstable`.
-#[allow(
-    dead_code,
-    reason = "the stability gate (planning-time predictions) is still to come"
-)]
 pub const UNSTABLE: u8 = 4;
 /// Interrupted by SIGINT or SIGTERM (128 + SIGINT, as shells report it); nothing was written.
 pub const INTERRUPTED: u8 = 130;

@@ -20,9 +20,18 @@ pub fn level(verbose: u8, quiet: bool) -> LevelFilter {
 /// Installs a `fmt` subscriber on stderr: `RUST_LOG` directives (ignored where malformed) over
 /// the default level from the flags; colour only on a terminal.
 pub fn init(verbose: u8, quiet: bool) {
-    let filter = EnvFilter::builder()
-        .with_default_directive(level(verbose, quiet).into())
-        .from_env_lossy();
+    let level = level(verbose, quiet);
+    let filter = match std::env::var("RUST_LOG") {
+        Ok(directives) if !directives.trim().is_empty() => EnvFilter::builder()
+            .with_default_directive(level.into())
+            .parse_lossy(directives),
+        // The CLI names bodies and springs as the scene does when it reports predictions and
+        // quarantines (target `tumble`); the engine's own events say the same with entity ids,
+        // so by default they are kept to errors. `RUST_LOG` shows them.
+        _ => EnvFilter::builder().parse_lossy(format!(
+            "{level},tumble_ecs::schedule=error,tumble_ecs::validate=error"
+        )),
+    };
     // `try_init`: a second subscriber (none today) must not make the CLI panic.
     let _ = tracing_subscriber::fmt()
         .with_env_filter(filter)

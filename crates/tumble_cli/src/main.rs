@@ -9,6 +9,7 @@ mod generate;
 mod interrupt;
 mod logging;
 mod run;
+mod summary;
 
 use std::ffi::OsString;
 use std::path::{Path, PathBuf};
@@ -203,10 +204,15 @@ fn dispatch(cli: Cli) -> Result<(), Failure> {
                 }
                 None => scene.integrator,
             };
-            // For the stability gate (exit::UNSTABLE unless allowed), to come with the
-            // planning-time predictions.
-            let _allow_unstable = allow_unstable;
-            compare::run(&scene, integrator, gyroscopic == "on").map_err(Failure::from)
+            // The same planning-time predictions as `run`, for tumble's side of the comparison.
+            let mut built = scene.build();
+            built
+                .world
+                .resource_mut::<tumble_ecs::prelude::PhysicsSettings>()
+                .integrator = integrator;
+            let names = summary::Names::new(&mut built.world, &built.bodies);
+            run::stability_gate(&mut built, &names, allow_unstable)?;
+            compare::run(&scene, integrator, gyroscopic == "on")
         }
         Command::Report(options) => {
             tumble_report::run::run_report(&options).map_err(|e| Failure::from(e.to_string()))

@@ -8,9 +8,7 @@ use std::time::Instant;
 
 use bevy_ecs::prelude::*;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressFinish, ProgressStyle};
-use tumble_core::invariants::{angular_momentum, kinetic_energy};
-use tumble_core::math::{Real, Vec3, Widen, to_f64};
-use tumble_ecs::components::body_state;
+use tumble_core::math::{Real, to_f64};
 use tumble_ecs::prelude::*;
 use tumble_scene::output::{OutputError, OutputFile};
 use tumble_scene::text::{path_for_terminal, terminal_safe};
@@ -19,6 +17,7 @@ use tumble_scene::{BuiltScene, MAX_STEPS, Scene, SceneError, TrajectoryError, cs
 use crate::cli::RunArgs;
 use crate::exit::{self, Failure};
 use crate::interrupt;
+use crate::summary::{self, Names, quarantine_line, warning_line};
 
 /// Runs longer than this many body-steps show a progress bar (when stderr is a terminal).
 pub const PROGRESS_BODY_STEPS: f64 = 1e6;
@@ -86,30 +85,24 @@ pub fn run(args: RunArgs) -> Result<(), Failure> {
         println!("{}", PhysicsPlan::for_world(&mut built.world));
         return Ok(());
     }
-    // For the stability gate (exit::UNSTABLE unless allowed), to come with the planning-time
-    // predictions.
-    let _allow_unstable = args.allow_unstable;
+    let names = Names::new(&mut built.world, &built.bodies);
+    stability_gate(&mut built, &names, args.allow_unstable)?;
     let steps = scene.steps;
     let to_stdout = args.out.as_deref().is_some_and(crate::is_stdout);
 
-    // Energy and angular momentum are invariants only of free, undamped bodies.
-    let invariant = scene.gravity.is_none()
-        && scene.file.forces.is_empty()
-        && scene
-            .file
-            .bodies
-            .iter()
-            .all(|b| b.linear_damping == 0.0 && b.angular_damping == 0.0);
-    let before = totals(&mut built.world);
+    let conserved = summary::conserved(&mut built.world);
+    let before = summary::totals(&mut built.world);
+    let mut reported = 0;
     let start = Instant::now();
     // Created before the output file, dropped after it: a second signal while the temporary
     // file is being removed cannot cut that short.
     let guard = interrupt::Guard::poll();
     let bar = progress_bar(steps, built.bodies.len());
-    let mut on_step = |step: u64| {
+    let mut on_step = |step: u64, world: &World| {
         if step.is_multiple_of(PROGRESS_EVERY) {
             bar.set_position(step);
         }
+        reported = report_quarantines(world, &names, step, reported);
         if guard.interrupted() {
             ControlFlow::Break(())
         } else {
@@ -153,7 +146,7 @@ pub fn run(args: RunArgs) -> Result<(), Failure> {
             for step in 1..=steps {
                 built.schedule.run(&mut built.world);
                 built.world.clear_trackers();
-                if on_step(step).is_break() {
+                if on_step(step, &built.world).is_break() {
                     return Err(interrupted(step, None));
                 }
             }
@@ -161,7 +154,7 @@ pub fn run(args: RunArgs) -> Result<(), Failure> {
     }
     bar.finish_and_clear();
     let wall = start.elapsed();
-    let after = totals(&mut built.world);
+    let after = summary::totals(&mut built.world);
     let body_steps = (steps as f64) * built.bodies.len().max(1) as f64;
     let (dt, integrator) = {
         let settings = built.world.resource::<PhysicsSettings>();
@@ -184,12 +177,23 @@ pub fn run(args: RunArgs) -> Result<(), Failure> {
             wall.as_nanos() as f64 / body_steps
         ),
     ];
-    if invariant {
-        lines.push(format!("energy     {}", drift(before.0, after.0)));
-        lines.push(format!("|L|        {}", drift(before.1, after.1)));
-    }
+    // Totals over every body, quarantined ones at their last valid state.
+    let energy = summary::drift(before.0, after.0, "J");
+    lines.push(match conserved.energy {
+        None => format!("energy     {energy} (kinetic + spring + gravity)"),
+        Some(why) => {
+            format!("energy     {energy} (kinetic + spring + gravity; not conserved: {why})")
+        }
+    });
+    let momentum = summary::drift(before.1.length(), after.1.length(), "kg·m²/s");
+    lines.push(match conserved.momentum {
+        None => format!("|L|        {momentum} (about the origin)"),
+        Some(why) => format!("|L|        {momentum} (about the origin; not conserved: {why})"),
+    });
     if rejected > 0 {
-        lines.push(format!("rejected   {rejected} bodies (see warnings)"));
+        lines.push(format!(
+            "rejected   {rejected} bodies (named above, on stderr)"
+        ));
     }
     for line in lines {
         // A closed stdout (`| head`) must not turn a finished run into a panic.
@@ -302,25 +306,44 @@ fn human_bytes(bytes: u64) -> String {
     }
 }
 
-/// The relative drift `after/before − 1`, or the absolute change when `before` is zero.
-fn drift(before: f64, after: f64) -> String {
-    if before == 0.0 {
-        format!("absolute change {:.3e} (zero at the start)", after - before)
-    } else {
-        format!("relative drift {:.3e}", after / before - 1.0)
+
+/// Prints the planning-time predictions, naming bodies and springs; refuses a world predicted to
+/// diverge unless `allow` (then the run is energy-audited, so that a divergence is caught while
+/// the state is still finite). Precision warnings are printed and do not refuse the run.
+pub fn stability_gate(built: &mut BuiltScene, names: &Names, allow: bool) -> Result<(), Failure> {
+    let warnings = check_stability(&mut built.world);
+    for warning in &warnings {
+        tracing::warn!(target: "tumble", "{}", warning_line(warning, names));
     }
+    let unstable = warnings.iter().filter(|w| w.is_instability()).count();
+    if unstable == 0 {
+        return Ok(());
+    }
+    if !allow {
+        return Err(Failure::new(
+            exit::UNSTABLE,
+            format!(
+                "{unstable} setting(s) outside the integrator's stable region (warnings above); \
+                 nothing was run; lower the time step or the stiffness, or pass \
+                 --allow-unstable to run anyway"
+            ),
+        ));
+    }
+    built.world.insert_resource(EnergyAudit::Always);
+    built.schedule = PhysicsPlan::for_world(&mut built.world).build_schedule();
+    Ok(())
 }
 
-/// Total kinetic energy and |ΣL| of the bodies.
-fn totals(world: &mut World) -> (f64, f64) {
-    let mut q = world.query_filtered::<(&Transform, &Velocity, &MassProps), With<RigidBody>>();
-    let (mut e, mut l) = (0.0, Vec3::ZERO.widen());
-    for (t, v, m) in q.iter(world) {
-        let s = body_state(t, v, m);
-        e += to_f64(kinetic_energy(&s, m));
-        l += angular_momentum(&s, m).widen();
+/// Logs every quarantine recorded since the first `reported` errors, with the step it happened
+/// on; returns the new count.
+fn report_quarantines(world: &World, names: &Names, step: u64, reported: usize) -> usize {
+    let Some(errors) = world.get_resource::<PhysicsErrors>() else {
+        return reported;
+    };
+    for error in errors.0.iter().skip(reported) {
+        tracing::error!(target: "tumble", "{}", quarantine_line(error, step, world, names));
     }
-    (e, l.length())
+    errors.0.len()
 }
 
 #[cfg(test)]

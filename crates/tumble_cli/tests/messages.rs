@@ -23,6 +23,14 @@ fn error_line(output: &Output) -> String {
     text.trim_end().to_owned()
 }
 
+/// The final `error:` line of a run that also logged warnings or quarantines before it.
+fn last_error_line(output: &Output) -> String {
+    let text = stderr(output);
+    let errors: Vec<&str> = text.lines().filter(|l| l.starts_with("error: ")).collect();
+    assert_eq!(errors.len(), 1, "one error line: {text}");
+    errors[0].to_owned()
+}
+
 #[test]
 fn negative_numbers_reach_tumbles_own_checks() {
     for (args, expected) in [
@@ -177,6 +185,7 @@ fn a_rejected_body_exits_3_and_its_rows_stop() {
             "0.2",
             "--steps",
             "50",
+            "--allow-unstable",
             "--out",
         ])
         .arg(&out)
@@ -184,7 +193,7 @@ fn a_rejected_body_exits_3_and_its_rows_stop() {
         .unwrap();
     assert_eq!(output.status.code(), Some(3), "{}", stderr(&output));
     assert_eq!(
-        error_line(&output),
+        last_error_line(&output),
         "error: 3 of 3 bodies were rejected; their CSV rows stop at the step they were rejected on"
     );
     assert!(String::from_utf8_lossy(&output.stdout).contains("rejected   3 bodies"));
@@ -197,13 +206,70 @@ fn a_rejected_body_exits_3_and_its_rows_stop() {
         .unwrap();
     assert!(last_step < 50, "rows up to step {last_step}");
     for line in csv.lines().skip(1) {
+        // Not only finite: the energy audit stops the chain before its state is garbage (the
+        // chain starts within 3 m of the origin; an unchecked run reaches 1e19 m).
         assert!(
             line.split(',')
                 .skip(3)
-                .all(|x| x.parse::<f64>().unwrap().is_finite()),
+                .all(|x| x.parse::<f64>().unwrap().abs() < 1e3),
             "{line}"
         );
     }
+}
+
+#[test]
+fn a_predicted_divergence_is_refused_with_exit_4_unless_allowed() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("chain.csv");
+    let output = tumble()
+        .args(["run", "spring_chain", "--dt", "0.2", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_eq!(output.status.code(), Some(4), "{}", stderr(&output));
+    let text = stderr(&output);
+    // Each warning names the spring as the scene file does, before the refusal.
+    assert!(text.contains("forces[0] (spring)"), "{text}");
+    assert!(
+        last_error_line(&output).contains("--allow-unstable"),
+        "{text}"
+    );
+    assert!(!out.exists(), "nothing is written for a refused run");
+    // Quarantines are named with their step and the state kept.
+    let allowed = tumble()
+        .args([
+            "run",
+            "spring_chain",
+            "--dt",
+            "0.2",
+            "--steps",
+            "5",
+            "--allow-unstable",
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(allowed.status.code(), Some(3));
+    let text = stderr(&allowed);
+    assert!(
+        text.contains("body `m1` quarantined at step 1: energy grew")
+            && text.contains("it keeps its last valid state: position [1.2"),
+        "{text}"
+    );
+}
+
+#[test]
+fn the_summary_gives_total_energy_and_never_an_unexplained_nan() {
+    let output = tumble()
+        .args(["run", "spring_chain", "--steps", "100"])
+        .output()
+        .unwrap();
+    assert!(output.status.success(), "{}", stderr(&output));
+    let text = String::from_utf8_lossy(&output.stdout);
+    let energy = text.lines().find(|l| l.starts_with("energy")).unwrap();
+    assert!(energy.contains("kinetic + spring + gravity"), "{energy}");
+    assert!(energy.contains("not conserved: damping"), "{energy}");
+    assert!(text.lines().any(|l| l.starts_with("|L|")), "{text}");
+    assert!(!text.contains("NaN") && !text.contains("inf"), "{text}");
 }
 
 #[cfg(target_os = "linux")]
@@ -241,4 +307,34 @@ fn long_runs_show_a_progress_bar_on_a_terminal_only() {
         .output()
         .unwrap();
     assert!(!String::from_utf8_lossy(&short.stdout).contains("steps ["));
+}
+
+#[test]
+fn compare_never_reports_a_quarantined_body_as_agreement() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("thin.toml");
+    std::fs::write(
+        &scene,
+        "name = \"thin\"\n[world]\ndt = 0.016666668\nsteps = 300\n\
+         integrator = \"symplectic-euler\"\n[[bodies]]\nname = \"thin\"\nmass = 1.0\n\
+         inertia = [0.01, 1.0, 1.005]\nangular_velocity = [1.0, 60.0, 1.0]\n",
+    )
+    .unwrap();
+    // Predicted: refused.
+    let refused = tumble().arg("compare").arg(&scene).output().unwrap();
+    assert_eq!(refused.status.code(), Some(4), "{}", stderr(&refused));
+    // Allowed: the explicit spin diverges, tumble quarantines it, and compare says so.
+    let output = tumble()
+        .arg("compare")
+        .arg(&scene)
+        .arg("--allow-unstable")
+        .output()
+        .unwrap();
+    assert_eq!(output.status.code(), Some(3), "{}", stderr(&output));
+    let text = stderr(&output);
+    assert!(
+        text.contains("body `thin`: tumble quarantined it at step"),
+        "{text}"
+    );
+    assert!(last_error_line(&output).contains("did not run cleanly"));
 }

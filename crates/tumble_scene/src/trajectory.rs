@@ -53,8 +53,9 @@ pub enum TrajectoryError {
 ///   leading `'`; a name holding `,`, `"`, a line feed or a carriage return is quoted as in
 ///   RFC 4180. Scene files reject such names anyway; library users may name bodies freely.
 ///
-/// `on_step(step)` is called after each step (1 ..= `steps`) has been run and its rows written:
-/// report progress there, and return [`ControlFlow::Break`] to stop (the result is then
+/// `on_step(step, world)` is called after each step (1 ..= `steps`) has been run and its rows
+/// written: report progress or read the world there (e.g. new
+/// [`PhysicsErrors`](tumble_ecs::validate::PhysicsErrors)), and return [`ControlFlow::Break`] to stop (the result is then
 /// [`TrajectoryError::Stopped`]). `out` is buffered here; pass it unbuffered. Rows already
 /// written stay in `out` on error: write to a temporary file and rename it only on success
 /// (see [`crate::output::OutputFile`]).
@@ -63,7 +64,7 @@ pub fn write_trajectory(
     steps: u64,
     every: NonZeroU64,
     out: impl Write,
-    mut on_step: impl FnMut(u64) -> ControlFlow<()>,
+    mut on_step: impl FnMut(u64, &World) -> ControlFlow<()>,
 ) -> Result<(), TrajectoryError> {
     let dt = scene
         .world
@@ -85,7 +86,7 @@ pub fn write_trajectory(
         if step.is_multiple_of(every.get()) {
             write_rows(&mut w, scene, &names, step, dt)?;
         }
-        if on_step(step).is_break() {
+        if on_step(step, &scene.world).is_break() {
             w.flush()?;
             return Err(TrajectoryError::Stopped { step });
         }
@@ -178,7 +179,7 @@ mod tests {
             steps,
             NonZeroU64::new(every).unwrap(),
             &mut out,
-            |_| ControlFlow::Continue(()),
+            |_, _| ControlFlow::Continue(()),
         )
         .unwrap();
         String::from_utf8(out).unwrap()
@@ -202,7 +203,7 @@ mod tests {
         assert_eq!(rows.len(), 3 * 3);
         assert_eq!((rows[8][0], rows[8][1], rows[8][2]), ("6", "0.75", "m3"));
         built.world.remove_resource::<PhysicsSettings>();
-        let err = write_trajectory(&mut built, 1, NonZeroU64::MIN, std::io::sink(), |_| {
+        let err = write_trajectory(&mut built, 1, NonZeroU64::MIN, std::io::sink(), |_, _| {
             ControlFlow::Continue(())
         })
         .unwrap_err();
@@ -213,14 +214,20 @@ mod tests {
     fn the_callback_sees_every_step_and_can_stop_the_run() {
         let mut built = chain();
         let mut seen = Vec::new();
-        let err = write_trajectory(&mut built, 10, NonZeroU64::MIN, std::io::sink(), |step| {
-            seen.push(step);
-            if step == 3 {
-                ControlFlow::Break(())
-            } else {
-                ControlFlow::Continue(())
-            }
-        })
+        let err = write_trajectory(
+            &mut built,
+            10,
+            NonZeroU64::MIN,
+            std::io::sink(),
+            |step, _| {
+                seen.push(step);
+                if step == 3 {
+                    ControlFlow::Break(())
+                } else {
+                    ControlFlow::Continue(())
+                }
+            },
+        )
         .unwrap_err();
         assert!(matches!(err, TrajectoryError::Stopped { step: 3 }), "{err}");
         assert_eq!(seen, [1, 2, 3]);

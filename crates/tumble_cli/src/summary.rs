@@ -1,0 +1,214 @@
+//! What `tumble run` and `tumble compare` say about a world: the invariants of its summary,
+//! planning-time warnings and quarantined bodies, each naming bodies and forces as the scene file
+//! does.
+
+use std::collections::HashMap;
+
+use bevy_ecs::prelude::*;
+use glam::DVec3;
+use tumble_core::math::{Vec3, Widen};
+use tumble_ecs::prelude::*;
+use tumble_scene::text::terminal_safe;
+
+/// Names of a built scene's entities: bodies by their `name`, force generators as
+/// `forces[i] (kind)` in file order.
+pub struct Names(HashMap<Entity, String>);
+
+impl Names {
+    /// Names for `world`, whose bodies are `bodies` (`(name, entity)` in file order). Force
+    /// generators were spawned in file order after the bodies, so their entity order is the
+    /// file order.
+    pub fn new(world: &mut World, bodies: &[(String, Entity)]) -> Self {
+        let mut names: HashMap<Entity, String> = bodies
+            .iter()
+            .map(|(name, e)| (*e, format!("body `{}`", terminal_safe(name))))
+            .collect();
+        let mut forces: Vec<(Entity, &'static str)> = world
+            .query::<(Entity, Has<Spring>, Has<ConstantForce>, Has<ConstantTorque>)>()
+            .iter(world)
+            .filter_map(|(e, spring, force, torque)| match (spring, force, torque) {
+                (true, _, _) => Some((e, "spring")),
+                (_, true, _) => Some((e, "constant force")),
+                (_, _, true) => Some((e, "torque")),
+                _ => None,
+            })
+            .collect();
+        forces.sort_by_key(|(e, _)| e.index());
+        for (i, (e, kind)) in forces.into_iter().enumerate() {
+            names.insert(e, format!("forces[{i}] ({kind})"));
+        }
+        Self(names)
+    }
+
+    /// The name of `entity`, or its id when it is not part of the scene.
+    pub fn of(&self, entity: Entity) -> String {
+        self.0
+            .get(&entity)
+            .cloned()
+            .unwrap_or_else(|| format!("entity {entity}"))
+    }
+}
+
+/// A planning-time warning, naming the body or spring as the scene does.
+pub fn warning_line(warning: &StabilityWarning, names: &Names) -> String {
+    let subject = match *warning {
+        StabilityWarning::StiffSpring { spring, .. } => spring,
+        StabilityWarning::ExplicitGyroscopic { body, .. } => body,
+        StabilityWarning::CoarsePosition { body, .. } => body,
+    };
+    let text = warning.to_string();
+    // `Display` starts with the entity ("spring 12v0: …"); say the scene's name instead.
+    let detail = text.split_once(": ").map_or(text.as_str(), |(_, d)| d);
+    format!("{}: {detail}", names.of(subject))
+}
+
+/// A quarantined body: which, when, why, and the last valid state it keeps.
+pub fn quarantine_line(error: &BodyError, step: u64, world: &World, names: &Names) -> String {
+    let kept = match (
+        world.get::<Transform>(error.entity),
+        world.get::<Velocity>(error.entity),
+    ) {
+        (Some(t), Some(v)) => format!(
+            "; it keeps its last valid state: position {}, rotation {}, velocity {}, angular \
+             velocity {}",
+            vector(t.translation),
+            quaternion(t.rotation.to_array()),
+            vector(v.linear),
+            vector(v.angular)
+        ),
+        _ => String::new(),
+    };
+    // The error's own text starts with the entity id; the kind alone says why.
+    format!(
+        "{} quarantined at step {step}: {}{kept}",
+        names.of(error.entity),
+        error.kind
+    )
+}
+
+fn vector(v: Vec3) -> String {
+    format!("[{:.6e}, {:.6e}, {:.6e}]", v.x, v.y, v.z)
+}
+
+fn quaternion(q: [tumble_core::math::Real; 4]) -> String {
+    format!("[{:.6}, {:.6}, {:.6}, {:.6}]", q[0], q[1], q[2], q[3])
+}
+
+/// Total mechanical energy (J, f64): kinetic `Σ ½m|v|² + ½ωᵀIω`, elastic `Σ ½k(|d| − L₀)²` of
+/// the springs, and gravitational `−Σ m s g·x` (centre of mass; zero at the origin), and the
+/// total angular momentum about the origin `Σ (x × m v + I ω)`.
+pub fn totals(world: &mut World) -> (f64, DVec3) {
+    let g = world
+        .get_resource::<Gravity>()
+        .map_or(DVec3::ZERO, |g| g.0.widen());
+    let mut bodies = world.query_filtered::<(
+        &Transform,
+        &Velocity,
+        &MassProps,
+        Option<&GravityScale>,
+        Has<Static>,
+        Has<Kinematic>,
+    ), With<RigidBody>>();
+    let (mut energy, mut momentum) = (0.0, DVec3::ZERO);
+    for (t, v, m, scale, fixed, kinematic) in bodies.iter(world) {
+        if fixed || kinematic {
+            continue;
+        }
+        let mass = m.mass().widen();
+        let x = t.center_of_mass(m).widen();
+        let lin = v.linear.widen();
+        let spin = m.world_inertia_mul(t.rotation, v.angular).widen();
+        energy += 0.5 * mass * lin.length_squared() + 0.5 * v.angular.widen().dot(spin);
+        energy -= mass * scale.map_or(1.0, |s| s.0.widen()) * g.dot(x);
+        momentum += x.cross(mass * lin) + spin;
+    }
+    let springs: Vec<Spring> = world.query::<&Spring>().iter(world).copied().collect();
+    for s in springs {
+        let point =
+            |e: Entity, local: Vec3| world.get::<Transform>(e).map(|t| t.transform_point(local));
+        let pb = match s.b {
+            SpringEnd::World(p) => Some(p),
+            SpringEnd::Body { body, anchor } => point(body, anchor),
+        };
+        if let (Some(pa), Some(pb)) = (point(s.a, s.anchor_a), pb) {
+            let stretch = (pa - pb).widen().length() - s.rest_length.widen();
+            energy += 0.5 * s.stiffness.widen() * stretch * stretch;
+        }
+    }
+    (energy, momentum)
+}
+
+/// Which totals a world conserves, and why not where it does not.
+pub struct Conserved {
+    /// `None` when the mechanical energy is conserved, else what changes it.
+    pub energy: Option<&'static str>,
+    /// `None` when the angular momentum about the origin is conserved, else what changes it.
+    pub momentum: Option<&'static str>,
+}
+
+/// What the world's contents allow: damping (of bodies or springs) removes energy, constant
+/// forces and torques do work; gravity keeps the energy (it is counted) but turns the momentum,
+/// as do springs to fixed points and constant loads.
+pub fn conserved(world: &mut World) -> Conserved {
+    let damped_bodies = world
+        .query::<&Damping>()
+        .iter(world)
+        .any(|d| d.linear != 0.0 || d.angular != 0.0);
+    let springs: Vec<Spring> = world.query::<&Spring>().iter(world).copied().collect();
+    let damped_springs = springs.iter().any(|s| s.damping != 0.0);
+    let fixed = |world: &World, e: Entity| {
+        world.get::<Static>(e).is_some() || world.get::<Kinematic>(e).is_some()
+    };
+    let anchored = springs.iter().any(|s| match s.b {
+        SpringEnd::World(_) => true,
+        SpringEnd::Body { body, .. } => fixed(world, body) || fixed(world, s.a),
+    });
+    let loads = world.query::<&ConstantForce>().iter(world).next().is_some()
+        || world
+            .query::<&ConstantTorque>()
+            .iter(world)
+            .next()
+            .is_some();
+    let gravity = world
+        .get_resource::<Gravity>()
+        .is_some_and(|g| g.0 != Vec3::ZERO);
+    let energy = if damped_bodies || damped_springs {
+        Some("damping removes energy")
+    } else if loads {
+        Some("constant forces and torques do work")
+    } else {
+        None
+    };
+    let momentum = if damped_bodies {
+        Some("damping")
+    } else if loads {
+        Some("constant forces and torques")
+    } else if gravity {
+        Some("gravity")
+    } else if anchored {
+        Some("springs to fixed points")
+    } else {
+        None
+    };
+    Conserved { energy, momentum }
+}
+
+/// `after` against `before` in words: the relative drift, or the absolute change from zero.
+/// Never prints NaN or infinity without saying why.
+pub fn drift(before: f64, after: f64, unit: &str) -> String {
+    if !(before.is_finite() && after.is_finite()) {
+        return format!("not finite ({before:e} → {after:e} {unit}): a body's state overflowed");
+    }
+    if before == 0.0 {
+        format!(
+            "{after:.6e} {unit} from 0 (absolute change {:.3e})",
+            after - before
+        )
+    } else {
+        // Relative to |before|: a total that includes gravity's potential may be negative.
+        format!(
+            "{before:.6e} → {after:.6e} {unit}, relative drift {:.3e}",
+            (after - before) / before.abs()
+        )
+    }
+}
