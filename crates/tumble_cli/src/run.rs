@@ -306,7 +306,6 @@ fn human_bytes(bytes: u64) -> String {
     }
 }
 
-
 /// Prints the planning-time predictions, naming bodies and springs; refuses a world predicted to
 /// diverge unless `allow` (then the run is energy-audited, so that a divergence is caught while
 /// the state is still finite). Precision warnings are printed and do not refuse the run.
