@@ -6,8 +6,8 @@ use tumble_core::math::{Quat, REAL_NAME, Real, Vec3};
 use bevy_ecs::prelude::*;
 use bevy_ecs::schedule::Schedule;
 
-use tumble_core::shapes::mass_properties_of;
-use tumble_core::shapes::parry::shape::{Ball, Capsule, Cone, ConvexPolyhedron, Cuboid, Cylinder};
+use tumble_core::shapes::parry::shape::{Ball, Capsule, Cone, Cuboid, Cylinder};
+use tumble_core::shapes::{HullError, convex_hull_mass_properties, mass_properties_of};
 use tumble_core::{Density, Integrator, Mass, MassProperties};
 use tumble_ecs::prelude::*;
 
@@ -450,28 +450,26 @@ fn shape_mass(
                 .iter()
                 .map(|p| ck.vec3("bodies", Some(i), "shape", *p))
                 .collect::<Result<_, _>>()?;
-            let hull = ConvexPolyhedron::from_convex_hull(&pts).ok_or_else(|| {
-                ck.error(
-                    "bodies",
-                    Some(i),
-                    "shape",
-                    "convex hull is degenerate (needs 4 points spanning a volume)",
-                )
-            })?;
-            mass_properties_of(&hull, density)
+            return convex_hull_mass_properties(&pts, density).map_err(|e| match e {
+                HullError::Mass(e) => mass_error(ck, i, e),
+                e => ck.error("bodies", Some(i), "shape", e.to_string()),
+            });
         }
     };
-    result.map_err(|e| {
-        ck.error(
-            "bodies",
-            Some(i),
-            "shape",
-            format!(
-                "{e}: expected dimensions and a density whose mass and moments of inertia are \
-                 finite and > 0 in {REAL_NAME}"
-            ),
-        )
-    })
+    result.map_err(|e| mass_error(ck, i, e))
+}
+
+/// A shape whose mass properties are not valid.
+fn mass_error(ck: &Checker<'_>, i: usize, e: tumble_core::InvalidInput) -> SceneError {
+    ck.error(
+        "bodies",
+        Some(i),
+        "shape",
+        format!(
+            "{e}: expected dimensions and a density whose mass and moments of inertia are \
+             finite and > 0 in {REAL_NAME}"
+        ),
+    )
 }
 
 /// Why a body name cannot be used, if it cannot: names are CSV cells and must stay one cell.
