@@ -186,7 +186,7 @@ fn run(cli: Cli) -> Result<(), String> {
                 Some(name) => name
                     .parse()
                     .map_err(|e: tumble_core::integrate::UnknownIntegrator| e.to_string())?,
-                None => scene.integrator,
+                None => scene.integrator(),
             };
             compare::run(&scene, integrator, gyroscopic == "on")
         }
@@ -210,12 +210,12 @@ fn run(cli: Cli) -> Result<(), String> {
             let mut scene = Scene::parse(&file, &text).map_err(|e| e.to_string())?;
             if steps.is_some() || dt.is_some() || integrator.is_some() {
                 // Overrides are applied to the file model, then validated like the file itself.
-                let mut model = scene.file.clone();
+                let mut model = scene.file().clone();
                 model.world.steps = steps.unwrap_or(model.world.steps);
                 model.world.dt = dt.unwrap_or(model.world.dt);
                 let overridden = integrator.is_some();
                 model.world.integrator = integrator.or(model.world.integrator);
-                let text = tumble_scene::to_toml_string(&model);
+                let text = tumble_scene::to_toml_string(&model).map_err(|e| e.to_string())?;
                 scene = Scene::parse(&file, &text)
                     .map_err(|e| override_error(e, dt, steps, overridden))?;
             }
@@ -225,20 +225,20 @@ fn run(cli: Cli) -> Result<(), String> {
                 return Ok(());
             }
             // Energy and angular momentum are invariants only of free, undamped bodies.
-            let invariant = scene.gravity.is_none()
-                && scene.file.forces.is_empty()
+            let invariant = scene.gravity().is_none()
+                && scene.file().forces.is_empty()
                 && scene
-                    .file
+                    .file()
                     .bodies
                     .iter()
                     .all(|b| b.linear_damping == 0.0 && b.angular_damping == 0.0);
             let before = totals(&mut built.world);
             let start = Instant::now();
             match &out {
-                Some(path) => write_trajectory(&mut built, scene.dt, scene.steps, every, path)
+                Some(path) => write_trajectory(&mut built, scene.dt(), scene.steps(), every, path)
                     .map_err(|e| format!("{}: {e}", path.display()))?,
                 None => {
-                    for _ in 0..scene.steps {
+                    for _ in 0..scene.steps() {
                         built.schedule.run(&mut built.world);
                         built.world.clear_trackers();
                     }
@@ -246,12 +246,14 @@ fn run(cli: Cli) -> Result<(), String> {
             }
             let wall = start.elapsed();
             let after = totals(&mut built.world);
-            let body_steps = (scene.steps as f64) * built.bodies.len().max(1) as f64;
-            println!("scene      {}", scene.file.name);
+            let body_steps = (scene.steps() as f64) * built.bodies.len().max(1) as f64;
+            println!("scene      {}", scene.file().name);
             println!("bodies     {}", built.bodies.len());
             println!(
                 "steps      {} × {} s ({})",
-                scene.steps, scene.dt, scene.integrator
+                scene.steps(),
+                scene.dt(),
+                scene.integrator()
             );
             println!(
                 "wall time  {:.3} s, {:.1} ns per body-step",
