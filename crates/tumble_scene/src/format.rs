@@ -8,7 +8,8 @@ use exact_fns as exact;
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SceneFile {
-    /// Scene name.
+    /// Scene name: non-empty, at most [`crate::MAX_NAME_BYTES`] bytes, no control or format
+    /// characters (it is printed to terminals and reports).
     pub name: String,
     /// Time step, step count, integrator, gravity.
     pub world: WorldDef,
@@ -24,7 +25,7 @@ pub struct SceneFile {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct WorldDef {
-    /// Seconds per step, > 0.
+    /// Seconds per step, > 0, and neither 0 nor infinite once rounded to the engine precision.
     pub dt: f64,
     /// Number of steps, 1..=1e9.
     pub steps: u64,
@@ -67,7 +68,9 @@ pub enum ShapeDef {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BodyDef {
-    /// Unique name.
+    /// Unique name, with the rules of the scene name, and since it is a CSV cell: no comma or
+    /// quote, and no leading `=`, `+`, `-` or `@` (a spreadsheet would run the cell as a
+    /// formula).
     pub name: String,
     /// Mass (kg), with `inertia`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
