@@ -205,11 +205,11 @@ fn numbers_in_messages_are_compact() {
         ("-1e300", "-1e300"),
         ("1e300", "1e300"),
     ] {
-        let text = format!("name = \"x\"\n[world]\ndt = {dt}\nsteps = 1\n");
-        let e = Scene::parse("x.toml", &text).unwrap_err();
         if tumble_core::math::DOUBLE_PRECISION && !dt.starts_with('-') {
             continue; // fits in f64
         }
+        let text = format!("name = \"x\"\n[world]\ndt = {dt}\nsteps = 1\n");
+        let e = Scene::parse("x.toml", &text).unwrap_err();
         assert!(e.message.contains(shown), "{e}");
         assert!(e.message.len() < 120, "{e}");
     }
