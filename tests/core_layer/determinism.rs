@@ -14,7 +14,7 @@ fn scene_bits() -> Vec<u64> {
         let e = world
             .spawn((
                 RigidBody,
-                mass_props(1.0 + f * 0.1, [1.0, 1.0 + f * 0.01, 2.0 + f * 0.02]),
+                mass_props(1.0 + f * 0.1, [1.0, 1.0 + f * 0.01, 1.9 + f * 0.01]),
                 Transform {
                     translation: Vec3::new(f, (f * 0.7).sin(), 0.0),
                     rotation: Quat::from_rotation_y(f * 0.1),
