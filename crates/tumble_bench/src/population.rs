@@ -23,7 +23,7 @@ pub fn scene(n: usize) -> ComparisonScene {
             let f = (i as Real + 0.5) / n as Real;
             let g = ((i as Real) * 0.618_034).fract();
             let mass = Mass::new(0.5 + f).expect("positive mass");
-            let inertia = Vec3::new(1.0, 2.0 + f, 3.0 + 2.0 * g) * mass.get();
+            let inertia = Vec3::new(1.0, 2.0 + f, 3.0 + f * g) * mass.get();
             let properties = MassProperties::new(mass, inertia).expect("valid inertia");
             let side = (n as Real).cbrt().ceil().max(1.0) as usize;
             let cell = Vec3::new(

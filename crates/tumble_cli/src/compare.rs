@@ -19,16 +19,16 @@ pub fn run(scene: &Scene, integrator: Integrator, gyroscopic: bool) -> Result<()
     let states = scene.body_states();
     let mut bodies: Vec<ComparisonBody> = states
         .iter()
-        .map(|(name, mass, state, scale, lin, ang)| {
-            let mut b = ComparisonBody::new(name.clone(), *mass, *state);
-            b.gravity_scale = *scale;
-            b.linear_damping = *lin;
-            b.angular_damping = *ang;
+        .map(|s| {
+            let mut b = ComparisonBody::new(s.name.clone(), s.mass, s.state);
+            b.gravity_scale = s.gravity_scale;
+            b.linear_damping = s.linear_damping;
+            b.angular_damping = s.angular_damping;
             b
         })
         .collect();
-    let index = |name: &str| states.iter().position(|s| s.0 == name);
-    for force in &scene.file.forces {
+    let index = |name: &str| states.iter().position(|s| s.name == name);
+    for force in &scene.file().forces {
         match force {
             ForceDef::Constant { body, force, point } => {
                 let i = index(body).ok_or_else(|| Failure::from("unknown body"))?;
@@ -50,20 +50,20 @@ pub fn run(scene: &Scene, integrator: Integrator, gyroscopic: bool) -> Result<()
                     "scene `{}` has springs, which the rapier comparison does not model (rapier \
                      has no spring force generator); supported: free bodies, gravity, gravity \
                      scale, constant forces (at points) and torques, damping",
-                    terminal_safe(&scene.file.name)
+                    terminal_safe(&scene.name())
                 )));
             }
         }
     }
     let comparison = ComparisonScene {
-        dt: scene.dt,
-        gravity: scene.gravity,
+        dt: scene.dt(),
+        gravity: scene.gravity(),
         bodies,
     };
     // Exact solutions for bodies without loads or damping: the position is the parabola
     // x₀ + v₀t + ½ g s t²; the orientation is a steady rotation for a spherical body, or the
     // elliptic torque-free top for distinct moments (identity principal frame).
-    let gravity = scene.gravity.unwrap_or(Vec3::ZERO).widen();
+    let gravity = scene.gravity().unwrap_or(Vec3::ZERO).widen();
     let exact_for: Vec<Option<(Option<TorqueFreeTop>, bool)>> = comparison
         .bodies
         .iter()
@@ -112,15 +112,15 @@ pub fn run(scene: &Scene, integrator: Integrator, gyroscopic: bool) -> Result<()
         integrator,
         gyroscopic,
         rapier_solver_iterations: 4,
-        steps: scene.steps.min(1_000_000) as usize,
+        steps: scene.steps().min(1_000_000) as usize,
     };
     let result = compare(&comparison, &options, Some(&exact));
     println!(
         "scene {} · tumble `{integrator}` vs rapier 0.36 (gyroscopic {}, 4 substeps) · {} steps of {} s",
-        terminal_safe(&scene.file.name),
+        terminal_safe(&scene.name()),
         if gyroscopic { "on" } else { "off" },
         options.steps,
-        scene.dt
+        scene.dt()
     );
     println!(
         "{:<16} {:>11} {:>12} {:>11} {:>11} {:>21} {:>21}",

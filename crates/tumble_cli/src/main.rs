@@ -202,7 +202,7 @@ fn dispatch(cli: Cli) -> Result<(), Failure> {
                             format!("--integrator: {e}")
                         })?
                 }
-                None => scene.integrator,
+                None => scene.integrator(),
             };
             // The same planning-time predictions as `run`, for tumble's side of the comparison.
             let mut built = scene.build();

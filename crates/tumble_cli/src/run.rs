@@ -71,12 +71,12 @@ pub fn run(args: RunArgs) -> Result<(), Failure> {
     let mut scene = Scene::parse(&loaded.file, &loaded.text)?;
     if steps.is_some() || args.dt.is_some() || integrator.is_some() {
         // Overrides are applied to the file model, then validated like the file itself.
-        let mut model = scene.file.clone();
+        let mut model = scene.file().clone();
         model.world.steps = steps.unwrap_or(model.world.steps);
         model.world.dt = args.dt.unwrap_or(model.world.dt);
         let overridden = integrator.is_some();
         model.world.integrator = integrator.or(model.world.integrator);
-        let text = tumble_scene::to_toml_string(&model);
+        let text = tumble_scene::to_toml_string(&model)?;
         scene = Scene::parse(&loaded.file, &text)
             .map_err(|e| override_error(e, args.dt, steps, overridden))?;
     }
@@ -87,7 +87,7 @@ pub fn run(args: RunArgs) -> Result<(), Failure> {
     }
     let names = Names::new(&mut built.world, &built.bodies);
     stability_gate(&mut built, &names, args.allow_unstable)?;
-    let steps = scene.steps;
+    let steps = scene.steps();
     let to_stdout = args.out.as_deref().is_some_and(crate::is_stdout);
 
     let conserved = summary::conserved(&mut built.world);
@@ -168,7 +168,7 @@ pub fn run(args: RunArgs) -> Result<(), Failure> {
         Box::new(std::io::stdout().lock())
     };
     let mut lines = vec![
-        format!("scene      {}", terminal_safe(&scene.file.name)),
+        format!("scene      {}", terminal_safe(scene.name())),
         format!("bodies     {}", built.bodies.len()),
         format!("steps      {steps} × {dt} s ({integrator})"),
         format!(

@@ -196,7 +196,7 @@ fn gen_many_writes_a_valid_scene() {
         .unwrap();
     assert!(status.success());
     let scene = load_scene(&out).unwrap();
-    assert_eq!(scene.file.bodies.len(), 1000);
+    assert_eq!(scene.file().bodies.len(), 1000);
     let run = tumble().args(["run"]).arg(&out).output().unwrap();
     assert!(
         run.status.success(),

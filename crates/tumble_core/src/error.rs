@@ -1,6 +1,6 @@
 //! Typed errors for invalid physical input.
 
-use crate::math::{Quat, Real, Vec3};
+use crate::math::{Quat, REAL_NAME, Real, Vec3};
 use thiserror::Error;
 
 /// Largest accepted deviation `||q| − 1|` of a rotation quaternion.
@@ -21,13 +21,13 @@ pub enum InvalidInput {
         value: String,
     },
     /// Mass must be strictly positive and finite.
-    #[error("mass must be > 0 and finite, got {0}")]
+    #[error("mass must be > 0 and finite, got {}", compact(*.0))]
     NonPositiveMass(Real),
     /// Density must be strictly positive and finite.
-    #[error("density must be > 0 and finite, got {0}")]
+    #[error("density must be > 0 and finite, got {}", compact(*.0))]
     NonPositiveDensity(Real),
     /// A principal moment of inertia is negative (or NaN).
-    #[error("principal inertia must be >= 0 on every axis, got [{}, {}, {}]", .0[0], .0[1], .0[2])]
+    #[error("principal inertia must be >= 0 on every axis, got [{}, {}, {}]", compact(.0[0]), compact(.0[1]), compact(.0[2]))]
     NegativeInertia([Real; 3]),
     /// All principal moments are zero: the body could not rotate at all and has no inertia tensor.
     #[error("principal inertia is zero on every axis; give at least one axis a positive moment")]
@@ -43,8 +43,45 @@ pub enum InvalidInput {
         norm: Real,
     },
     /// The time step must be strictly positive and finite.
-    #[error("time step must be > 0 and finite, got {0}")]
+    #[error("time step must be > 0 and finite, got {}", compact(*.0))]
     NonPositiveTimeStep(Real),
+    /// A mass or principal moment whose reciprocal is not a finite, normal number in the build
+    /// precision ([`Real`]): the engine stores `1/m` and `1/I`, so such a body would be
+    /// quarantined at its first step (or move with a garbage inverse).
+    #[error(
+        "{field} {} has no usable reciprocal in {REAL_NAME}; expected a value between {} and {}",
+        compact(*.value),
+        compact(*.min),
+        compact(*.max)
+    )]
+    ReciprocalOutOfRange {
+        /// Which quantity, e.g. `"mass"`.
+        field: &'static str,
+        /// The offending value.
+        value: Real,
+        /// The smallest accepted value.
+        min: Real,
+        /// The largest accepted value.
+        max: Real,
+    },
+    /// Principal moments that violate the triangle inequality `I_a ≤ I_b + I_c`, which every
+    /// rigid body satisfies (see [`crate::MassProperties::new`]).
+    #[error(
+        "principal inertia [{}, {}, {}] violates the triangle inequality: {} > {} + {}; no rigid \
+         body has such moments (each must be at most the sum of the other two)",
+        compact(.moments[0]),
+        compact(.moments[1]),
+        compact(.moments[2]),
+        compact(.moments[*.axis]),
+        compact(.moments[(*.axis + 1) % 3]),
+        compact(.moments[(*.axis + 2) % 3])
+    )]
+    TriangleInequality {
+        /// The principal moments.
+        moments: [Real; 3],
+        /// The axis whose moment is too large.
+        axis: usize,
+    },
     /// Saved data whose parts disagree (e.g. moments and their stored reciprocals).
     #[error("inconsistent saved data: {0}")]
     Inconsistent(&'static str),
@@ -83,5 +120,21 @@ pub fn check_time_step(dt: Real) -> Result<(), InvalidInput> {
         Ok(())
     } else {
         Err(InvalidInput::NonPositiveTimeStep(dt))
+    }
+}
+
+/// A number formatted compactly for messages: plain decimals between `1e-4` and `1e6`, the
+/// shortest exponent form (`1e-50`, `3.4028235e38`) outside that range, so that a tiny or huge
+/// value never prints as hundreds of digits. The digits are the shortest that read back as the
+/// same value in the number's own type (`f32` or `f64`).
+pub fn compact<T>(x: T) -> String
+where
+    T: Copy + Into<f64> + std::fmt::Display + std::fmt::LowerExp,
+{
+    let magnitude = x.into().abs();
+    if magnitude == 0.0 || !magnitude.is_finite() || (1e-4..1e6).contains(&magnitude) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
     }
 }

@@ -4,20 +4,57 @@
 //! expected (or the reverse).
 
 use crate::error::{InvalidInput, check_finite_vec3, check_unit_quat};
-use crate::math::{Quat, Real, Vec3};
+use crate::math::{Quat, Real, Vec3, to_f64};
+
+/// Smallest accepted mass or nonzero principal moment: the smallest normal [`Real`]
+/// (`2⁻¹²⁶ ≈ 1.2e-38` in `f32`, `2⁻¹⁰²² ≈ 2.2e-308` in `f64`). Below it the reciprocal the
+/// engine stores (`1/m`, `1/I`) overflows or loses its precision.
+pub const MIN_RECIPROCABLE: Real = Real::MIN_POSITIVE;
+
+/// Largest accepted mass or principal moment: `1 / MIN_RECIPROCABLE` (`2¹²⁶ ≈ 8.5e37` in `f32`,
+/// `2¹⁰²² ≈ 4.5e307` in `f64`). Above it the stored reciprocal would be subnormal, and `1/(1/m)`
+/// would no longer give the mass back.
+pub const MAX_RECIPROCABLE: Real = 1.0 / Real::MIN_POSITIVE;
+
+/// Slack of the triangle inequality `I_a ≤ I_b + I_c + slack·(I_a + I_b + I_c)`, in units of
+/// [`Real::EPSILON`]. A flat plate has `I₃ = I₁ + I₂` exactly, and a thin body is close to it:
+/// moments computed in floating point (an eigen-decomposition, the sum over a hull's triangles)
+/// carry a few ulps of round-off, so the exact inequality would reject valid thin bodies.
+pub const TRIANGLE_INEQUALITY_SLACK_ULPS: Real = 16.0;
+
+/// Whether `x` is in `[MIN_RECIPROCABLE, MAX_RECIPROCABLE]` (false for NaN).
+fn reciprocable(x: Real) -> bool {
+    (MIN_RECIPROCABLE..=MAX_RECIPROCABLE).contains(&x)
+}
+
+/// [`InvalidInput::ReciprocalOutOfRange`] for `field`.
+fn out_of_range(field: &'static str, value: Real) -> InvalidInput {
+    InvalidInput::ReciprocalOutOfRange {
+        field,
+        value,
+        min: MIN_RECIPROCABLE,
+        max: MAX_RECIPROCABLE,
+    }
+}
 
 /// A mass in kilograms, strictly positive and finite.
 #[derive(Debug, Clone, Copy, PartialEq, PartialOrd)]
 pub struct Mass(Real);
 
 impl Mass {
-    /// Creates a mass; rejects values that are not finite or not `> 0`.
+    /// Creates a mass; rejects values that are not finite or not `> 0`
+    /// ([`InvalidInput::NonPositiveMass`]), and masses outside
+    /// [`MIN_RECIPROCABLE`]`..=`[`MAX_RECIPROCABLE`], whose reciprocal is not a finite normal
+    /// number in the build precision ([`InvalidInput::ReciprocalOutOfRange`]; e.g. `1e-39` in
+    /// `f32`, where `1/m` is infinite).
     pub fn new(kilograms: Real) -> Result<Self, InvalidInput> {
-        if kilograms.is_finite() && kilograms > 0.0 {
-            Ok(Self(kilograms))
-        } else {
-            Err(InvalidInput::NonPositiveMass(kilograms))
+        if !(kilograms.is_finite() && kilograms > 0.0) {
+            return Err(InvalidInput::NonPositiveMass(kilograms));
         }
+        if !reciprocable(kilograms) {
+            return Err(out_of_range("mass", kilograms));
+        }
+        Ok(Self(kilograms))
     }
 
     /// The mass in kilograms.
@@ -109,6 +146,19 @@ impl MassProperties {
     /// centre of mass at the body origin.
     ///
     /// Moments must be `>= 0` and finite, and not all zero. A zero moment locks that axis.
+    ///
+    /// Also rejected:
+    /// - a nonzero moment outside [`MIN_RECIPROCABLE`]`..=`[`MAX_RECIPROCABLE`]: its reciprocal,
+    ///   which the engine stores, would not be a finite normal number
+    ///   ([`InvalidInput::ReciprocalOutOfRange`]);
+    /// - moments that violate the triangle inequality `I_a ≤ I_b + I_c` on some axis `a`
+    ///   ([`InvalidInput::TriangleInequality`]): `I_a = ∫ (r_b² + r_c²) dm ≤ I_b + I_c =
+    ///   ∫ (r_a² + r_b² + r_a² + r_c²) dm` for every mass distribution, with equality for a flat
+    ///   plate normal to `a`. The check allows [`TRIANGLE_INEQUALITY_SLACK_ULPS`] ulps of the sum
+    ///   of the moments for round-off, so computed moments of a thin plate pass.
+    ///
+    /// A zero moment means a locked axis, i.e. an infinite moment: the inequality then cannot
+    /// be violated on any axis and is not checked (the other moments may be anything).
     pub fn new(mass: Mass, principal_inertia: Vec3) -> Result<Self, InvalidInput> {
         check_finite_vec3("principal inertia", principal_inertia)?;
         // `!(x >= 0)` also catches NaN.
@@ -117,6 +167,20 @@ impl MassProperties {
         }
         if principal_inertia == Vec3::ZERO {
             return Err(InvalidInput::ZeroInertia);
+        }
+        let moments = principal_inertia.to_array();
+        if let Some(&bad) = moments.iter().find(|&&m| m != 0.0 && !reciprocable(m)) {
+            return Err(out_of_range("principal moment", bad));
+        }
+        if !principal_inertia.cmpeq(Vec3::ZERO).any() {
+            // In f64, so that neither the sums nor the slack round.
+            let m = moments.map(to_f64);
+            let slack = to_f64(TRIANGLE_INEQUALITY_SLACK_ULPS)
+                * to_f64(Real::EPSILON)
+                * (m[0] + m[1] + m[2]);
+            if let Some(axis) = (0..3).find(|&a| m[a] > m[(a + 1) % 3] + m[(a + 2) % 3] + slack) {
+                return Err(InvalidInput::TriangleInequality { moments, axis });
+            }
         }
         Ok(Self {
             inv_mass: 1.0 / mass.get(),
@@ -226,5 +290,81 @@ impl MassProperties {
     pub fn world_inertia_mul(&self, body_rotation: Quat, world: Vec3) -> Vec3 {
         let frame = body_rotation * self.principal_frame;
         frame * (self.principal_inertia * (frame.inverse() * world))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn one() -> Mass {
+        Mass::new(1.0).unwrap()
+    }
+
+    /// `1/m` and `1/I` are stored: values whose reciprocal is not a finite normal number in the
+    /// build precision are rejected at construction, not quarantined at step 1.
+    #[test]
+    fn masses_and_moments_without_a_usable_reciprocal_are_rejected() {
+        for bad in [Real::MIN_POSITIVE / 2.0, MAX_RECIPROCABLE * 2.0] {
+            assert!(
+                matches!(
+                    Mass::new(bad),
+                    Err(InvalidInput::ReciprocalOutOfRange { field: "mass", .. })
+                ),
+                "mass {bad}"
+            );
+            let e = MassProperties::new(one(), Vec3::new(bad, bad, bad)).unwrap_err();
+            assert!(
+                matches!(e, InvalidInput::ReciprocalOutOfRange { .. }),
+                "{e}"
+            );
+        }
+        if !crate::math::DOUBLE_PRECISION {
+            // The case of the issue: 1e-39 kg is a valid f32 but its reciprocal overflows.
+            let e = Mass::new((1e-39_f64) as Real).unwrap_err();
+            let shown = e.to_string();
+            assert!(shown.contains("f32") && shown.contains("1e-39"), "{shown}");
+            assert!(shown.len() < 200, "compact numbers: {shown}");
+        }
+        for ok in [MIN_RECIPROCABLE, MAX_RECIPROCABLE] {
+            let m = Mass::new(ok).unwrap();
+            let props = MassProperties::new(m, Vec3::splat(ok)).unwrap();
+            assert!(props.inv_mass().is_normal() && props.mass().is_finite());
+            assert!(props.inv_principal_inertia().x.is_normal());
+        }
+    }
+
+    #[test]
+    fn moments_must_satisfy_the_triangle_inequality() {
+        for (moments, axis) in [
+            (Vec3::new(3.0, 1.0, 1.0), 0),
+            (Vec3::new(1.0, 5.0, 1.0), 1),
+            (Vec3::new(0.2, 0.3, 0.6), 2),
+        ] {
+            assert_eq!(
+                MassProperties::new(one(), moments),
+                Err(InvalidInput::TriangleInequality {
+                    moments: moments.to_array(),
+                    axis
+                })
+            );
+        }
+        let e = MassProperties::new(one(), Vec3::new(1.0, 5.0, 1.0)).unwrap_err();
+        assert!(e.to_string().contains("5 > 1 + 1"), "{e}");
+        // The flat plate is the boundary case: equality holds and is accepted, also a few
+        // ulps past it (round-off of computed moments).
+        MassProperties::new(one(), Vec3::new(1.0, 2.0, 3.0)).unwrap();
+        let past = 3.0 * (1.0 + 4.0 * Real::EPSILON);
+        MassProperties::new(one(), Vec3::new(1.0, 2.0, past)).unwrap();
+        // A thin plate built from its formula passes.
+        MassProperties::solid_cuboid(one(), Vec3::new(1.0, 0.5, 1e-6)).unwrap();
+    }
+
+    /// A zero moment is a locked axis, i.e. an infinite moment: the inequality is not checked.
+    #[test]
+    fn a_locked_axis_skips_the_triangle_inequality() {
+        let props = MassProperties::new(one(), Vec3::new(0.0, 1.0, 5.0)).unwrap();
+        assert!(props.has_locked_axis());
+        MassProperties::new(one(), Vec3::new(7.0, 0.0, 0.0)).unwrap();
     }
 }

@@ -18,7 +18,7 @@ fn scene(integrator: Integrator) -> World {
         let f = i as Real;
         let mass = MassProperties::new(
             Mass::new(1.0 + 0.3 * f).unwrap(),
-            Vec3::new(0.5, 1.0 + 0.1 * f, 1.7),
+            Vec3::new(0.5, 1.0 + 0.05 * f, 1.4),
         )
         .unwrap()
         .with_center_of_mass(Vec3::new(0.05, 0.0, -0.02))

@@ -6,30 +6,48 @@ use tumble_core::math::{Quat, REAL_NAME, Real, Vec3};
 use bevy_ecs::prelude::*;
 use bevy_ecs::schedule::Schedule;
 
-use tumble_core::shapes::mass_properties_of;
-use tumble_core::shapes::parry::shape::{Ball, Capsule, Cone, ConvexPolyhedron, Cuboid, Cylinder};
+use tumble_core::shapes::parry::shape::{Ball, Capsule, Cone, Cuboid, Cylinder};
+use tumble_core::shapes::{HullError, convex_hull_mass_properties, mass_properties_of};
 use tumble_core::{Density, Integrator, Mass, MassProperties};
 use tumble_ecs::prelude::*;
 
-use crate::error::SceneError;
+use crate::error::{SaveError, SceneError};
 use crate::format::{BodyDef, ForceDef, SceneFile, ShapeDef};
+use crate::text::{is_unsafe_char, terminal_safe};
 use crate::validate::Checker;
+use tumble_core::error::compact;
 
 /// A scene that passed every check: it builds a world without failing.
+///
+/// Its parts are read through accessors and cannot be changed in place, so a `Scene` always
+/// holds what its checks accepted (no NaN step, no unknown body). To change a scene, change its
+/// [`SceneFile`] and parse the result again (`to_toml` then [`Scene::parse`]), which checks it
+/// like a file.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Scene {
-    /// The file model (for saving).
-    pub file: SceneFile,
-    /// Time step (s).
-    pub dt: Real,
-    /// Number of steps.
-    pub steps: u64,
-    /// Integrator.
-    pub integrator: Integrator,
-    /// Gravity, if any.
-    pub gravity: Option<Vec3>,
+    file: SceneFile,
+    settings: PhysicsSettings,
+    steps: u64,
+    gravity: Option<Vec3>,
     bodies: Vec<ValidBody>,
     forces: Vec<ValidForce>,
+}
+
+/// One body of a [`Scene`], as the engine will start it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SceneBody {
+    /// Its name (unique in the scene).
+    pub name: String,
+    /// Mass properties.
+    pub mass: MassProperties,
+    /// Initial state, with the centre-of-mass position.
+    pub state: tumble_core::BodyState,
+    /// Gravity scale.
+    pub gravity_scale: Real,
+    /// Padé linear damping (1/s).
+    pub linear_damping: Real,
+    /// Padé angular damping (1/s).
+    pub angular_damping: Real,
 }
 
 #[derive(Debug, Clone, PartialEq)]
@@ -81,7 +99,19 @@ impl Scene {
     /// Parses and validates scene text; `file` names it in errors.
     pub fn parse(file: &str, text: &str) -> Result<Self, SceneError> {
         let parsed: SceneFile = toml::from_str(text).map_err(|e| {
-            let start = e.span().map_or(0, |s| s.start.min(text.len()));
+            let mut start = e.span().map_or(0, |s| s.start.min(text.len()));
+            if let (Some(span), Some(got)) = (e.span(), wrong_length(e.message())) {
+                // Inside a tagged table toml points at the table: find the array itself.
+                if let Some(at) = crate::validate::array_of_len_after(text, span.start, got) {
+                    start = at;
+                }
+            }
+            if let (Some(span), Some(key)) = (e.span(), unknown_name(e.message())) {
+                // Likewise for an unknown key or variant in a tagged table.
+                if let Some(at) = crate::validate::key_after(text, span.start, key) {
+                    start = at;
+                }
+            }
             let line = crate::validate::line_at(text, start);
             let message = e.message().replace('\n', " ");
             // The field is the key path at the error, when the text parses as TOML at all;
@@ -103,12 +133,25 @@ impl Scene {
         let ck = Checker { file, text };
         let w = parsed.world.clone();
         let dt = ck.scalar("world", None, "dt", w.dt)?;
-        if dt <= 0.0 {
+        if w.dt <= 0.0 {
             return Err(ck.error(
                 "world",
                 None,
                 "dt",
-                format!("expected a time step > 0, got {}", w.dt),
+                format!("expected a time step > 0, got {}", compact(w.dt)),
+            ));
+        }
+        if dt == 0.0 {
+            // Positive in the file, zero in the engine: the step underflows the precision.
+            return Err(ck.error(
+                "world",
+                None,
+                "dt",
+                format!(
+                    "{} rounds to 0 in {REAL_NAME}; expected a step ≥ {:.1e} s",
+                    compact(w.dt),
+                    Real::from_bits(1)
+                ),
             ));
         }
         if w.steps == 0 || w.steps > MAX_STEPS {
@@ -128,6 +171,11 @@ impl Scene {
                     })?
             }
         };
+        let settings = PhysicsSettings::new(dt, integrator)
+            .map_err(|e| ck.error("world", None, "dt", e.to_string()))?;
+        if let Some(why) = bad_text(&parsed.name) {
+            return Err(ck.top_error("name", why));
+        }
         let gravity = w
             .gravity
             .map(|g| ck.vec3("world", None, "gravity", g))
@@ -143,7 +191,7 @@ impl Scene {
                     "bodies",
                     Some(i),
                     "name",
-                    format!("duplicate body name `{}`", b.name),
+                    format!("duplicate body name `{}`", terminal_safe(&b.name)),
                 ));
             }
             bodies.push(validate_body(&ck, i, b)?);
@@ -154,7 +202,10 @@ impl Scene {
                     "forces",
                     Some(i),
                     key,
-                    format!("unknown body `{name}`; expected one of the [[bodies]] names"),
+                    format!(
+                        "unknown body `{}`; expected one of the [[bodies]] names",
+                        terminal_safe(name)
+                    ),
                 )
             })
         };
@@ -191,7 +242,7 @@ impl Scene {
                                 "forces",
                                 Some(i),
                                 key,
-                                format!("expected a value >= 0, got {x}"),
+                                format!("expected a value >= 0, got {}", compact(x)),
                             ));
                         }
                         Ok(y)
@@ -204,8 +255,9 @@ impl Scene {
                             Some(i),
                             "b",
                             format!(
-                                "spring joins `{a}` to itself; expected a different body, \
-                                 or no `b` to anchor `a` to the world point `anchor_b`"
+                                "spring joins `{}` to itself; expected a different body, \
+                                 or no `b` to anchor `a` to the world point `anchor_b`",
+                                terminal_safe(a)
                             ),
                         ));
                     }
@@ -223,53 +275,78 @@ impl Scene {
         }
         Ok(Self {
             file: parsed,
-            dt,
+            settings,
             steps: w.steps,
-            integrator,
             gravity,
             bodies,
             forces,
         })
     }
 
-    /// Each body as `(name, mass properties, initial state with the centre-of-mass position,
-    /// gravity scale, linear damping, angular damping)`, in file order.
-    pub fn body_states(
-        &self,
-    ) -> Vec<(
-        String,
-        MassProperties,
-        tumble_core::BodyState,
-        Real,
-        Real,
-        Real,
-    )> {
+    /// The file model, as read (for saving, or to derive a changed scene from).
+    pub fn file(&self) -> &SceneFile {
+        &self.file
+    }
+
+    /// The scene name.
+    pub fn name(&self) -> &str {
+        &self.file.name
+    }
+
+    /// Time step (s): finite and `> 0` in the build precision.
+    pub fn dt(&self) -> Real {
+        self.settings.dt()
+    }
+
+    /// Step and integrator, as the world will get them.
+    pub fn settings(&self) -> PhysicsSettings {
+        self.settings
+    }
+
+    /// Number of steps, `1..=`[`MAX_STEPS`].
+    pub fn steps(&self) -> u64 {
+        self.steps
+    }
+
+    /// The integrator.
+    pub fn integrator(&self) -> Integrator {
+        self.settings.integrator
+    }
+
+    /// Uniform gravity, if the scene has any.
+    pub fn gravity(&self) -> Option<Vec3> {
+        self.gravity
+    }
+
+    /// Each body with its mass properties, initial state and per-body parameters, in file
+    /// order.
+    pub fn body_states(&self) -> Vec<SceneBody> {
         self.bodies
             .iter()
             .map(|b| {
                 let props = MassProps(b.mass);
-                let state = tumble_ecs::components::body_state(&b.transform, &b.velocity, &props);
-                (
-                    b.name.clone(),
-                    b.mass,
-                    state,
-                    b.gravity_scale,
-                    b.damping.linear,
-                    b.damping.angular,
-                )
+                SceneBody {
+                    name: b.name.clone(),
+                    mass: b.mass,
+                    state: tumble_ecs::components::body_state(&b.transform, &b.velocity, &props),
+                    gravity_scale: b.gravity_scale,
+                    linear_damping: b.damping.linear,
+                    angular_damping: b.damping.angular,
+                }
             })
             .collect()
     }
 
     /// The scene as TOML (loading it gives the same scene).
-    pub fn to_toml(&self) -> String {
+    pub fn to_toml(&self) -> Result<String, SaveError> {
         crate::to_toml_string(&self.file)
     }
 
-    /// Builds the world and plans its schedule.
+    /// Builds the world and plans its schedule. Cannot fail: everything was checked when the
+    /// scene was parsed.
     pub fn build(&self) -> BuiltScene {
         let mut world = World::new();
-        world.insert_resource(PhysicsSettings::new(self.dt, self.integrator).unwrap_or_default());
+        world.insert_resource(self.settings);
         if let Some(g) = self.gravity {
             world.insert_resource(Gravity(g));
         }
@@ -383,6 +460,38 @@ fn validate_body(ck: &Checker<'_>, i: usize, b: &BodyDef) -> Result<ValidBody, S
     })?;
     let linear = ck.vec3(t, Some(i), "linear_velocity", b.linear_velocity)?;
     let angular = ck.vec3(t, Some(i), "angular_velocity", b.angular_velocity)?;
+    // The engine computes ½m|v|² and ½ωᵀIω in its precision (energy reports, the divergence
+    // check): both must be finite there, or the body is garbage from step 0.
+    let overflow = |key: &str, what: &str, value: Real| {
+        ck.error(
+            t,
+            Some(i),
+            key,
+            format!(
+                "initial kinetic energy overflows {REAL_NAME} ({what} = {}); expected a smaller \
+                 velocity",
+                compact(value)
+            ),
+        )
+    };
+    let linear_energy = 0.5 * mass.mass() * linear.length_squared();
+    if !linear_energy.is_finite() {
+        return Err(overflow("linear_velocity", "½m|v|²", linear_energy));
+    }
+    let angular_energy = 0.5
+        * mass
+            .world_inertia_mul(rotation.normalize(), angular)
+            .dot(angular);
+    if !angular_energy.is_finite() {
+        return Err(overflow("angular_velocity", "½ωᵀIω", angular_energy));
+    }
+    if !(linear_energy + angular_energy).is_finite() {
+        return Err(overflow(
+            "angular_velocity",
+            "½m|v|² + ½ωᵀIω",
+            linear_energy + angular_energy,
+        ));
+    }
     let gravity_scale = ck.scalar(t, Some(i), "gravity_scale", b.gravity_scale)?;
     let mut damping = Damping::default();
     for (key, value, out) in [
@@ -395,7 +504,7 @@ fn validate_body(ck: &Checker<'_>, i: usize, b: &BodyDef) -> Result<ValidBody, S
                 t,
                 Some(i),
                 key,
-                format!("expected a value >= 0, got {value}"),
+                format!("expected a value >= 0, got {}", compact(value)),
             ));
         }
     }
@@ -425,7 +534,7 @@ fn shape_mass(
                 "bodies",
                 Some(i),
                 "shape",
-                format!("expected dimensions > 0, got {x}"),
+                format!("expected dimensions > 0, got {}", compact(x)),
             ));
         }
         Ok(y)
@@ -450,45 +559,88 @@ fn shape_mass(
                 .iter()
                 .map(|p| ck.vec3("bodies", Some(i), "shape", *p))
                 .collect::<Result<_, _>>()?;
-            let hull = ConvexPolyhedron::from_convex_hull(&pts).ok_or_else(|| {
-                ck.error(
-                    "bodies",
-                    Some(i),
-                    "shape",
-                    "convex hull is degenerate (needs 4 points spanning a volume)",
-                )
-            })?;
-            mass_properties_of(&hull, density)
+            return convex_hull_mass_properties(&pts, density).map_err(|e| match e {
+                HullError::Mass(e) => mass_error(ck, i, e),
+                e => ck.error("bodies", Some(i), "shape", e.to_string()),
+            });
         }
     };
-    result.map_err(|e| {
-        ck.error(
-            "bodies",
-            Some(i),
-            "shape",
-            format!(
-                "{e}: expected dimensions and a density whose mass and moments of inertia are \
-                 finite and > 0 in {REAL_NAME}"
-            ),
-        )
-    })
+    result.map_err(|e| mass_error(ck, i, e))
 }
 
-/// Why a body name cannot be used, if it cannot: names are CSV cells and must stay one cell.
-fn bad_name(name: &str) -> Option<String> {
+/// A shape whose mass properties are not valid.
+fn mass_error(ck: &Checker<'_>, i: usize, e: tumble_core::InvalidInput) -> SceneError {
+    ck.error(
+        "bodies",
+        Some(i),
+        "shape",
+        format!(
+            "{e}: expected dimensions and a density whose mass and moments of inertia are \
+             finite and > 0 in {REAL_NAME}"
+        ),
+    )
+}
+
+/// `k` from the messages "unknown field `k`, …" and "unknown variant `k`, …".
+fn unknown_name(message: &str) -> Option<&str> {
+    let rest = message
+        .strip_prefix("unknown field `")
+        .or_else(|| message.strip_prefix("unknown variant `"))?;
+    rest.split_once('`').map(|(name, _)| name)
+}
+
+/// `M` from the message "expected N numbers, got M" of a fixed-length array.
+fn wrong_length(message: &str) -> Option<usize> {
+    let rest = message.split_once("numbers, got ")?.1;
+    rest.trim().parse().ok()
+}
+
+/// Longest scene or body name, in bytes.
+pub const MAX_NAME_BYTES: usize = 256;
+
+/// Why a name (scene or body) cannot be used, if it cannot: names are echoed to terminals and
+/// written into CSV and report files, so they are non-empty, at most [`MAX_NAME_BYTES`] long
+/// and free of control and format characters ([`is_unsafe_char`]: newlines, ESC, bidi
+/// overrides, zero-width characters).
+fn bad_text(name: &str) -> Option<String> {
     if name.trim().is_empty() {
         return Some("expected a non-empty name".to_owned());
     }
-    if name.len() > 256 {
+    if name.len() > MAX_NAME_BYTES {
         return Some(format!(
-            "name is {} bytes long; expected at most 256",
+            "name is {} bytes long; expected at most {MAX_NAME_BYTES}",
             name.len()
         ));
     }
-    if name.chars().any(|c| c == ',' || c == '"' || c.is_control()) {
+    if let Some(c) = name.chars().find(|&c| is_unsafe_char(c)) {
         return Some(format!(
-            "name {name:?} contains a comma, a quote or a control character; expected a name \
-             that fits in one CSV cell"
+            "name `{}` contains the control or format character {}; expected printable text \
+             that fits in one CSV cell",
+            terminal_safe(name),
+            c.escape_unicode()
+        ));
+    }
+    None
+}
+
+/// Why a body name cannot be used, if it cannot: [`bad_text`], and names are CSV cells that
+/// must stay one cell and must not be run by a spreadsheet.
+fn bad_name(name: &str) -> Option<String> {
+    if let Some(why) = bad_text(name) {
+        return Some(why);
+    }
+    if name.chars().any(|c| c == ',' || c == '"') {
+        return Some(format!(
+            "name `{}` contains a comma or a quote; expected a name that fits in one CSV cell",
+            terminal_safe(name)
+        ));
+    }
+    if name.starts_with(['=', '+', '-', '@']) {
+        return Some(format!(
+            "name `{}` begins with `{}`, which a spreadsheet opening the CSV would run as a \
+             formula; expected a name beginning with another character",
+            terminal_safe(name),
+            &name[..1]
         ));
     }
     None

@@ -2,11 +2,14 @@
 
 use thiserror::Error;
 
+use crate::text::is_unsafe_char;
+
 /// A scene file that cannot be used, with where and why.
 #[derive(Debug, Clone, PartialEq, Error)]
 #[error("{}", location(self))]
 pub struct SceneError {
-    /// The file.
+    /// The file, made safe to print ([`crate::text::terminal_safe`]: a newline or ESC in the
+    /// path is shown escaped).
     pub file: String,
     /// 1-based line; 0 when the error concerns the whole file (it could not be read).
     pub line: usize,
@@ -25,7 +28,7 @@ impl SceneError {
         message: impl Into<String>,
     ) -> Self {
         Self {
-            file: file.to_owned(),
+            file: crate::text::terminal_safe(file).into_owned(),
             line,
             field: one_line(field.into(), MAX_FIELD_CHARS),
             message: one_line(message.into(), MAX_MESSAGE_CHARS),
@@ -51,15 +54,27 @@ const MAX_FIELD_CHARS: usize = 120;
 /// Longest message kept in an error.
 const MAX_MESSAGE_CHARS: usize = 400;
 
-/// `text` on one line (line breaks become spaces), cut to `max` characters with an ellipsis.
+/// `text` made safe to print on one line: control and format characters
+/// ([`is_unsafe_char`]: line breaks, ESC, bidi overrides, zero-width characters) are shown as
+/// Rust escapes, the same rule as [`crate::text::terminal_safe`], and the text is cut to `max`
+/// characters with an ellipsis. Messages quote user strings (keys, names, values), so this
+/// applies to the whole message, not only to the parts known to come from the user.
 fn one_line(text: String, max: usize) -> String {
-    let mut out: String = text
-        .chars()
-        .take(max)
-        .map(|c| if c.is_control() { ' ' } else { c })
-        .collect();
+    let mut out = String::with_capacity(text.len().min(4 * max));
+    for c in text.chars().take(max) {
+        if is_unsafe_char(c) {
+            out.extend(c.escape_default());
+        } else {
+            out.push(c);
+        }
+    }
     if text.chars().nth(max).is_some() {
         out.push('…');
     }
     out
 }
+
+/// A scene model that could not be written as TOML.
+#[derive(Debug, Error)]
+#[error("the scene cannot be written as TOML: {0}")]
+pub struct SaveError(#[from] toml::ser::Error);

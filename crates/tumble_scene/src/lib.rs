@@ -17,8 +17,8 @@ pub mod text;
 mod trajectory;
 mod validate;
 
-pub use build::{BuiltScene, MAX_STEPS, Scene};
-pub use error::SceneError;
+pub use build::{BuiltScene, MAX_NAME_BYTES, MAX_STEPS, Scene, SceneBody};
+pub use error::{SaveError, SceneError};
 pub use format::{BodyDef, ForceDef, SceneFile, ShapeDef, WorldDef};
 pub use trajectory::{CSV_HEADER, TrajectoryError, csv_text_cell, write_trajectory};
 
@@ -28,8 +28,10 @@ pub use trajectory::{CSV_HEADER, TrajectoryError, csv_text_cell, write_trajector
 pub const MAX_SCENE_BYTES: u64 = 64 * 1024 * 1024;
 
 /// Serializes a scene model to TOML (loading the text gives the same model back).
-pub fn to_toml_string(model: &SceneFile) -> String {
-    toml::to_string(model).unwrap_or_default()
+///
+/// The model is not validated here: parse the text with [`Scene::parse`] to check it.
+pub fn to_toml_string(model: &SceneFile) -> Result<String, SaveError> {
+    Ok(toml::to_string(model)?)
 }
 
 /// Loads and validates a scene file (see [`read_scene_text`]).

@@ -1,6 +1,7 @@
 //! Semantic checks of a parsed scene file, with the line of each offending field.
 
 use toml::de::{DeTable, DeValue};
+use tumble_core::error::compact;
 use tumble_core::math::{REAL_NAME, Real, Vec3};
 
 use crate::error::SceneError;
@@ -76,6 +77,70 @@ fn value_path(value: &DeValue<'_>, at: usize, path: &mut String) -> bool {
     }
 }
 
+/// The start of the first array of `len` elements (not an array of tables) that begins at or
+/// after byte `from`. An array of the wrong length inside an internally tagged table
+/// (`[[forces]]`) is reported by toml at the table's header, because serde buffers tagged
+/// tables; the offending array is the first one of that length in the table, hence the first
+/// after the header.
+pub fn array_of_len_after(text: &str, from: usize, len: usize) -> Option<usize> {
+    fn search(
+        value: &toml::Spanned<DeValue<'_>>,
+        from: usize,
+        len: usize,
+        best: &mut Option<usize>,
+    ) {
+        match value.get_ref() {
+            DeValue::Table(t) => t.iter().for_each(|(_, v)| search(v, from, len, best)),
+            DeValue::Array(items) => {
+                let start = value.span().start;
+                let is_table_array = items
+                    .iter()
+                    .all(|v| matches!(v.get_ref(), DeValue::Table(_)));
+                if start >= from && items.len() == len && !(is_table_array && len > 0) {
+                    *best = Some(best.map_or(start, |b| b.min(start)));
+                }
+                items.iter().for_each(|v| search(v, from, len, best));
+            }
+            _ => {}
+        }
+    }
+    let doc = DeTable::parse(text).ok()?;
+    let mut best = None;
+    doc.get_ref()
+        .iter()
+        .for_each(|(_, v)| search(v, from, len, &mut best));
+    best
+}
+
+/// The start of the first key named `name` at or after byte `from`. toml reports an unknown
+/// key inside an internally tagged table (`[[forces]]`, also under a deeply nested header such
+/// as `[forces.x.y.z]`) at the table's header; the key itself is the first of that name after
+/// it.
+pub fn key_after(text: &str, from: usize, name: &str) -> Option<usize> {
+    fn search(table: &DeTable<'_>, from: usize, name: &str, best: &mut Option<usize>) {
+        for (k, v) in table.iter() {
+            let start = k.span().start;
+            if k.get_ref() == name && start >= from {
+                *best = Some(best.map_or(start, |b| b.min(start)));
+            }
+            value(v.get_ref(), from, name, best);
+        }
+    }
+    fn value(v: &DeValue<'_>, from: usize, name: &str, best: &mut Option<usize>) {
+        match v {
+            DeValue::Table(t) => search(t, from, name, best),
+            DeValue::Array(items) => items
+                .iter()
+                .for_each(|i| value(i.get_ref(), from, name, best)),
+            _ => {}
+        }
+    }
+    let doc = DeTable::parse(text).ok()?;
+    let mut best = None;
+    search(doc.get_ref(), from, name, &mut best);
+    best
+}
+
 /// Context for the checks of one scene: the file name and its text.
 pub struct Checker<'a> {
     /// File name for messages.
@@ -105,6 +170,19 @@ impl Checker<'_> {
         )
     }
 
+    /// An error at the top-level key `key` (e.g. the scene `name`).
+    pub fn top_error(&self, key: &str, message: impl Into<String>) -> SceneError {
+        let line = DeTable::parse(self.text)
+            .ok()
+            .and_then(|doc| {
+                doc.get_ref()
+                    .get_key_value(key)
+                    .map(|(k, _)| line_at(self.text, k.span().start))
+            })
+            .unwrap_or(1);
+        SceneError::at(self.file, line, key, message)
+    }
+
     /// A finite number that fits in the engine precision ([`Real`]).
     pub fn scalar(
         &self,
@@ -118,7 +196,7 @@ impl Checker<'_> {
                 table,
                 index,
                 key,
-                format!("expected a finite number, got {x}"),
+                format!("expected a finite number, got {}", compact(x)),
             ));
         }
         let y = x as Real;
@@ -128,7 +206,8 @@ impl Checker<'_> {
                 index,
                 key,
                 format!(
-                    "{x} overflows {REAL_NAME} (|x| must be below {:.1e})",
+                    "{} overflows {REAL_NAME} (|x| must be below {:.1e})",
+                    compact(x),
                     Real::MAX
                 ),
             ));

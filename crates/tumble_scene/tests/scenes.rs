@@ -16,10 +16,10 @@ fn bundled_scenes_load_build_and_round_trip() {
             continue;
         }
         let scene = load_scene(&path).unwrap_or_else(|e| panic!("{e}"));
-        let again = Scene::parse("saved", &scene.to_toml()).unwrap();
+        let again = Scene::parse("saved", &scene.to_toml().unwrap()).unwrap();
         assert_eq!(again, scene, "{} does not round-trip", path.display());
         let built = scene.build();
-        assert_eq!(built.bodies.len(), scene.file.bodies.len());
+        assert_eq!(built.bodies.len(), scene.file().bodies.len());
         count += 1;
     }
     assert!(count >= 9, "bundled scenes: {count}");
@@ -148,4 +148,141 @@ fn errors_stay_one_short_line() {
         "{} bytes",
         shown.len()
     );
+}
+
+const WORLD: &str = "name = \"x\"\n[world]\ndt = 0.01\nsteps = 1\n";
+
+/// A million-element array where three numbers are expected is an error naming the count, not
+/// silently cut to three (and it is counted, not parsed: this stays fast).
+#[test]
+fn a_million_element_position_is_rejected_with_its_length() {
+    let numbers = vec!["1"; 1_000_000].join(", ");
+    let text = format!(
+        "{WORLD}[[bodies]]\nname = \"a\"\nmass = 1.0\ninertia = [1.0, 2.0, 3.0]\nposition = [{numbers}]\n"
+    );
+    let e = Scene::parse("big.toml", &text).unwrap_err();
+    assert_eq!((e.line, e.field.as_str()), (9, "bodies[0].position"), "{e}");
+    assert!(e.message.contains("expected 3 numbers, got 1000000"), "{e}");
+}
+
+/// Exact-length arrays in every place they occur, including convex hull points.
+#[test]
+fn extra_elements_are_rejected_everywhere() {
+    for (table, line, field) in [
+        (
+            "[world]\ndt = 0.01\nsteps = 1\ngravity = [0, -9.8, 0, 1]\n",
+            5,
+            "world.gravity",
+        ),
+        (
+            "[world]\ndt = 0.01\nsteps = 1\n[[bodies]]\nname = \"a\"\ndensity = 1.0\nshape = { cuboid = [1, 1, 1, 1] }\n",
+            8,
+            "bodies[0].shape",
+        ),
+        (
+            "[world]\ndt = 0.01\nsteps = 1\n[[bodies]]\nname = \"a\"\ndensity = 1.0\nshape = { convex_hull = [[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1, 5]] }\n",
+            8,
+            "bodies[0].shape",
+        ),
+        (
+            "[world]\ndt = 0.01\nsteps = 1\n[[bodies]]\nname = \"a\"\nmass = 1.0\ninertia = [1, 1, 1]\nrotation = [0, 0, 0, 1, 0]\n",
+            9,
+            "bodies[0].rotation",
+        ),
+    ] {
+        let e = Scene::parse("x.toml", &format!("name = \"x\"\n{table}")).unwrap_err();
+        assert_eq!(e.line, line, "{e}");
+        assert!(e.field.contains(field), "{e}");
+        assert!(e.message.contains("numbers, got"), "{e}");
+    }
+}
+
+/// Tiny and huge numbers are shown in exponent form, never as hundreds of digits.
+#[test]
+fn numbers_in_messages_are_compact() {
+    for (dt, shown) in [
+        ("1e-300", "1e-300"),
+        ("-1e300", "-1e300"),
+        ("1e300", "1e300"),
+    ] {
+        if tumble_core::math::DOUBLE_PRECISION && !dt.starts_with('-') {
+            continue; // fits in f64
+        }
+        let text = format!("name = \"x\"\n[world]\ndt = {dt}\nsteps = 1\n");
+        let e = Scene::parse("x.toml", &text).unwrap_err();
+        assert!(e.message.contains(shown), "{e}");
+        assert!(e.message.len() < 120, "{e}");
+    }
+}
+
+/// The file name is echoed escaped: a newline or ESC in it cannot break the one-line error or
+/// reach the terminal.
+#[test]
+fn file_names_are_escaped_in_errors() {
+    let e = Scene::parse("evil\n\u{1b}[2J\u{202e}.toml", "name = 1\n").unwrap_err();
+    let shown = e.to_string();
+    assert!(
+        !shown.chars().any(tumble_scene::text::is_unsafe_char),
+        "{shown:?}"
+    );
+    assert!(
+        shown.starts_with("evil\\n\\u{1b}[2J\\u{202e}.toml:1: "),
+        "{shown}"
+    );
+}
+
+/// Unknown body names in forces are echoed escaped and cut.
+#[test]
+fn unknown_body_names_are_echoed_safely() {
+    let ghost = format!("g\u{1b}]0;x\u{7}{}", "h".repeat(100_000));
+    let text = format!(
+        "{WORLD}[[bodies]]\nname = \"a\"\nmass = 1.0\ninertia = [1.0, 2.0, 3.0]\n[[forces]]\ntype = \"torque\"\nbody = \"{}\"\ntorque = [1, 0, 0]\n",
+        ghost
+            .replace('\u{1b}', "\\u001b")
+            .replace('\u{7}', "\\u0007")
+    );
+    let e = Scene::parse("x.toml", &text).unwrap_err();
+    let shown = e.to_string();
+    assert!(
+        shown.contains("unknown body `g\\u{1b}]0;x\\u{7}h"),
+        "{shown}"
+    );
+    assert!(!shown.chars().any(tumble_scene::text::is_unsafe_char));
+    assert!(shown.len() < 1_000);
+}
+
+/// A long scene name is rejected, not echoed whole.
+#[test]
+fn long_scene_names_are_rejected() {
+    let text = format!(
+        "name = \"{}\"\n[world]\ndt = 0.01\nsteps = 1\n",
+        "n".repeat(1_000_000)
+    );
+    let e = Scene::parse("x.toml", &text).unwrap_err();
+    assert_eq!((e.line, e.field.as_str()), (1, "name"), "{e}");
+    assert!(e.message.contains("at most 256"), "{e}");
+    assert!(e.to_string().len() < 1_000);
+}
+
+/// `Scene` keeps what its checks accepted: the step is read through an accessor and built into
+/// the world as is; `body_states` names its fields.
+#[test]
+fn scene_accessors_and_body_states() {
+    let text = format!(
+        "{WORLD}[[bodies]]\nname = \"a\"\nmass = 2.0\ninertia = [1.0, 2.0, 3.0]\nlinear_damping = 0.5\n"
+    );
+    let scene = Scene::parse("x.toml", &text).unwrap();
+    assert_eq!(scene.dt(), 0.01);
+    assert_eq!(scene.steps(), 1);
+    assert_eq!(scene.gravity(), None);
+    let built = scene.build();
+    let settings = built
+        .world
+        .resource::<tumble_ecs::components::PhysicsSettings>();
+    assert_eq!(settings.dt(), 0.01);
+    let bodies = scene.body_states();
+    assert_eq!(bodies[0].name, "a");
+    assert_eq!(bodies[0].mass.mass(), 2.0);
+    assert_eq!(bodies[0].linear_damping, 0.5);
+    assert_eq!(bodies[0].gravity_scale, 1.0);
 }
