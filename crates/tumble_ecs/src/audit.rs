@@ -190,6 +190,24 @@ pub struct EnergyLedger {
     dt: f64,
     /// Whether the integrator drifts–kicks–drifts (else it kicks, then drifts).
     midpoint: bool,
+    /// Accounts were restored under some member of their group, not necessarily its smallest
+    /// entity (entity ids change when a world is restored): re-key them at the next audit.
+    restored: bool,
+}
+
+/// One group's running account as a snapshot saves it: a member of the group (any), the group's
+/// size and springs when the account was opened, and the energy the integrator made up so far.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct SavedAccount {
+    /// A body of the group.
+    pub member: Entity,
+    /// Bodies in the group.
+    pub members: usize,
+    /// Springs of the group.
+    pub springs: usize,
+    /// `D` (J).
+    pub created: f64,
 }
 
 impl EnergyLedger {
@@ -214,6 +232,38 @@ impl EnergyLedger {
     /// The energy the integrator created so far in the group whose smallest entity is `key`.
     pub fn created_energy(&self, key: Entity) -> Option<f64> {
         self.accounts.get(&key).map(|a| a.created)
+    }
+
+    /// The running accounts, for a snapshot (in a stable order: by entity).
+    pub fn saved_accounts(&self) -> Vec<SavedAccount> {
+        let mut saved: Vec<SavedAccount> = self
+            .accounts
+            .iter()
+            .map(|(&member, a)| SavedAccount {
+                member,
+                members: a.signature.0,
+                springs: a.signature.1,
+                created: a.created,
+            })
+            .collect();
+        saved.sort_by_key(|a| a.member);
+        saved
+    }
+
+    /// Restores saved accounts, their members already mapped to the restored entities.
+    pub fn restore_accounts(&mut self, saved: impl IntoIterator<Item = SavedAccount>) {
+        self.accounts.clear();
+        for a in saved {
+            self.accounts.insert(
+                a.member,
+                Account {
+                    signature: (a.members, a.springs),
+                    created: a.created,
+                    seen: true,
+                },
+            );
+        }
+        self.restored = true;
     }
 
     /// The group (root index) a link belongs to, if it touches an audited body.
@@ -461,6 +511,19 @@ pub fn audit_energy(
         if let Some(v) = ledger.elastic(&link, |b| b.end) {
             ledger.groups[root].end += v;
             ledger.groups[root].magnitude += v;
+        }
+    }
+    if std::mem::take(&mut ledger.restored) {
+        // Move each restored account to its group's key (the smallest entity of the group).
+        for i in 0..ledger.bodies.len() {
+            let entity = ledger.bodies[i].entity;
+            let root = ledger.find(i);
+            if let Some(key) = ledger.groups[root].key
+                && key != entity
+                && let Some(account) = ledger.accounts.remove(&entity)
+            {
+                ledger.accounts.insert(key, account);
+            }
         }
     }
     for account in ledger.accounts.values_mut() {

@@ -17,6 +17,7 @@ use bevy_ecs::prelude::*;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
+use crate::audit::{EnergyLedger, SavedAccount};
 use crate::components::{
     Damping, ForceAccumulator, Gravity, GravityScale, Kinematic, MassProps, PhysicsSettings,
     RigidBody, Static, Transform, Velocity,
@@ -83,6 +84,10 @@ pub struct Snapshot {
     pub springs: Vec<Spring>,
     /// The error log, as messages.
     pub errors: Vec<String>,
+    /// The energy audit's running accounts (their `member` is a saved entity): a resumed world
+    /// quarantines a diverging group at the same step as the world it was saved from.
+    #[serde(default)]
+    pub energy_accounts: Vec<SavedAccount>,
 }
 
 /// A snapshot that cannot be restored.
@@ -154,6 +159,10 @@ impl Snapshot {
             errors: world
                 .get_resource::<PhysicsErrors>()
                 .map(|e| e.0.iter().map(ToString::to_string).collect())
+                .unwrap_or_default(),
+            energy_accounts: world
+                .get_resource::<EnergyLedger>()
+                .map(EnergyLedger::saved_accounts)
                 .unwrap_or_default(),
         }
     }
@@ -271,6 +280,17 @@ impl Snapshot {
                 }
             }
         }
+        let accounts: Vec<SavedAccount> = self
+            .energy_accounts
+            .iter()
+            .filter_map(|a| {
+                map.get(&a.member)
+                    .map(|&member| SavedAccount { member, ..*a })
+            })
+            .collect();
+        world
+            .get_resource_or_init::<EnergyLedger>()
+            .restore_accounts(accounts);
         if !self.errors.is_empty() {
             let errors = self
                 .errors
