@@ -39,9 +39,10 @@ pub enum StepPhase {
 /// Where a batched step finds its bodies and puts them back.
 ///
 /// [`Integrator::step_batch`] calls [`read`](Self::read) once for every index in `0..len()`,
-/// in increasing order, then exactly one of [`write`](Self::write) (the new state is finite)
-/// or [`diverged`](Self::diverged) (it is not: the body keeps its old state) for every body that
-/// `read` returned, not necessarily in order.
+/// in increasing order, then exactly one of [`write`](Self::write) (the new state is valid:
+/// finite, with a unit rotation, [`BodyState::is_valid`]) or [`diverged`](Self::diverged) (it is
+/// not: the body keeps its old state) for every body that `read` returned, not necessarily in
+/// order.
 ///
 /// Bodies kept in your own layout, here one struct per body with a frozen flag:
 ///
@@ -87,9 +88,10 @@ pub trait BodyBatch {
     fn read(&mut self, i: usize, state: &mut BodyState) -> Option<Wrench>;
     /// Body `i`'s mass properties.
     fn mass(&self, i: usize) -> &MassProperties;
-    /// Stores body `i`'s new, finite state.
+    /// Stores body `i`'s new, valid state.
     fn write(&mut self, i: usize, state: &BodyState);
-    /// Body `i`'s step did not give a finite state; it keeps its old one.
+    /// Body `i`'s step did not give a valid state (non-finite, or a non-unit rotation); it keeps
+    /// its old one.
     fn diverged(&mut self, i: usize);
     /// A hint: body `i` (possibly beyond the last) will be read soon; fetch its memory with
     /// [`prefetch`](crate::prefetch::prefetch). The batch loops call it [`PREFETCH_AHEAD`]
@@ -105,10 +107,10 @@ pub trait BodyBatch {
 /// no change at 10⁴ and 10⁵, where the hardware prefetchers keep up.
 pub const PREFETCH_AHEAD: usize = 32;
 
-/// Hands `next` to `bodies` as body `i`'s new state if it is finite, else reports divergence.
+/// Hands `next` to `bodies` as body `i`'s new state if it is valid, else reports divergence.
 #[inline(always)]
 fn commit(bodies: &mut impl BodyBatch, i: usize, next: &BodyState) {
-    if next.is_finite() {
+    if next.is_valid() {
         bodies.write(i, next);
     } else {
         bodies.diverged(i);
@@ -294,8 +296,8 @@ impl<M: Borrow<MassProperties>> BodyBatch for Slices<'_, M> {
 
 impl Integrator {
     /// Steps every body of `bodies` through `phase` by `dt` (each body's load held constant),
-    /// reading and writing through the [`BodyBatch`]. A body whose result is not finite keeps
-    /// its state and is reported to [`BodyBatch::diverged`]; no other body is affected. Does not
+    /// reading and writing through the [`BodyBatch`]. A body whose result is not valid
+    /// ([`BodyState::is_valid`]) keeps its state and is reported to [`BodyBatch::diverged`]; no other body is affected. Does not
     /// allocate.
     pub fn step_batch(self, phase: StepPhase, bodies: &mut impl BodyBatch, dt: Real) {
         if self != Integrator::Splitting {
@@ -367,7 +369,7 @@ impl Integrator {
     }
 
     /// [`try_step`](Self::try_step) for every body: `states[i]` advances by `dt` under
-    /// `wrenches[i]` with mass `masses[i]`. A body whose result is not finite keeps its state and
+    /// `wrenches[i]` with mass `masses[i]`. A body whose result is not valid keeps its state and
     /// its index is returned (in increasing order); no other body is affected. Allocates only
     /// when a body diverges.
     pub fn try_step_many<M: Borrow<MassProperties>>(

@@ -39,6 +39,8 @@ mod rk4;
 mod splitting;
 mod symmetric_kernel;
 mod symplectic_euler;
+#[cfg(test)]
+mod tests;
 mod yoshida;
 
 use crate::math::{Real, Vec3};
@@ -182,13 +184,13 @@ impl Integrator {
         }
     }
 
-    /// A whole step under a constant `wrench`. The caller checks finiteness (see
+    /// A whole step under a constant `wrench`. The caller checks the result (see
     /// [`try_step`](Self::try_step)).
-    #[inline]
     ///
     /// For the drift–kick–drift methods a torque-free step takes its rotation as one free flow
     /// over `Δt` instead of two halves (nothing is kicked between them): half the cost, same
     /// order. The ECS takes this path for bodies without a `ForceAccumulator`.
+    #[inline]
     pub fn step(self, state: &mut BodyState, mass: &MassProperties, wrench: &Wrench, dt: Real) {
         if self.samples_forces_at_midpoint() && wrench.torque == Vec3::ZERO {
             torque_free_dkd(state, mass, wrench, dt, self.free_rotation());
@@ -213,8 +215,9 @@ impl Integrator {
         self.finish_step(state, mass, &wrench, dt);
     }
 
-    /// Advances `state` by `dt` and commits the result only if it is finite; otherwise `state`
-    /// is left unchanged and [`StepError::Diverged`] is returned.
+    /// Advances `state` by `dt` and commits the result only if it is valid (finite, with a unit
+    /// rotation: [`BodyState::is_valid`]); otherwise `state` is left unchanged and
+    /// [`StepError::Diverged`] is returned.
     #[inline]
     pub fn try_step(
         self,
@@ -223,10 +226,11 @@ impl Integrator {
         wrench: &Wrench,
         dt: Real,
     ) -> Result<(), StepError> {
-        self.commit_if_finite(state, |next| self.step(next, mass, wrench, dt))
+        self.commit_if_valid(state, |next| self.step(next, mass, wrench, dt))
     }
 
-    /// [`finish_step`](Self::finish_step) that commits only a finite result.
+    /// [`finish_step`](Self::finish_step) that commits only a valid result (see
+    /// [`try_step`](Self::try_step)).
     #[inline]
     pub fn try_finish_step(
         self,
@@ -235,19 +239,19 @@ impl Integrator {
         wrench: &Wrench,
         dt: Real,
     ) -> Result<(), StepError> {
-        self.commit_if_finite(state, |next| self.finish_step(next, mass, wrench, dt))
+        self.commit_if_valid(state, |next| self.finish_step(next, mass, wrench, dt))
     }
 
-    /// Runs `advance` on a copy of `state` and commits the copy only if it is finite.
+    /// Runs `advance` on a copy of `state` and commits the copy only if it is valid.
     #[inline]
-    fn commit_if_finite(
+    fn commit_if_valid(
         self,
         state: &mut BodyState,
         advance: impl FnOnce(&mut BodyState),
     ) -> Result<(), StepError> {
         let mut next = *state;
         advance(&mut next);
-        if next.is_finite() {
+        if next.is_valid() {
             *state = next;
             Ok(())
         } else {
@@ -255,7 +259,8 @@ impl Integrator {
         }
     }
 
-    /// [`begin_step`](Self::begin_step) that commits only a finite result.
+    /// [`begin_step`](Self::begin_step) that commits only a valid result (see
+    /// [`try_step`](Self::try_step)).
     #[inline]
     pub fn try_begin_step(
         self,
@@ -263,7 +268,7 @@ impl Integrator {
         mass: &MassProperties,
         dt: Real,
     ) -> Result<(), StepError> {
-        self.commit_if_finite(state, |next| self.begin_step(next, mass, dt))
+        self.commit_if_valid(state, |next| self.begin_step(next, mass, dt))
     }
 }
 
@@ -296,8 +301,11 @@ impl FromStr for Integrator {
 /// A step that could not be taken.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Error)]
 pub enum StepError {
-    /// The step produced NaN or Inf: the setting is outside the method's stable region.
-    #[error("integrator `{integrator}` diverged (non-finite state); the body was left unchanged")]
+    /// The step produced NaN or Inf, or a rotation that is no longer a unit quaternion (see
+    /// [`BodyState::is_valid`]): the setting is outside the method's stable region.
+    #[error(
+        "integrator `{integrator}` diverged (non-finite state or non-unit rotation); the body was left unchanged"
+    )]
     Diverged {
         /// The method that diverged.
         integrator: Integrator,
