@@ -13,7 +13,7 @@ use crate::math::{Quat, Real, Vec3};
 use std::borrow::Borrow;
 
 use super::Integrator;
-use super::lanes::LANES;
+use super::simd::{Kernel, LANES};
 use super::splitting::{kick, translate_dkd};
 use super::symmetric_kernel::{
     LaneInputs, SymmetricInput, rotate_symmetric_lanes, rotate_symmetric_one,
@@ -127,17 +127,19 @@ struct PendingRotations {
     input: LaneInputs,
     h: [Real; LANES],
     len: usize,
+    kernel: Kernel,
 }
 
 impl PendingRotations {
-    /// No bodies yet; all of them will rotate over `h`.
-    fn new(h: Real) -> Self {
+    /// No bodies yet; all of them will rotate over `h`, `LANES` at a time on `kernel`.
+    fn new(h: Real, kernel: Kernel) -> Self {
         Self {
             index: [0; LANES],
             state: [BodyState::ZEROED; LANES],
             input: LaneInputs::default(),
             h: [h; LANES],
             len: 0,
+            kernel,
         }
     }
 
@@ -167,7 +169,7 @@ impl PendingRotations {
             }
             len => {
                 self.input.fill_from_first(len);
-                let rotated = rotate_symmetric_lanes(&self.input, self.h);
+                let rotated = rotate_symmetric_lanes(self.kernel, &self.input, self.h);
                 for lane in 0..len {
                     let (rotation, omega) = rotated.lane(lane);
                     self.finish(lane, rotation, omega, bodies);
@@ -214,12 +216,13 @@ fn each_alone(
 /// true if the body then rotates freely over `h` (queued for the SIMD kernel), or false if it
 /// needs the whole scalar step `alone` instead (and `next` is untouched).
 fn batched(
+    kernel: Kernel,
     bodies: &mut impl BodyBatch,
     h: Real,
     mut translate: impl FnMut(&mut BodyState, &MassProperties, &Wrench) -> bool,
     mut alone: impl FnMut(&mut BodyState, &MassProperties, &Wrench),
 ) {
-    let mut pending = PendingRotations::new(h);
+    let mut pending = PendingRotations::new(h, kernel);
     let mut next = BodyState::ZEROED;
     for i in 0..bodies.len() {
         bodies.prefetch(i + PREFETCH_AHEAD);
@@ -299,7 +302,31 @@ impl Integrator {
     /// reading and writing through the [`BodyBatch`]. A body whose result is not valid
     /// ([`BodyState::is_valid`]) keeps its state and is reported to [`BodyBatch::diverged`]; no other body is affected. Does not
     /// allocate.
+    ///
+    /// `splitting` rotates its bodies in SIMD lanes on the [`kernel_path`](super::kernel_path)
+    /// (every path gives the same bits).
+    ///
+    /// # Panics
+    ///
+    /// For `splitting`, when the environment variable [`KERNEL_ENV`](super::KERNEL_ENV) names a
+    /// kernel path this CPU cannot run (see [`KernelPath::selected`](super::KernelPath::selected)).
     pub fn step_batch(self, phase: StepPhase, bodies: &mut impl BodyBatch, dt: Real) {
+        let kernel = if self == Integrator::Splitting {
+            Kernel::selected()
+        } else {
+            Kernel::Portable
+        };
+        self.step_batch_on(kernel, phase, bodies, dt);
+    }
+
+    /// [`step_batch`](Self::step_batch) with the SIMD lanes of `splitting` on `kernel`.
+    pub(crate) fn step_batch_on(
+        self,
+        kernel: Kernel,
+        phase: StepPhase,
+        bodies: &mut impl BodyBatch,
+        dt: Real,
+    ) {
         if self != Integrator::Splitting {
             return match phase {
                 StepPhase::Whole => each_alone(bodies, |s, m, w| self.step(s, m, w, dt)),
@@ -310,6 +337,7 @@ impl Integrator {
         let h = 0.5 * dt;
         match phase {
             StepPhase::Whole => batched(
+                kernel,
                 bodies,
                 dt,
                 |next, m, wrench| {
@@ -323,6 +351,7 @@ impl Integrator {
                 |s, m, w| self.step(s, m, w, dt),
             ),
             StepPhase::Begin => batched(
+                kernel,
                 bodies,
                 h,
                 |next, _, _| {
@@ -332,6 +361,7 @@ impl Integrator {
                 |s, m, _| self.begin_step(s, m, dt),
             ),
             StepPhase::Finish => batched(
+                kernel,
                 bodies,
                 h,
                 |next, m, wrench| {

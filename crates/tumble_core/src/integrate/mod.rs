@@ -25,17 +25,13 @@
 //! | `yoshida4` | Yoshida composition of `splitting` | 4 | round-off | bounded |
 //! | `rk4` | RK4 on `Q̇ = ½ ω(Q) Q` at constant `L` | 4 | exact | slow drift |
 
-#[cfg(target_arch = "x86_64")]
-mod avx;
-#[cfg(target_arch = "x86_64")]
-mod avx512;
 mod batch;
 pub use batch::{BodyBatch, PREFETCH_AHEAD, StepPhase};
 mod frame;
 mod implicit_gyroscopic;
-pub mod lanes;
 mod lclamp;
 mod rk4;
+mod simd;
 mod splitting;
 mod symmetric_kernel;
 mod symplectic_euler;
@@ -56,6 +52,7 @@ pub use frame::{rotate, rotate_inv, world_momentum, world_omega};
 pub use implicit_gyroscopic::{implicit_gyroscopic, implicit_gyroscopic_rate};
 pub use lclamp::lclamp;
 pub use rk4::rk4_free_flow;
+pub use simd::{KERNEL_ENV, KernelError, KernelPath, kernel_path};
 pub use splitting::{
     FreeBody, FreeFlow, Rotation, begin_dkd, drift, finish_dkd, kick, rotate_freely,
     rotate_symmetric, strang_free_flow, symmetric_free_flow, torque_free_dkd, translate_dkd,
