@@ -3,8 +3,8 @@
 //!
 //! A batch reads each body from a [`BodyBatch`] (plain arrays, or an ECS table without an
 //! intermediate copy), steps it and writes it back. For `splitting` (the default) the free
-//! rotations of up to [`LANES`] non-spherical bodies are computed together in SIMD lanes by the
-//! kernel of [`super::symmetric_kernel`]; the translation, the kicks and spherical bodies stay
+//! rotations of up to eight non-spherical bodies are computed together in SIMD lanes by the
+//! kernel of `symmetric_kernel`, on the [`kernel_path`](super::kernel_path); the translation, the kicks and spherical bodies stay
 //! scalar. Every other method steps body by body. Either way each body's result is bit-identical
 //! to [`Integrator::try_step`] and friends on that body alone, whatever the batch, its order or
 //! the thread that runs it.
@@ -94,18 +94,18 @@ pub trait BodyBatch {
     /// its old one.
     fn diverged(&mut self, i: usize);
     /// A hint: body `i` (possibly beyond the last) will be read soon; fetch its memory with
-    /// [`prefetch`](crate::prefetch::prefetch). The batch loops call it [`PREFETCH_AHEAD`]
-    /// bodies ahead. Default: nothing.
+    /// [`prefetch`](crate::prefetch::prefetch). The batch loops call it a few dozen bodies
+    /// ahead, far enough for the memory to arrive before the body is read. Default: nothing.
     #[inline(always)]
     fn prefetch(&self, i: usize) {
         let _ = i;
     }
 }
 
-/// How many bodies ahead of the one being read the batch loops call [`BodyBatch::prefetch`].
-/// Measured (`ecs_vs_raw` example, 10⁶ bodies, `splitting`): ECS 53 → 40 ns per body-step;
-/// no change at 10⁴ and 10⁵, where the hardware prefetchers keep up.
-pub const PREFETCH_AHEAD: usize = 32;
+/// How many bodies ahead of the one being read the batch loops call [`BodyBatch::prefetch`]:
+/// it pays in worlds that outgrow the caches (see `report/bench.md`); smaller worlds, where the
+/// hardware prefetchers keep up, are unchanged.
+const PREFETCH_AHEAD: usize = 32;
 
 /// Hands `next` to `bodies` as body `i`'s new state if it is valid, else reports divergence.
 #[inline(always)]

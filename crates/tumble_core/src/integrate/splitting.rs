@@ -27,7 +27,7 @@
 //! In every sub-flow the world momentum `L` is fixed, so `|L|` of a torque-free body is kept to
 //! round-off. The flows run in f64 on the body momentum `m` and the principal orientation `Q`,
 //! each sub-flow a body-frame rotation `Q ← Q exp(θ e)` with `m ← exp(−θ e) m`; only the final
-//! `ω` and `q` are rounded to f32.
+//! `ω` and `q` are rounded to the engine's precision.
 //!
 //! **Known limit.** A thin body that is *not* symmetric (e.g. I = (1e-4, 1, 1.02)) spinning fast
 //! about a tilted axis: the residual rotation mixes the large transverse momentum into the tiny

@@ -367,7 +367,7 @@ fn rotate_symmetric_lanes_in<T: Lane>(
 
 /// The kernel on bodies `start .. start + T::WIDTH` of the batch. Plain indexing, no closures:
 /// inside a `#[target_feature]` function every helper must inline, and a closure is compiled
-/// without the feature (its intrinsics then become calls, 1.8× slower).
+/// without the feature (its intrinsics then become calls).
 #[inline(always)]
 #[allow(clippy::needless_range_loop)]
 fn rotate_run<T: Lane>(
