@@ -14,7 +14,7 @@ use std::borrow::Borrow;
 
 use super::Integrator;
 use super::simd::{Kernel, LANES};
-use super::splitting::{kick, translate_dkd};
+use super::splitting::{drift_kick_drift_translation, free_rotation_span};
 use super::symmetric_kernel::{
     LaneInputs, SymmetricInput, rotate_symmetric_lanes, rotate_symmetric_one,
 };
@@ -212,16 +212,17 @@ fn each_alone(
     }
 }
 
-/// The `splitting` batch: `translate(next, mass, wrench)` does a body's scalar part and returns
-/// true if the body then rotates freely over `h` (queued for the SIMD kernel), or false if it
-/// needs the whole scalar step `alone` instead (and `next` is untouched).
+/// The `splitting` batch: each body's drift–kick–drift translation, then its free rotation,
+/// queued for the SIMD kernel ([`PendingRotations`]), or stepped whole by `alone` when its
+/// translation cannot run first (a whole step under a torque).
 fn batched(
     kernel: Kernel,
+    phase: StepPhase,
     bodies: &mut impl BodyBatch,
-    h: Real,
-    mut translate: impl FnMut(&mut BodyState, &MassProperties, &Wrench) -> bool,
+    dt: Real,
     mut alone: impl FnMut(&mut BodyState, &MassProperties, &Wrench),
 ) {
+    let h = free_rotation_span(phase, dt);
     let mut pending = PendingRotations::new(h, kernel);
     let mut next = BodyState::ZEROED;
     for i in 0..bodies.len() {
@@ -230,7 +231,7 @@ fn batched(
             continue;
         };
         let mass = bodies.mass(i);
-        match translate(&mut next, mass, &wrench) {
+        match drift_kick_drift_translation(phase, &mut next, mass, &wrench, dt) {
             true if mass.is_spherical() => {
                 next.rotation = rotate_exact(next.rotation, next.angular_velocity, h);
                 commit(bodies, i, &next);
@@ -327,50 +328,13 @@ impl Integrator {
         bodies: &mut impl BodyBatch,
         dt: Real,
     ) {
-        if self != Integrator::Splitting {
-            return match phase {
-                StepPhase::Whole => each_alone(bodies, |s, m, w| self.step(s, m, w, dt)),
-                StepPhase::Begin => each_alone(bodies, |s, m, _| self.begin_step(s, m, dt)),
-                StepPhase::Finish => each_alone(bodies, |s, m, w| self.finish_step(s, m, w, dt)),
-            };
-        }
-        let h = 0.5 * dt;
-        match phase {
-            StepPhase::Whole => batched(
-                kernel,
-                bodies,
-                dt,
-                |next, m, wrench| {
-                    // A torque must be kicked between two half rotations: that body steps alone.
-                    let free = wrench.torque == Vec3::ZERO;
-                    if free {
-                        translate_dkd(next, m, wrench, dt);
-                    }
-                    free
-                },
-                |s, m, w| self.step(s, m, w, dt),
-            ),
-            StepPhase::Begin => batched(
-                kernel,
-                bodies,
-                h,
-                |next, _, _| {
-                    next.position += h * next.linear_velocity;
-                    true
-                },
-                |s, m, _| self.begin_step(s, m, dt),
-            ),
-            StepPhase::Finish => batched(
-                kernel,
-                bodies,
-                h,
-                |next, m, wrench| {
-                    kick(next, m, wrench, dt);
-                    next.position += h * next.linear_velocity;
-                    true
-                },
-                |s, m, w| self.finish_step(s, m, w, dt),
-            ),
+        let alone = |s: &mut BodyState, m: &MassProperties, w: &Wrench| {
+            self.step_phase(phase, s, m, w, dt);
+        };
+        if self == Integrator::Splitting {
+            batched(kernel, phase, bodies, dt, alone);
+        } else {
+            each_alone(bodies, alone);
         }
     }
 

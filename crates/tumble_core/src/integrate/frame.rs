@@ -6,13 +6,16 @@
 use crate::math::{Narrow, Quat, Vec3, Widen};
 use glam::{DQuat, DVec3};
 
+use super::simd::Lane;
 use crate::mass::MassProperties;
 use crate::state::BodyState;
 
-/// Reciprocal of a principal moment, `0` for a locked axis.
-#[inline]
-pub fn recip(moment: f64) -> f64 {
-    if moment > 0.0 { 1.0 / moment } else { 0.0 }
+/// Reciprocal of a principal moment, `0` for a locked axis, in lanes (`f64` for one body).
+#[inline(always)]
+pub(crate) fn reciprocal<T: Lane>(moment: T) -> T {
+    let cpu = moment.cpu();
+    let zero = T::splat(cpu, 0.0);
+    T::select(moment.gt(zero), T::splat(cpu, 1.0) / moment, zero)
 }
 
 /// `q v q* / |q|²` in f64: `((w² − b·b) v + 2 (b·v) b + 2w (b × v)) / (w² + b·b)`, `q = (b, w)`;

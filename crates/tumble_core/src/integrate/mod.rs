@@ -39,7 +39,7 @@ mod symplectic_euler;
 mod tests;
 mod yoshida;
 
-use crate::math::{Real, Vec3};
+use crate::math::Real;
 use std::fmt;
 use std::str::FromStr;
 
@@ -56,11 +56,9 @@ use lclamp::lclamp;
 use rk4::rk4_free_flow;
 pub use simd::{KERNEL_ENV, KernelError, KernelPath, kernel_path};
 use splitting::{
-    Rotation, begin_dkd, finish_dkd, rotate_freely, rotate_symmetric, strang_free_flow,
-    torque_free_dkd,
+    Rotation, drift_kick_drift, rotate_freely, rotate_symmetric, rotate_yoshida, strang_free_flow,
 };
 use symplectic_euler::{symplectic_euler, symplectic_euler_linear};
-use yoshida::yoshida_free_flow;
 
 /// A time-integration method, selectable per world.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
@@ -146,7 +144,7 @@ impl Integrator {
     /// The free rotation of a drift–kick–drift method.
     fn free_rotation(self) -> Rotation {
         match self {
-            Integrator::Yoshida4 => |s, m, h| rotate_freely(s, m, h, yoshida_free_flow),
+            Integrator::Yoshida4 => rotate_yoshida,
             Integrator::Rk4 => |s, m, h| rotate_freely(s, m, h, rk4_free_flow),
             Integrator::SplittingXyz => |s, m, h| rotate_freely(s, m, h, strang_free_flow),
             _ => rotate_symmetric,
@@ -158,7 +156,8 @@ impl Integrator {
     #[inline]
     pub fn begin_step(self, state: &mut BodyState, mass: &MassProperties, dt: Real) {
         if self.samples_forces_at_midpoint() {
-            begin_dkd(state, mass, dt, self.free_rotation());
+            let rotation = self.free_rotation();
+            drift_kick_drift(StepPhase::Begin, state, mass, &Wrench::ZERO, dt, rotation);
         }
     }
 
@@ -179,7 +178,10 @@ impl Integrator {
             Integrator::Splitting
             | Integrator::SplittingXyz
             | Integrator::Yoshida4
-            | Integrator::Rk4 => finish_dkd(state, mass, wrench, dt, self.free_rotation()),
+            | Integrator::Rk4 => {
+                let rotation = self.free_rotation();
+                drift_kick_drift(StepPhase::Finish, state, mass, wrench, dt, rotation);
+            }
         }
     }
 
@@ -191,11 +193,30 @@ impl Integrator {
     /// order. The ECS takes this path for bodies without a `ForceAccumulator`.
     #[inline]
     pub fn step(self, state: &mut BodyState, mass: &MassProperties, wrench: &Wrench, dt: Real) {
-        if self.samples_forces_at_midpoint() && wrench.torque == Vec3::ZERO {
-            torque_free_dkd(state, mass, wrench, dt, self.free_rotation());
+        if self.samples_forces_at_midpoint() {
+            let rotation = self.free_rotation();
+            drift_kick_drift(StepPhase::Whole, state, mass, wrench, dt, rotation);
         } else {
-            self.begin_step(state, mass, dt);
+            // The kick–drift methods do nothing before the forces: the step is its second phase.
             self.finish_step(state, mass, wrench, dt);
+        }
+    }
+
+    /// `phase` of a step: [`step`](Self::step), [`begin_step`](Self::begin_step) (the load is
+    /// not used) or [`finish_step`](Self::finish_step).
+    #[inline]
+    fn step_phase(
+        self,
+        phase: StepPhase,
+        state: &mut BodyState,
+        mass: &MassProperties,
+        wrench: &Wrench,
+        dt: Real,
+    ) {
+        match phase {
+            StepPhase::Whole => self.step(state, mass, wrench, dt),
+            StepPhase::Begin => self.begin_step(state, mass, dt),
+            StepPhase::Finish => self.finish_step(state, mass, wrench, dt),
         }
     }
 

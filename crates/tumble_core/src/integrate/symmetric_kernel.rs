@@ -16,6 +16,7 @@
 //! A rotation by a zero angle is the exact identity (`sin 0 = 0`, `cos 0 = 1`), so locked axes
 //! (`r = 0`) and symmetric bodies need no branches.
 
+use super::frame::reciprocal;
 #[cfg(target_arch = "x86_64")]
 use super::simd::{Avx2, Avx4, Avx8, Avx512};
 use super::simd::{F64x4, Kernel, LANES, Lane, Portable, sin_cos};
@@ -207,52 +208,72 @@ impl LaneInputs {
     }
 }
 
-/// Reciprocal of a principal moment, `0` for a locked axis.
-#[inline(always)]
-fn reciprocal<T: Lane>(moment: T) -> T {
-    let cpu = moment.cpu();
-    let zero = T::splat(cpu, 0.0);
-    T::select(moment.gt(zero), T::splat(cpu, 1.0) / moment, zero)
+/// A free flow under way: the body in its relabelled principal frame `F'`, its reciprocal
+/// moments `r` (0 on a locked axis), and `F'` to return through.
+pub(super) struct Flowing<T> {
+    free: Free<T>,
+    r: Vec3L<T>,
+    frame: Quat4<T>,
+}
+
+impl<T: Lane> Flowing<T> {
+    /// `Q = q F'`, `m = I' ⊙ Qᵀω`.
+    #[inline(always)]
+    pub(super) fn start(input: &SymmetricInput<T>) -> Self {
+        let inertia = input.inertia;
+        let r = inertia.map(reciprocal);
+        let frame = mul(input.frame, input.relabel);
+        let q = mul(input.rotation, frame);
+        let body = rotate(conjugate(q), input.omega);
+        let m = [
+            inertia[0] * body[0],
+            inertia[1] * body[1],
+            inertia[2] * body[2],
+        ];
+        Self {
+            free: Free { q, m },
+            r,
+            frame,
+        }
+    }
+
+    /// The symmetric + residual Strang flow over `h`, `R(h/2) ∘ S(h) ∘ R(h/2)` (see
+    /// [`super::splitting`]): the odd axis is `x`, the symmetric pair `(y, z)`.
+    #[inline(always)]
+    pub(super) fn symmetric_flow(&mut self, h: T) {
+        let (free, r) = (&mut self.free, self.r);
+        let half = T::splat(h.cpu(), 0.5) * h;
+        let residual = r[2] - r[1];
+        free.rotate_z(half * residual * free.m[2]);
+        free.rotate_about_momentum(r[1], h);
+        free.rotate_x(h * (r[0] - r[1]) * free.m[0]);
+        free.rotate_z(half * residual * free.m[2]);
+    }
+
+    /// The new orientation (unit, f64) and world angular velocity: `ω' = Q (r ⊙ m)`,
+    /// `q' = normalize(Q F'ᵀ)`.
+    #[inline(always)]
+    pub(super) fn finish(self) -> (Quat4<T>, Vec3L<T>) {
+        let (Free { q, m }, r) = (self.free, self.r);
+        let omega = rotate(q, [r[0] * m[0], r[1] * m[1], r[2] * m[2]]);
+        let [x, y, z, w] = mul(q, conjugate(self.frame));
+        let inv = T::splat(w.cpu(), 1.0) / (x * x + y * y + z * z + w * w).sqrt();
+        ([x * inv, y * inv, z * inv, w * inv], omega)
+    }
 }
 
 /// The free rotation over `h` of the `splitting` method, in lanes: returns the new orientation
 /// (unit, f64) and world angular velocity. See the module documentation for the sequence.
 #[inline(always)]
 pub fn symmetric_rotation<T: Lane>(input: &SymmetricInput<T>, h: T) -> (Quat4<T>, Vec3L<T>) {
-    let inertia = input.inertia;
-    let r = [
-        reciprocal(inertia[0]),
-        reciprocal(inertia[1]),
-        reciprocal(inertia[2]),
-    ];
-    let frame = mul(input.frame, input.relabel);
-    let q = mul(input.rotation, frame);
-    let body = rotate(conjugate(q), input.omega);
-    let mut free = Free {
-        q,
-        m: [
-            inertia[0] * body[0],
-            inertia[1] * body[1],
-            inertia[2] * body[2],
-        ],
-    };
-    let cpu = h.cpu();
-    let half = T::splat(cpu, 0.5) * h;
-    let residual = r[2] - r[1];
-    free.rotate_z(half * residual * free.m[2]);
-    free.rotate_about_momentum(r[1], h);
-    free.rotate_x(h * (r[0] - r[1]) * free.m[0]);
-    free.rotate_z(half * residual * free.m[2]);
-    let m = free.m;
-    let omega = rotate(free.q, [r[0] * m[0], r[1] * m[1], r[2] * m[2]]);
-    let [x, y, z, w] = mul(free.q, conjugate(frame));
-    let inv = T::splat(cpu, 1.0) / (x * x + y * y + z * z + w * w).sqrt();
-    ([x * inv, y * inv, z * inv, w * inv], omega)
+    let mut flowing = Flowing::start(input);
+    flowing.symmetric_flow(h);
+    flowing.finish()
 }
 
 /// Rounds a kernel result to the engine's precision.
 #[inline(always)]
-fn to_real(q: [f64; 4], w: [f64; 3]) -> (Quat, Vec3) {
+pub(super) fn to_real(q: [f64; 4], w: [f64; 3]) -> (Quat, Vec3) {
     (
         Quat::from_xyzw(q[0].narrow(), q[1].narrow(), q[2].narrow(), q[3].narrow()),
         Vec3::new(w[0].narrow(), w[1].narrow(), w[2].narrow()),

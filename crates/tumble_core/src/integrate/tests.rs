@@ -3,7 +3,7 @@
 use super::*;
 use crate::error::UNIT_QUATERNION_TOLERANCE;
 use crate::mass::Mass;
-use crate::math::Quat;
+use crate::math::{Quat, Vec3, Widen};
 
 /// A ball spinning so fast that the linearized rotation update `q + ½Δt (ω, 0) q` overflows
 /// `|q|²`: `normalize` then scales by `1/√∞ = 0` and returns the zero quaternion, a finite
@@ -185,7 +185,6 @@ fn bits(states: &[BodyState]) -> Vec<u64> {
         .collect()
 }
 
-use crate::math::Widen;
 use simd::Kernel;
 
 #[test]
