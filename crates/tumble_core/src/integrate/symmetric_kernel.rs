@@ -221,7 +221,13 @@ impl<T: Lane> Flowing<T> {
     #[inline(always)]
     pub(super) fn start(input: &SymmetricInput<T>) -> Self {
         let inertia = input.inertia;
-        let r = inertia.map(reciprocal);
+        // Written out, not `inertia.map(reciprocal)`: inside a `#[target_feature]` function
+        // every helper must inline, and `map` need not (see `rotate_run`).
+        let r = [
+            reciprocal(inertia[0]),
+            reciprocal(inertia[1]),
+            reciprocal(inertia[2]),
+        ];
         let frame = mul(input.frame, input.relabel);
         let q = mul(input.rotation, frame);
         let body = rotate(conjugate(q), input.omega);
