@@ -215,6 +215,7 @@ fn each_alone(
 /// The `splitting` batch: each body's drift–kick–drift translation, then its free rotation,
 /// queued for the SIMD kernel ([`PendingRotations`]), or stepped whole by `alone` when its
 /// translation cannot run first (a whole step under a torque).
+#[inline(always)]
 fn batched(
     kernel: Kernel,
     phase: StepPhase,
@@ -331,10 +332,14 @@ impl Integrator {
         let alone = |s: &mut BodyState, m: &MassProperties, w: &Wrench| {
             self.step_phase(phase, s, m, w, dt);
         };
-        if self == Integrator::Splitting {
-            batched(kernel, phase, bodies, dt, alone);
-        } else {
-            each_alone(bodies, alone);
+        if self != Integrator::Splitting {
+            return each_alone(bodies, alone);
+        }
+        // One loop per phase, each with its phase a constant, as if written out three times.
+        match phase {
+            StepPhase::Whole => batched(kernel, StepPhase::Whole, bodies, dt, alone),
+            StepPhase::Begin => batched(kernel, StepPhase::Begin, bodies, dt, alone),
+            StepPhase::Finish => batched(kernel, StepPhase::Finish, bodies, dt, alone),
         }
     }
 

@@ -321,7 +321,10 @@ impl RotatedLanes {
 /// [`LANES`] bodies through the kernel at once (SIMD lanes), each over its own `h`, on the
 /// `kernel`'s instruction set; lane `i` of the result is bit-identical to
 /// [`rotate_symmetric_one`]`(&inputs[i], h[i])` on every path.
-#[inline]
+// Not inlined: the portable kernel compiles into this function, and inlined into the batch
+// loops (three of them, one per phase) it bloats them past what the instruction cache and the
+// register allocator handle well; one call per eight bodies costs nothing in comparison.
+#[inline(never)]
 pub fn rotate_symmetric_lanes(
     kernel: Kernel,
     inputs: &LaneInputs,
