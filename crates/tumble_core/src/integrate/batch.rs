@@ -4,8 +4,8 @@
 //! A batch reads each body from a [`BodyBatch`] (plain arrays, or an ECS table without an
 //! intermediate copy), steps it and writes it back. For `splitting` (the default) the free
 //! rotations of up to eight non-spherical bodies are computed together in SIMD lanes by the
-//! kernel of `symmetric_kernel`, on the [`kernel_path`](super::kernel_path); the translation, the kicks and spherical bodies stay
-//! scalar. Every other method steps body by body. Either way each body's result is bit-identical
+//! kernel of `symmetric_kernel`, on the [`kernel_path`](super::kernel_path); the translation,
+//! the kicks and spherical bodies stay scalar. Every other method steps body by body. Either way each body's result is bit-identical
 //! to [`Integrator::try_step`] and friends on that body alone, whatever the batch, its order or
 //! the thread that runs it.
 
@@ -302,8 +302,8 @@ impl<M: Borrow<MassProperties>> BodyBatch for Slices<'_, M> {
 impl Integrator {
     /// Steps every body of `bodies` through `phase` by `dt` (each body's load held constant),
     /// reading and writing through the [`BodyBatch`]. A body whose result is not valid
-    /// ([`BodyState::is_valid`]) keeps its state and is reported to [`BodyBatch::diverged`]; no other body is affected. Does not
-    /// allocate.
+    /// ([`BodyState::is_valid`]) keeps its state and is reported to [`BodyBatch::diverged`]; no
+    /// other body is affected. Does not allocate.
     ///
     /// `splitting` rotates its bodies in SIMD lanes on the [`kernel_path`](super::kernel_path)
     /// (every path gives the same bits).

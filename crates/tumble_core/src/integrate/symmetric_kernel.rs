@@ -286,7 +286,8 @@ pub(super) fn to_real(q: [f64; 4], w: [f64; 3]) -> (Quat, Vec3) {
     )
 }
 
-/// One body through the kernel (`f64` lanes): the new `(q, ω)`, rounded to the engine precision once.
+/// One body through the kernel (`f64` lanes): the new `(q, ω)`, rounded to the engine
+/// precision once.
 #[inline]
 pub fn rotate_symmetric_one(input: &SymmetricInput, h: Real) -> (Quat, Vec3) {
     let (q, w) = symmetric_rotation::<f64>(input, h.widen());

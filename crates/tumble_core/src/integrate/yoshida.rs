@@ -1,4 +1,5 @@
-//! Fourth-order composition of the symmetric + residual Strang free flow (Yoshida 1990; Suzuki 1990):
+//! Fourth-order composition of the symmetric + residual Strang free flow (Yoshida 1990;
+//! Suzuki 1990):
 //!
 //! ```text
 //! Ψ_h = Φ_{c₁h} ∘ Φ_{c₀h} ∘ Φ_{c₁h},   c₁ = 1/(2 − 2^{1/3}),   c₀ = 1 − 2c₁ = −2^{1/3} c₁

@@ -1,6 +1,8 @@
 //! The lanes every CPU runs: `f64` (one body) and [`F64x4`] (`wide::f64x4`: SSE2 pairs on the
 //! x86_64 baseline, NEON or scalar elsewhere).
 
+use std::ops::{Add, Div, Mul, Sub};
+
 use super::{Lane, lane_ops};
 
 /// Proof that the CPU runs the portable lanes: every CPU does, so anyone may make one.
@@ -56,7 +58,7 @@ pub(crate) struct F64x4 {
     cpu: Portable,
 }
 
-lane_ops!(F64x4, safe: std::ops::Add::add, std::ops::Sub::sub, std::ops::Mul::mul, std::ops::Div::div);
+lane_ops!(F64x4, safe: Add::add, Sub::sub, Mul::mul, Div::div);
 
 impl std::ops::Neg for F64x4 {
     type Output = Self;
