@@ -3,6 +3,11 @@
 //! audit (`EnergyAudit::Auto`, the default for a world with springs) and without it
 //! (`EnergyAudit::Never`). Report the ratio, not the absolute time.
 
+#![expect(
+    missing_docs,
+    reason = "criterion_group! generates a public fn without docs; a bench has no API"
+)]
+
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use tumble::bevy_ecs::prelude::*;
 use tumble::math::{Quat, Real, Vec3};

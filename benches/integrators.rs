@@ -3,6 +3,10 @@
 //! Rates stay below 1.5 rad/s so that even the explicit textbook step stays finite for the
 //! whole measurement (its blow-up time is over 1000 s here): a benchmark of NaN arithmetic
 //! would measure nothing.
+#![expect(
+    missing_docs,
+    reason = "criterion_group! generates a public fn without docs; a bench has no API"
+)]
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use tumble::math::{Quat, Real, Vec3};

@@ -60,6 +60,10 @@ fn main() -> ExitCode {
         Err(e) => return usage_error(&e),
     };
     logging::init(cli.verbose, cli.quiet);
+    // A bad TUMBLE_KERNEL is a clear error here, not a panic in the middle of a step.
+    if let Err(e) = tumble_core::KernelPath::selected() {
+        return Failure::new(exit::ERROR, e.to_string()).report();
+    }
     interrupt::install();
     match dispatch(cli) {
         Ok(()) => ExitCode::from(exit::SUCCESS),

@@ -12,9 +12,6 @@
 //!   `R I_b⁻¹ Rᵀ` is applied by rotating into the principal frame, never inverted numerically.
 //! - A zero principal moment locks that axis (its inverse is 0), never NaN.
 
-#![deny(unsafe_code)]
-#![warn(missing_docs)]
-
 pub mod error;
 pub mod exact;
 pub mod integrate;
@@ -31,6 +28,6 @@ pub mod shapes;
 pub mod state;
 
 pub use error::{InvalidInput, UNIT_QUATERNION_TOLERANCE};
-pub use integrate::{BodyBatch, Integrator, StepError, StepPhase};
+pub use integrate::{BodyBatch, Integrator, KernelPath, StepError, StepPhase, kernel_path};
 pub use mass::{Density, Mass, MassProperties};
 pub use state::{BodyState, Wrench};

@@ -1,4 +1,5 @@
-//! Quaternion helpers: the exponential map and its linearization.
+//! Quaternion helpers: the exponential map and its linearization (internal to the integrators),
+//! and the angle between two orientations.
 
 use crate::math::{Quat, Real, Vec3, Widen};
 /// The unit quaternion of a rotation by the vector `θ` (axis `θ/|θ|`, angle `|θ|`):
@@ -7,7 +8,7 @@ use crate::math::{Quat, Real, Vec3, Widen};
 /// For `|θ|` below 1e-4 rad the Taylor form `(θ/2 (1 − |θ|²/24), 1 − |θ|²/8)` is used, which is
 /// exact in f32 there and avoids dividing by a tiny angle.
 #[inline]
-pub fn exp_rotation(theta: Vec3) -> Quat {
+pub(crate) fn exp_rotation(theta: Vec3) -> Quat {
     let angle2 = theta.length_squared();
     if angle2 < 1e-8 {
         let xyz = theta * (0.5 * (1.0 - angle2 / 24.0));
@@ -23,14 +24,14 @@ pub fn exp_rotation(theta: Vec3) -> Quat {
 /// Rotates `q` by the world angular velocity `ω` over `dt` with the exact exponential map:
 /// `q ← exp(½ Δt ω) q`, then renormalizes to remove round-off.
 #[inline]
-pub fn rotate_exact(q: Quat, omega: Vec3, dt: Real) -> Quat {
+pub(crate) fn rotate_exact(q: Quat, omega: Vec3, dt: Real) -> Quat {
     (exp_rotation(omega * dt) * q).normalize()
 }
 
 /// The linearized update `q ← normalize(q + ½ Δt (ω, 0) q)`: first-order, its error grows with
 /// `|ω|Δt` (kept to show that error, see the `symplectic-euler-linear` integrator).
 #[inline]
-pub fn rotate_linearized(q: Quat, omega: Vec3, dt: Real) -> Quat {
+pub(crate) fn rotate_linearized(q: Quat, omega: Vec3, dt: Real) -> Quat {
     let w = Quat::from_xyzw(omega.x, omega.y, omega.z, 0.0);
     (q + (w * q) * (0.5 * dt)).normalize()
 }

@@ -1,6 +1,6 @@
 //! Rigid-body state and the external load applied over one step.
 
-use crate::error::{InvalidInput, check_finite_vec3, check_unit_quat};
+use crate::error::{InvalidInput, UNIT_QUATERNION_TOLERANCE, check_finite_vec3, check_unit_quat};
 use crate::math::{Quat, Vec3};
 
 /// Kinematic state of one rigid body.
@@ -67,6 +67,16 @@ impl BodyState {
         let vectors = p * 0.0 + v * 0.0 + w * 0.0;
         let quat = crate::math::Vec4::from(q) * 0.0;
         (vectors.x + vectors.y + vectors.z + quat.x + quat.y + quat.z + quat.w) == 0.0
+    }
+
+    /// True when every component is finite and the rotation is a unit quaternion within
+    /// [`UNIT_QUATERNION_TOLERANCE`]: the test [`validate`](Self::validate) makes, as a `bool`
+    /// (no allocation), which a step's result must pass to be committed.
+    #[inline]
+    pub fn is_valid(&self) -> bool {
+        // `is_finite` first: the length of a non-finite quaternion is NaN or Inf anyway, but
+        // a finite state is the common case and the cheap test is branch-free.
+        self.is_finite() && (self.rotation.length() - 1.0).abs() <= UNIT_QUATERNION_TOLERANCE
     }
 
     /// Checks that every component is finite and the rotation is a unit quaternion.

@@ -3,9 +3,9 @@
 //!
 //! A batch reads each body from a [`BodyBatch`] (plain arrays, or an ECS table without an
 //! intermediate copy), steps it and writes it back. For `splitting` (the default) the free
-//! rotations of up to [`LANES`] non-spherical bodies are computed together in SIMD lanes by the
-//! kernel of [`super::symmetric_kernel`]; the translation, the kicks and spherical bodies stay
-//! scalar. Every other method steps body by body. Either way each body's result is bit-identical
+//! rotations of up to eight non-spherical bodies are computed together in SIMD lanes by the
+//! kernel of `symmetric_kernel`, on the [`kernel_path`](super::kernel_path); the translation,
+//! the kicks and spherical bodies stay scalar. Every other method steps body by body. Either way each body's result is bit-identical
 //! to [`Integrator::try_step`] and friends on that body alone, whatever the batch, its order or
 //! the thread that runs it.
 
@@ -13,8 +13,8 @@ use crate::math::{Quat, Real, Vec3};
 use std::borrow::Borrow;
 
 use super::Integrator;
-use super::lanes::LANES;
-use super::splitting::{kick, translate_dkd};
+use super::simd::{Kernel, LANES};
+use super::splitting::{drift_kick_drift_translation, free_rotation_span};
 use super::symmetric_kernel::{
     LaneInputs, SymmetricInput, rotate_symmetric_lanes, rotate_symmetric_one,
 };
@@ -39,9 +39,10 @@ pub enum StepPhase {
 /// Where a batched step finds its bodies and puts them back.
 ///
 /// [`Integrator::step_batch`] calls [`read`](Self::read) once for every index in `0..len()`,
-/// in increasing order, then exactly one of [`write`](Self::write) (the new state is finite)
-/// or [`diverged`](Self::diverged) (it is not: the body keeps its old state) for every body that
-/// `read` returned, not necessarily in order.
+/// in increasing order, then exactly one of [`write`](Self::write) (the new state is valid:
+/// finite, with a unit rotation, [`BodyState::is_valid`]) or [`diverged`](Self::diverged) (it is
+/// not: the body keeps its old state) for every body that `read` returned, not necessarily in
+/// order.
 ///
 /// Bodies kept in your own layout, here one struct per body with a frozen flag:
 ///
@@ -87,28 +88,29 @@ pub trait BodyBatch {
     fn read(&mut self, i: usize, state: &mut BodyState) -> Option<Wrench>;
     /// Body `i`'s mass properties.
     fn mass(&self, i: usize) -> &MassProperties;
-    /// Stores body `i`'s new, finite state.
+    /// Stores body `i`'s new, valid state.
     fn write(&mut self, i: usize, state: &BodyState);
-    /// Body `i`'s step did not give a finite state; it keeps its old one.
+    /// Body `i`'s step did not give a valid state (non-finite, or a non-unit rotation); it keeps
+    /// its old one.
     fn diverged(&mut self, i: usize);
     /// A hint: body `i` (possibly beyond the last) will be read soon; fetch its memory with
-    /// [`prefetch`](crate::prefetch::prefetch). The batch loops call it [`PREFETCH_AHEAD`]
-    /// bodies ahead. Default: nothing.
+    /// [`prefetch`](crate::prefetch::prefetch). The batch loops call it a few dozen bodies
+    /// ahead, far enough for the memory to arrive before the body is read. Default: nothing.
     #[inline(always)]
     fn prefetch(&self, i: usize) {
         let _ = i;
     }
 }
 
-/// How many bodies ahead of the one being read the batch loops call [`BodyBatch::prefetch`].
-/// Measured (`ecs_vs_raw` example, 10⁶ bodies, `splitting`): ECS 53 → 40 ns per body-step;
-/// no change at 10⁴ and 10⁵, where the hardware prefetchers keep up.
-pub const PREFETCH_AHEAD: usize = 32;
+/// How many bodies ahead of the one being read the batch loops call [`BodyBatch::prefetch`]:
+/// it pays in worlds that outgrow the caches (see `report/bench.md`); smaller worlds, where the
+/// hardware prefetchers keep up, are unchanged.
+const PREFETCH_AHEAD: usize = 32;
 
-/// Hands `next` to `bodies` as body `i`'s new state if it is finite, else reports divergence.
+/// Hands `next` to `bodies` as body `i`'s new state if it is valid, else reports divergence.
 #[inline(always)]
 fn commit(bodies: &mut impl BodyBatch, i: usize, next: &BodyState) {
-    if next.is_finite() {
+    if next.is_valid() {
         bodies.write(i, next);
     } else {
         bodies.diverged(i);
@@ -125,17 +127,19 @@ struct PendingRotations {
     input: LaneInputs,
     h: [Real; LANES],
     len: usize,
+    kernel: Kernel,
 }
 
 impl PendingRotations {
-    /// No bodies yet; all of them will rotate over `h`.
-    fn new(h: Real) -> Self {
+    /// No bodies yet; all of them will rotate over `h`, `LANES` at a time on `kernel`.
+    fn new(h: Real, kernel: Kernel) -> Self {
         Self {
             index: [0; LANES],
             state: [BodyState::ZEROED; LANES],
             input: LaneInputs::default(),
             h: [h; LANES],
             len: 0,
+            kernel,
         }
     }
 
@@ -165,7 +169,7 @@ impl PendingRotations {
             }
             len => {
                 self.input.fill_from_first(len);
-                let rotated = rotate_symmetric_lanes(&self.input, self.h);
+                let rotated = rotate_symmetric_lanes(self.kernel, &self.input, self.h);
                 for lane in 0..len {
                     let (rotation, omega) = rotated.lane(lane);
                     self.finish(lane, rotation, omega, bodies);
@@ -208,16 +212,19 @@ fn each_alone(
     }
 }
 
-/// The `splitting` batch: `translate(next, mass, wrench)` does a body's scalar part and returns
-/// true if the body then rotates freely over `h` (queued for the SIMD kernel), or false if it
-/// needs the whole scalar step `alone` instead (and `next` is untouched).
+/// The `splitting` batch: each body's drift–kick–drift translation, then its free rotation,
+/// queued for the SIMD kernel ([`PendingRotations`]), or stepped whole by `alone` when its
+/// translation cannot run first (a whole step under a torque).
+#[inline(always)]
 fn batched(
+    kernel: Kernel,
+    phase: StepPhase,
     bodies: &mut impl BodyBatch,
-    h: Real,
-    mut translate: impl FnMut(&mut BodyState, &MassProperties, &Wrench) -> bool,
+    dt: Real,
     mut alone: impl FnMut(&mut BodyState, &MassProperties, &Wrench),
 ) {
-    let mut pending = PendingRotations::new(h);
+    let h = free_rotation_span(phase, dt);
+    let mut pending = PendingRotations::new(h, kernel);
     let mut next = BodyState::ZEROED;
     for i in 0..bodies.len() {
         bodies.prefetch(i + PREFETCH_AHEAD);
@@ -225,7 +232,7 @@ fn batched(
             continue;
         };
         let mass = bodies.mass(i);
-        match translate(&mut next, mass, &wrench) {
+        match drift_kick_drift_translation(phase, &mut next, mass, &wrench, dt) {
             true if mass.is_spherical() => {
                 next.rotation = rotate_exact(next.rotation, next.angular_velocity, h);
                 commit(bodies, i, &next);
@@ -294,51 +301,45 @@ impl<M: Borrow<MassProperties>> BodyBatch for Slices<'_, M> {
 
 impl Integrator {
     /// Steps every body of `bodies` through `phase` by `dt` (each body's load held constant),
-    /// reading and writing through the [`BodyBatch`]. A body whose result is not finite keeps
-    /// its state and is reported to [`BodyBatch::diverged`]; no other body is affected. Does not
-    /// allocate.
+    /// reading and writing through the [`BodyBatch`]. A body whose result is not valid
+    /// ([`BodyState::is_valid`]) keeps its state and is reported to [`BodyBatch::diverged`]; no
+    /// other body is affected. Does not allocate.
+    ///
+    /// `splitting` rotates its bodies in SIMD lanes on the [`kernel_path`](super::kernel_path)
+    /// (every path gives the same bits).
+    ///
+    /// # Panics
+    ///
+    /// For `splitting`, when the environment variable [`KERNEL_ENV`](super::KERNEL_ENV) names a
+    /// kernel path this CPU cannot run (see [`KernelPath::selected`](super::KernelPath::selected)).
     pub fn step_batch(self, phase: StepPhase, bodies: &mut impl BodyBatch, dt: Real) {
+        let kernel = if self == Integrator::Splitting {
+            Kernel::selected()
+        } else {
+            Kernel::Portable
+        };
+        self.step_batch_on(kernel, phase, bodies, dt);
+    }
+
+    /// [`step_batch`](Self::step_batch) with the SIMD lanes of `splitting` on `kernel`.
+    pub(crate) fn step_batch_on(
+        self,
+        kernel: Kernel,
+        phase: StepPhase,
+        bodies: &mut impl BodyBatch,
+        dt: Real,
+    ) {
+        let alone = |s: &mut BodyState, m: &MassProperties, w: &Wrench| {
+            self.step_phase(phase, s, m, w, dt);
+        };
         if self != Integrator::Splitting {
-            return match phase {
-                StepPhase::Whole => each_alone(bodies, |s, m, w| self.step(s, m, w, dt)),
-                StepPhase::Begin => each_alone(bodies, |s, m, _| self.begin_step(s, m, dt)),
-                StepPhase::Finish => each_alone(bodies, |s, m, w| self.finish_step(s, m, w, dt)),
-            };
+            return each_alone(bodies, alone);
         }
-        let h = 0.5 * dt;
+        // One loop per phase, each with its phase a constant, as if written out three times.
         match phase {
-            StepPhase::Whole => batched(
-                bodies,
-                dt,
-                |next, m, wrench| {
-                    // A torque must be kicked between two half rotations: that body steps alone.
-                    let free = wrench.torque == Vec3::ZERO;
-                    if free {
-                        translate_dkd(next, m, wrench, dt);
-                    }
-                    free
-                },
-                |s, m, w| self.step(s, m, w, dt),
-            ),
-            StepPhase::Begin => batched(
-                bodies,
-                h,
-                |next, _, _| {
-                    next.position += h * next.linear_velocity;
-                    true
-                },
-                |s, m, _| self.begin_step(s, m, dt),
-            ),
-            StepPhase::Finish => batched(
-                bodies,
-                h,
-                |next, m, wrench| {
-                    kick(next, m, wrench, dt);
-                    next.position += h * next.linear_velocity;
-                    true
-                },
-                |s, m, w| self.finish_step(s, m, w, dt),
-            ),
+            StepPhase::Whole => batched(kernel, StepPhase::Whole, bodies, dt, alone),
+            StepPhase::Begin => batched(kernel, StepPhase::Begin, bodies, dt, alone),
+            StepPhase::Finish => batched(kernel, StepPhase::Finish, bodies, dt, alone),
         }
     }
 
@@ -367,7 +368,7 @@ impl Integrator {
     }
 
     /// [`try_step`](Self::try_step) for every body: `states[i]` advances by `dt` under
-    /// `wrenches[i]` with mass `masses[i]`. A body whose result is not finite keeps its state and
+    /// `wrenches[i]` with mass `masses[i]`. A body whose result is not valid keeps its state and
     /// its index is returned (in increasing order); no other body is affected. Allocates only
     /// when a body diverges.
     pub fn try_step_many<M: Borrow<MassProperties>>(

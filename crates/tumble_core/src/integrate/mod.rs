@@ -25,23 +25,21 @@
 //! | `yoshida4` | Yoshida composition of `splitting` | 4 | round-off | bounded |
 //! | `rk4` | RK4 on `Q̇ = ½ ω(Q) Q` at constant `L` | 4 | exact | slow drift |
 
-#[cfg(target_arch = "x86_64")]
-mod avx;
-#[cfg(target_arch = "x86_64")]
-mod avx512;
 mod batch;
-pub use batch::{BodyBatch, PREFETCH_AHEAD, StepPhase};
+pub use batch::{BodyBatch, StepPhase};
 mod frame;
 mod implicit_gyroscopic;
-pub mod lanes;
 mod lclamp;
 mod rk4;
+mod simd;
 mod splitting;
 mod symmetric_kernel;
 mod symplectic_euler;
+#[cfg(test)]
+mod tests;
 mod yoshida;
 
-use crate::math::{Real, Vec3};
+use crate::math::Real;
 use std::fmt;
 use std::str::FromStr;
 
@@ -50,16 +48,17 @@ use thiserror::Error;
 use crate::mass::MassProperties;
 use crate::state::{BodyState, Wrench};
 
-pub use frame::{rotate, rotate_inv, world_momentum, world_omega};
-pub use implicit_gyroscopic::{implicit_gyroscopic, implicit_gyroscopic_rate};
-pub use lclamp::lclamp;
-pub use rk4::rk4_free_flow;
-pub use splitting::{
-    FreeBody, FreeFlow, Rotation, begin_dkd, drift, finish_dkd, kick, rotate_freely,
-    rotate_symmetric, strang_free_flow, symmetric_free_flow, torque_free_dkd, translate_dkd,
+// The public surface is the `Integrator` enum, the batch interface, the kernel path and the two
+// frame rotations the tests and reports measure with; each method's functions are internal.
+pub use frame::{rotate, rotate_inv};
+use implicit_gyroscopic::implicit_gyroscopic;
+use lclamp::lclamp;
+use rk4::rk4_free_flow;
+pub use simd::{KERNEL_ENV, KernelError, KernelPath, kernel_path};
+use splitting::{
+    Rotation, drift_kick_drift, rotate_freely, rotate_symmetric, rotate_yoshida, strang_free_flow,
 };
-pub use symplectic_euler::{explicit_gyroscopic_kick, symplectic_euler, symplectic_euler_linear};
-pub use yoshida::yoshida_free_flow;
+use symplectic_euler::{symplectic_euler, symplectic_euler_linear};
 
 /// A time-integration method, selectable per world.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
@@ -145,7 +144,7 @@ impl Integrator {
     /// The free rotation of a drift–kick–drift method.
     fn free_rotation(self) -> Rotation {
         match self {
-            Integrator::Yoshida4 => |s, m, h| rotate_freely(s, m, h, yoshida_free_flow),
+            Integrator::Yoshida4 => rotate_yoshida,
             Integrator::Rk4 => |s, m, h| rotate_freely(s, m, h, rk4_free_flow),
             Integrator::SplittingXyz => |s, m, h| rotate_freely(s, m, h, strang_free_flow),
             _ => rotate_symmetric,
@@ -157,7 +156,8 @@ impl Integrator {
     #[inline]
     pub fn begin_step(self, state: &mut BodyState, mass: &MassProperties, dt: Real) {
         if self.samples_forces_at_midpoint() {
-            begin_dkd(state, mass, dt, self.free_rotation());
+            let rotation = self.free_rotation();
+            drift_kick_drift(StepPhase::Begin, state, mass, &Wrench::ZERO, dt, rotation);
         }
     }
 
@@ -178,23 +178,45 @@ impl Integrator {
             Integrator::Splitting
             | Integrator::SplittingXyz
             | Integrator::Yoshida4
-            | Integrator::Rk4 => finish_dkd(state, mass, wrench, dt, self.free_rotation()),
+            | Integrator::Rk4 => {
+                let rotation = self.free_rotation();
+                drift_kick_drift(StepPhase::Finish, state, mass, wrench, dt, rotation);
+            }
         }
     }
 
-    /// A whole step under a constant `wrench`. The caller checks finiteness (see
+    /// A whole step under a constant `wrench`. The caller checks the result (see
     /// [`try_step`](Self::try_step)).
-    #[inline]
     ///
     /// For the drift–kick–drift methods a torque-free step takes its rotation as one free flow
     /// over `Δt` instead of two halves (nothing is kicked between them): half the cost, same
     /// order. The ECS takes this path for bodies without a `ForceAccumulator`.
+    #[inline]
     pub fn step(self, state: &mut BodyState, mass: &MassProperties, wrench: &Wrench, dt: Real) {
-        if self.samples_forces_at_midpoint() && wrench.torque == Vec3::ZERO {
-            torque_free_dkd(state, mass, wrench, dt, self.free_rotation());
+        if self.samples_forces_at_midpoint() {
+            let rotation = self.free_rotation();
+            drift_kick_drift(StepPhase::Whole, state, mass, wrench, dt, rotation);
         } else {
-            self.begin_step(state, mass, dt);
+            // The kick–drift methods do nothing before the forces: the step is its second phase.
             self.finish_step(state, mass, wrench, dt);
+        }
+    }
+
+    /// `phase` of a step: [`step`](Self::step), [`begin_step`](Self::begin_step) (the load is
+    /// not used) or [`finish_step`](Self::finish_step).
+    #[inline]
+    fn step_phase(
+        self,
+        phase: StepPhase,
+        state: &mut BodyState,
+        mass: &MassProperties,
+        wrench: &Wrench,
+        dt: Real,
+    ) {
+        match phase {
+            StepPhase::Whole => self.step(state, mass, wrench, dt),
+            StepPhase::Begin => self.begin_step(state, mass, dt),
+            StepPhase::Finish => self.finish_step(state, mass, wrench, dt),
         }
     }
 
@@ -213,8 +235,9 @@ impl Integrator {
         self.finish_step(state, mass, &wrench, dt);
     }
 
-    /// Advances `state` by `dt` and commits the result only if it is finite; otherwise `state`
-    /// is left unchanged and [`StepError::Diverged`] is returned.
+    /// Advances `state` by `dt` and commits the result only if it is valid (finite, with a unit
+    /// rotation: [`BodyState::is_valid`]); otherwise `state` is left unchanged and
+    /// [`StepError::Diverged`] is returned.
     #[inline]
     pub fn try_step(
         self,
@@ -223,10 +246,11 @@ impl Integrator {
         wrench: &Wrench,
         dt: Real,
     ) -> Result<(), StepError> {
-        self.commit_if_finite(state, |next| self.step(next, mass, wrench, dt))
+        self.commit_if_valid(state, |next| self.step(next, mass, wrench, dt))
     }
 
-    /// [`finish_step`](Self::finish_step) that commits only a finite result.
+    /// [`finish_step`](Self::finish_step) that commits only a valid result (see
+    /// [`try_step`](Self::try_step)).
     #[inline]
     pub fn try_finish_step(
         self,
@@ -235,19 +259,19 @@ impl Integrator {
         wrench: &Wrench,
         dt: Real,
     ) -> Result<(), StepError> {
-        self.commit_if_finite(state, |next| self.finish_step(next, mass, wrench, dt))
+        self.commit_if_valid(state, |next| self.finish_step(next, mass, wrench, dt))
     }
 
-    /// Runs `advance` on a copy of `state` and commits the copy only if it is finite.
+    /// Runs `advance` on a copy of `state` and commits the copy only if it is valid.
     #[inline]
-    fn commit_if_finite(
+    fn commit_if_valid(
         self,
         state: &mut BodyState,
         advance: impl FnOnce(&mut BodyState),
     ) -> Result<(), StepError> {
         let mut next = *state;
         advance(&mut next);
-        if next.is_finite() {
+        if next.is_valid() {
             *state = next;
             Ok(())
         } else {
@@ -255,7 +279,8 @@ impl Integrator {
         }
     }
 
-    /// [`begin_step`](Self::begin_step) that commits only a finite result.
+    /// [`begin_step`](Self::begin_step) that commits only a valid result (see
+    /// [`try_step`](Self::try_step)).
     #[inline]
     pub fn try_begin_step(
         self,
@@ -263,7 +288,7 @@ impl Integrator {
         mass: &MassProperties,
         dt: Real,
     ) -> Result<(), StepError> {
-        self.commit_if_finite(state, |next| self.begin_step(next, mass, dt))
+        self.commit_if_valid(state, |next| self.begin_step(next, mass, dt))
     }
 }
 
@@ -296,8 +321,11 @@ impl FromStr for Integrator {
 /// A step that could not be taken.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Error)]
 pub enum StepError {
-    /// The step produced NaN or Inf: the setting is outside the method's stable region.
-    #[error("integrator `{integrator}` diverged (non-finite state); the body was left unchanged")]
+    /// The step produced NaN or Inf, or a rotation that is no longer a unit quaternion (see
+    /// [`BodyState::is_valid`]): the setting is outside the method's stable region.
+    #[error(
+        "integrator `{integrator}` diverged (non-finite state or non-unit rotation); the body was left unchanged"
+    )]
     Diverged {
         /// The method that diverged.
         integrator: Integrator,

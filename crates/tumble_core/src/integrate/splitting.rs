@@ -27,7 +27,7 @@
 //! In every sub-flow the world momentum `L` is fixed, so `|L|` of a torque-free body is kept to
 //! round-off. The flows run in f64 on the body momentum `m` and the principal orientation `Q`,
 //! each sub-flow a body-frame rotation `Q ← Q exp(θ e)` with `m ← exp(−θ e) m`; only the final
-//! `ω` and `q` are rounded to f32.
+//! `ω` and `q` are rounded to the engine's precision.
 //!
 //! **Known limit.** A thin body that is *not* symmetric (e.g. I = (1e-4, 1, 1.02)) spinning fast
 //! about a tilted axis: the residual rotation mixes the large transverse momentum into the tiny
@@ -37,17 +37,26 @@
 //! finite and `|L|` stays exact. An exact torque-free step (elliptic functions for `m`) is the
 //! cure; symmetric rods, discs and spheres are already exact.
 //!
+//! **Where the code is.** The `splitting` flow is written once, lane-generic, in
+//! `symmetric_kernel` (`Flowing::symmetric_flow`): one body runs it in `f64`, a batch in SIMD
+//! lanes, and `yoshida4` composes three of it. The one-axis flows of `splitting-xyz` (and
+//! `rk4`'s free flow) advance a [`FreeBody`] here. The drift–kick–drift phases are
+//! [`drift_kick_drift_translation`] plus the method's free rotation, on both the scalar and the
+//! batched paths.
+//!
 //! With external load the step is the symmetric drift–kick–drift
 //! `D(h/2) ∘ K(h) ∘ D(h/2)`: `D` moves `x += ½h v` and applies the free flow, `K` kicks
 //! `v += h F/m` and `L += h τ`. Forces are sampled once, between the two drifts (the ECS runs the
 //! first drift before the force systems), so constant forces are integrated exactly and springs
 //! get the second-order, symplectic position-Verlet scheme.
 
-use crate::math::{Narrow, Real, Vec3, Widen};
+use crate::math::{Narrow, Quat, Real, Vec3, Widen};
 use glam::{DQuat, DVec3};
 
-use super::frame::{recip, rotate64};
+use super::StepPhase;
+use super::frame::{reciprocal, rotate64};
 use super::symmetric_kernel::{SymmetricInput, rotate_symmetric_one};
+use super::yoshida::rotate_yoshida_one;
 use crate::mass::MassProperties;
 use crate::rotation::rotate_exact;
 use crate::state::{BodyState, Wrench};
@@ -94,18 +103,6 @@ impl FreeBody {
             self.rotate_about_axis(axis, h * k * self.m[axis]);
         }
     }
-
-    /// Exact flow of the Casimir `½ k |m|²` for time `h`: rotation about `m` itself by
-    /// `h k |m|` (so `m` is unchanged).
-    #[inline]
-    pub fn casimir_flow(&mut self, k: f64, h: f64) {
-        let length = self.m.length();
-        if length > 0.0 && k != 0.0 {
-            let (s, c) = (0.5 * h * k * length).sin_cos();
-            let v = self.m * (s / length);
-            self.q *= DQuat::from_xyzw(v.x, v.y, v.z, c);
-        }
-    }
 }
 
 /// A free-flow approximation over `h`, given the reciprocal principal moments `r = 1/I_b`
@@ -123,50 +120,38 @@ pub fn strang_free_flow(body: &mut FreeBody, r: DVec3, h: f64) {
     body.axis_flow(0, r.x, half);
 }
 
-/// Symmetric + residual splitting `R(h/2) ∘ S(h) ∘ R(h/2)` of the free flow over `h`
-/// (`splitting`); see the module documentation.
-#[inline]
-pub fn symmetric_free_flow(body: &mut FreeBody, r: DVec3, h: f64) {
-    // The pair (b, c) with the closest reciprocals; a is the remaining axis.
-    let gaps = [(r.y - r.z).abs(), (r.x - r.z).abs(), (r.x - r.y).abs()];
-    let a = if gaps[0] <= gaps[1] && gaps[0] <= gaps[2] {
-        0
-    } else if gaps[1] <= gaps[2] {
-        1
-    } else {
-        2
-    };
-    let (b, c) = ((a + 1) % 3, (a + 2) % 3);
-    let residual = r[c] - r[b];
-    body.axis_flow(c, residual, 0.5 * h);
-    // S(h): the Casimir rotation about m and the commuting rotation about axis a.
-    body.casimir_flow(r[b], h);
-    body.axis_flow(a, r[a] - r[b], h);
-    body.axis_flow(c, residual, 0.5 * h);
-}
-
 /// The rotational part of a drift over `h` at constant world `L`: a method's free rotation.
 pub type Rotation = fn(&mut BodyState, &MassProperties, Real);
 
-/// Drift for `h`: `x += h v` and the free rotation over `h` at constant `L`.
-#[inline]
-pub fn drift(state: &mut BodyState, mass: &MassProperties, h: Real, rotation: Rotation) {
-    state.position += h * state.linear_velocity;
-    rotation(state, mass, h);
-}
-
 /// The free rotation of the `splitting` method over `h`: spherical bodies exactly about `ω`
-/// (`ω ∥ L` for them), the others through the lane kernel of
-/// the module `symmetric_kernel` — the same code the batched step runs, so one
-/// body gets the same bits alone or in a batch.
+/// (`ω ∥ L` for them), the others through the lane kernel of the module `symmetric_kernel` —
+/// the same code the batched step runs, so one body gets the same bits alone or in a batch.
 #[inline]
 pub fn rotate_symmetric(state: &mut BodyState, mass: &MassProperties, h: Real) {
+    rotate_lie_poisson(state, mass, h, rotate_symmetric_one);
+}
+
+/// The free rotation of `yoshida4` over `h`: three of `splitting`'s flows (see `yoshida`).
+#[inline]
+pub fn rotate_yoshida(state: &mut BodyState, mass: &MassProperties, h: Real) {
+    rotate_lie_poisson(state, mass, h, rotate_yoshida_one);
+}
+
+/// A free rotation on the symmetric-top kernel: spherical bodies exactly about `ω`, the others
+/// by `flow` from their kernel inputs.
+#[inline(always)]
+fn rotate_lie_poisson(
+    state: &mut BodyState,
+    mass: &MassProperties,
+    h: Real,
+    flow: fn(&SymmetricInput, Real) -> (Quat, Vec3),
+) {
     if mass.is_spherical() {
         state.rotation = rotate_exact(state.rotation, state.angular_velocity, h);
         return;
     }
     let input = SymmetricInput::new(state.rotation, state.angular_velocity, mass);
-    (state.rotation, state.angular_velocity) = rotate_symmetric_one(&input, h);
+    (state.rotation, state.angular_velocity) = flow(&input, h);
 }
 
 /// The rotational part of a drift: the free flow over `h` at constant world `L`.
@@ -179,7 +164,11 @@ pub fn rotate_freely(state: &mut BodyState, mass: &MassProperties, h: Real, flow
     let frame = mass.principal_frame().widen();
     let q = state.rotation.widen() * frame;
     let inertia = mass.principal_inertia().widen();
-    let r = DVec3::new(recip(inertia.x), recip(inertia.y), recip(inertia.z));
+    let r = DVec3::new(
+        reciprocal(inertia.x),
+        reciprocal(inertia.y),
+        reciprocal(inertia.z),
+    );
     let mut body = FreeBody {
         q,
         m: inertia * rotate64(q.conjugate(), state.angular_velocity.widen()),
@@ -192,52 +181,75 @@ pub fn rotate_freely(state: &mut BodyState, mass: &MassProperties, h: Real, flow
 
 /// Kick for `h`: `v += h F/m`, `L += h τ` (so `ω += h I⁻¹ τ` at the current pose).
 #[inline]
-pub fn kick(state: &mut BodyState, mass: &MassProperties, wrench: &Wrench, h: Real) {
+fn kick(state: &mut BodyState, mass: &MassProperties, wrench: &Wrench, h: Real) {
     state.linear_velocity += (h * mass.inv_mass()) * wrench.force;
     if wrench.torque != Vec3::ZERO {
         state.angular_velocity += mass.world_inv_inertia_mul(state.rotation, h * wrench.torque);
     }
 }
 
-/// First half of a drift–kick–drift step: `D(h/2)`, before forces are sampled.
-#[inline]
-pub fn begin_dkd(state: &mut BodyState, mass: &MassProperties, h: Real, rotation: Rotation) {
-    drift(state, mass, 0.5 * h, rotation);
+/// The span of free rotation that completes `phase` of a drift–kick–drift step over `dt`: `½Δt`
+/// for either half, `Δt` for a whole torque-free step (see [`drift_kick_drift_translation`]).
+#[inline(always)]
+pub(crate) fn free_rotation_span(phase: StepPhase, dt: Real) -> Real {
+    match phase {
+        StepPhase::Whole => dt,
+        StepPhase::Begin | StepPhase::Finish => 0.5 * dt,
+    }
 }
 
-/// Second half of a drift–kick–drift step: `K(h)` then `D(h/2)`.
-#[inline]
-pub fn finish_dkd(
+/// The translational part of `phase` of the drift–kick–drift step `D(Δt/2) ∘ K(Δt) ∘ D(Δt/2)`,
+/// the one sequence the scalar and the batched paths both run; a free rotation over
+/// [`free_rotation_span`] completes the phase:
+///
+/// - `Begin`, before forces are sampled: the first half drift's `x += ½Δt v`.
+/// - `Finish`: the kick `v += Δt F/m`, `L += Δt τ`, then the second half drift's `x += ½Δt v`.
+/// - `Whole` without torque: `x += ½Δt v; v += Δt F/m; x += ½Δt v` (exact for a constant force);
+///   with nothing to kick between them, the two half rotations are one, over `Δt`.
+///
+/// Returns false, leaving `state` untouched, for `Whole` under a torque: the torque must be
+/// kicked between the two half rotations, so that step is `Begin` then `Finish`.
+#[inline(always)]
+pub(crate) fn drift_kick_drift_translation(
+    phase: StepPhase,
     state: &mut BodyState,
     mass: &MassProperties,
     wrench: &Wrench,
-    h: Real,
-    rotation: Rotation,
-) {
-    kick(state, mass, wrench, h);
-    drift(state, mass, 0.5 * h, rotation);
+    dt: Real,
+) -> bool {
+    let half = 0.5 * dt;
+    match phase {
+        StepPhase::Begin => state.position += half * state.linear_velocity,
+        StepPhase::Finish => {
+            kick(state, mass, wrench, dt);
+            state.position += half * state.linear_velocity;
+        }
+        StepPhase::Whole if wrench.torque == Vec3::ZERO => {
+            state.position += half * state.linear_velocity;
+            state.linear_velocity += (dt * mass.inv_mass()) * wrench.force;
+            state.position += half * state.linear_velocity;
+        }
+        StepPhase::Whole => return false,
+    }
+    true
 }
 
-/// A whole drift–kick–drift step under a torque-free `wrench`: the translation is
-/// `x += ½h v; v += h F/m; x += ½h v` (exact for constant `F`) and, with no torque to kick
-/// between them, the two rotational half drifts are taken as one free flow over `h`.
+/// `phase` of the drift–kick–drift step with a method's free `rotation`.
 #[inline]
-pub fn torque_free_dkd(
+pub(crate) fn drift_kick_drift(
+    phase: StepPhase,
     state: &mut BodyState,
     mass: &MassProperties,
     wrench: &Wrench,
-    h: Real,
+    dt: Real,
     rotation: Rotation,
 ) {
-    translate_dkd(state, mass, wrench, h);
-    rotation(state, mass, h);
-}
-
-/// The translational part of a whole drift–kick–drift step:
-/// `x += ½h v; v += h F/m; x += ½h v` (exact for a constant force).
-#[inline]
-pub fn translate_dkd(state: &mut BodyState, mass: &MassProperties, wrench: &Wrench, h: Real) {
-    state.position += (0.5 * h) * state.linear_velocity;
-    state.linear_velocity += (h * mass.inv_mass()) * wrench.force;
-    state.position += (0.5 * h) * state.linear_velocity;
+    if drift_kick_drift_translation(phase, state, mass, wrench, dt) {
+        rotation(state, mass, free_rotation_span(phase, dt));
+        return;
+    }
+    for half in [StepPhase::Begin, StepPhase::Finish] {
+        drift_kick_drift_translation(half, state, mass, wrench, dt);
+        rotation(state, mass, free_rotation_span(half, dt));
+    }
 }

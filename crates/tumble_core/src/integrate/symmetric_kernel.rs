@@ -16,7 +16,10 @@
 //! A rotation by a zero angle is the exact identity (`sin 0 = 0`, `cos 0 = 1`), so locked axes
 //! (`r = 0`) and symmetric bodies need no branches.
 
-use super::lanes::{F64x4, LANES, Lane, Run, sin_cos};
+use super::frame::reciprocal;
+#[cfg(target_arch = "x86_64")]
+use super::simd::{Avx2, Avx4, Avx8, Avx512};
+use super::simd::{F64x4, Kernel, LANES, Lane, Portable, sin_cos};
 use crate::mass::MassProperties;
 use crate::math::{Narrow, Quat, Real, Vec3, Widen};
 
@@ -42,11 +45,12 @@ fn mul<T: Lane>(a: Quat4<T>, b: Quat4<T>) -> Quat4<T> {
 #[inline(always)]
 fn rotate<T: Lane>(q: Quat4<T>, v: Vec3L<T>) -> Vec3L<T> {
     let [x, y, z, w] = q;
+    let cpu = w.cpu();
     let b2 = x * x + y * y + z * z;
-    let inv = T::splat(1.0) / (w * w + b2);
+    let inv = T::splat(cpu, 1.0) / (w * w + b2);
     let ww = w * w - b2;
-    let bv2 = T::splat(2.0) * (x * v[0] + y * v[1] + z * v[2]);
-    let w2 = T::splat(2.0) * w;
+    let bv2 = T::splat(cpu, 2.0) * (x * v[0] + y * v[1] + z * v[2]);
+    let w2 = T::splat(cpu, 2.0) * w;
     let cross = [
         y * v[2] - z * v[1],
         z * v[0] - x * v[2],
@@ -74,8 +78,9 @@ impl<T: Lane> Free<T> {
     /// `Q ← Q exp(θ e_x)`, `m ← exp(−θ e_x) m`.
     #[inline(always)]
     fn rotate_x(&mut self, angle: T) {
-        let (s, c) = sin_cos(T::splat(0.5) * angle);
-        let (cos, sin) = (c * c - s * s, T::splat(2.0) * s * c);
+        let cpu = angle.cpu();
+        let (s, c) = sin_cos(T::splat(cpu, 0.5) * angle);
+        let (cos, sin) = (c * c - s * s, T::splat(cpu, 2.0) * s * c);
         let [x, y, z, w] = self.q;
         self.q = [c * x + w * s, c * y + z * s, c * z - y * s, c * w - x * s];
         let [m0, m1, m2] = self.m;
@@ -85,8 +90,9 @@ impl<T: Lane> Free<T> {
     /// `Q ← Q exp(θ e_z)`, `m ← exp(−θ e_z) m`.
     #[inline(always)]
     fn rotate_z(&mut self, angle: T) {
-        let (s, c) = sin_cos(T::splat(0.5) * angle);
-        let (cos, sin) = (c * c - s * s, T::splat(2.0) * s * c);
+        let cpu = angle.cpu();
+        let (s, c) = sin_cos(T::splat(cpu, 0.5) * angle);
+        let (cos, sin) = (c * c - s * s, T::splat(cpu, 2.0) * s * c);
         let [x, y, z, w] = self.q;
         self.q = [c * x + y * s, c * y - x * s, c * z + w * s, c * w - z * s];
         let [m0, m1, m2] = self.m;
@@ -97,9 +103,11 @@ impl<T: Lane> Free<T> {
     #[inline(always)]
     fn rotate_about_momentum(&mut self, k: T, h: T) {
         let [m0, m1, m2] = self.m;
+        let cpu = h.cpu();
         let length = (m0 * m0 + m1 * m1 + m2 * m2).sqrt();
-        let (s, c) = sin_cos(T::splat(0.5) * h * k * length);
-        let scale = T::select(length.gt(T::splat(0.0)), s / length, T::splat(0.0));
+        let (s, c) = sin_cos(T::splat(cpu, 0.5) * h * k * length);
+        let zero = T::splat(cpu, 0.0);
+        let scale = T::select(length.gt(zero), s / length, zero);
         self.q = mul(self.q, [m0 * scale, m1 * scale, m2 * scale, c]);
     }
 }
@@ -200,57 +208,86 @@ impl LaneInputs {
     }
 }
 
-/// Reciprocal of a principal moment, `0` for a locked axis.
-#[inline(always)]
-fn reciprocal<T: Lane>(moment: T) -> T {
-    let zero = T::splat(0.0);
-    T::select(moment.gt(zero), T::splat(1.0) / moment, zero)
+/// A free flow under way: the body in its relabelled principal frame `F'`, its reciprocal
+/// moments `r` (0 on a locked axis), and `F'` to return through.
+pub(super) struct Flowing<T> {
+    free: Free<T>,
+    r: Vec3L<T>,
+    frame: Quat4<T>,
+}
+
+impl<T: Lane> Flowing<T> {
+    /// `Q = q F'`, `m = I' ⊙ Qᵀω`.
+    #[inline(always)]
+    pub(super) fn start(input: &SymmetricInput<T>) -> Self {
+        let inertia = input.inertia;
+        // Written out, not `inertia.map(reciprocal)`: inside a `#[target_feature]` function
+        // every helper must inline, and `map` need not (see `rotate_run`).
+        let r = [
+            reciprocal(inertia[0]),
+            reciprocal(inertia[1]),
+            reciprocal(inertia[2]),
+        ];
+        let frame = mul(input.frame, input.relabel);
+        let q = mul(input.rotation, frame);
+        let body = rotate(conjugate(q), input.omega);
+        let m = [
+            inertia[0] * body[0],
+            inertia[1] * body[1],
+            inertia[2] * body[2],
+        ];
+        Self {
+            free: Free { q, m },
+            r,
+            frame,
+        }
+    }
+
+    /// The symmetric + residual Strang flow over `h`, `R(h/2) ∘ S(h) ∘ R(h/2)` (see
+    /// [`super::splitting`]): the odd axis is `x`, the symmetric pair `(y, z)`.
+    #[inline(always)]
+    pub(super) fn symmetric_flow(&mut self, h: T) {
+        let (free, r) = (&mut self.free, self.r);
+        let half = T::splat(h.cpu(), 0.5) * h;
+        let residual = r[2] - r[1];
+        free.rotate_z(half * residual * free.m[2]);
+        free.rotate_about_momentum(r[1], h);
+        free.rotate_x(h * (r[0] - r[1]) * free.m[0]);
+        free.rotate_z(half * residual * free.m[2]);
+    }
+
+    /// The new orientation (unit, f64) and world angular velocity: `ω' = Q (r ⊙ m)`,
+    /// `q' = normalize(Q F'ᵀ)`.
+    #[inline(always)]
+    pub(super) fn finish(self) -> (Quat4<T>, Vec3L<T>) {
+        let (Free { q, m }, r) = (self.free, self.r);
+        let omega = rotate(q, [r[0] * m[0], r[1] * m[1], r[2] * m[2]]);
+        let [x, y, z, w] = mul(q, conjugate(self.frame));
+        let inv = T::splat(w.cpu(), 1.0) / (x * x + y * y + z * z + w * w).sqrt();
+        ([x * inv, y * inv, z * inv, w * inv], omega)
+    }
 }
 
 /// The free rotation over `h` of the `splitting` method, in lanes: returns the new orientation
 /// (unit, f64) and world angular velocity. See the module documentation for the sequence.
 #[inline(always)]
 pub fn symmetric_rotation<T: Lane>(input: &SymmetricInput<T>, h: T) -> (Quat4<T>, Vec3L<T>) {
-    let inertia = input.inertia;
-    let r = [
-        reciprocal(inertia[0]),
-        reciprocal(inertia[1]),
-        reciprocal(inertia[2]),
-    ];
-    let frame = mul(input.frame, input.relabel);
-    let q = mul(input.rotation, frame);
-    let body = rotate(conjugate(q), input.omega);
-    let mut free = Free {
-        q,
-        m: [
-            inertia[0] * body[0],
-            inertia[1] * body[1],
-            inertia[2] * body[2],
-        ],
-    };
-    let half = T::splat(0.5) * h;
-    let residual = r[2] - r[1];
-    free.rotate_z(half * residual * free.m[2]);
-    free.rotate_about_momentum(r[1], h);
-    free.rotate_x(h * (r[0] - r[1]) * free.m[0]);
-    free.rotate_z(half * residual * free.m[2]);
-    let m = free.m;
-    let omega = rotate(free.q, [r[0] * m[0], r[1] * m[1], r[2] * m[2]]);
-    let [x, y, z, w] = mul(free.q, conjugate(frame));
-    let inv = T::splat(1.0) / (x * x + y * y + z * z + w * w).sqrt();
-    ([x * inv, y * inv, z * inv, w * inv], omega)
+    let mut flowing = Flowing::start(input);
+    flowing.symmetric_flow(h);
+    flowing.finish()
 }
 
-/// Rounds a kernel result to the engine's precision, lane `i`.
+/// Rounds a kernel result to the engine's precision.
 #[inline(always)]
-fn to_real(q: [f64; 4], w: [f64; 3]) -> (Quat, Vec3) {
+pub(super) fn to_real(q: [f64; 4], w: [f64; 3]) -> (Quat, Vec3) {
     (
         Quat::from_xyzw(q[0].narrow(), q[1].narrow(), q[2].narrow(), q[3].narrow()),
         Vec3::new(w[0].narrow(), w[1].narrow(), w[2].narrow()),
     )
 }
 
-/// One body through the kernel (`f64` lanes): the new `(q, ω)`, rounded to the engine precision once.
+/// One body through the kernel (`f64` lanes): the new `(q, ω)`, rounded to the engine
+/// precision once.
 #[inline]
 pub fn rotate_symmetric_one(input: &SymmetricInput, h: Real) -> (Quat, Vec3) {
     let (q, w) = symmetric_rotation::<f64>(input, h.widen());
@@ -282,58 +319,66 @@ impl RotatedLanes {
     }
 }
 
-/// [`LANES`] bodies through the kernel at once (SIMD lanes), each over its own `h`; lane `i`
-/// of the result is bit-identical to [`rotate_symmetric_one`]`(&inputs[i], h[i])`.
-///
-/// The widest instruction set the CPU has is picked at run time: AVX-512F (one register of
-/// eight f64), AVX (two registers of four), else the portable build (SSE2 pairs).
-#[inline]
-pub fn rotate_symmetric_lanes(inputs: &LaneInputs, h: [Real; LANES]) -> RotatedLanes {
-    #[cfg(target_arch = "x86_64")]
-    {
-        if std::arch::is_x86_feature_detected!("avx512f") {
-            #[allow(unsafe_code)]
-            // SAFETY: the CPU supports AVX-512F (checked just above), the only requirement of
-            // calling a function compiled with `#[target_feature(enable = "avx512f")]`.
-            return unsafe { rotate_symmetric_lanes_avx512(inputs, h) };
-        }
-        if std::arch::is_x86_feature_detected!("avx") {
-            #[allow(unsafe_code)]
-            // SAFETY: the CPU supports AVX (checked just above), the only requirement of
-            // calling a function compiled with `#[target_feature(enable = "avx")]`.
-            return unsafe { rotate_symmetric_lanes_avx(inputs, h) };
-        }
+/// [`LANES`] bodies through the kernel at once (SIMD lanes), each over its own `h`, on the
+/// `kernel`'s instruction set; lane `i` of the result is bit-identical to
+/// [`rotate_symmetric_one`]`(&inputs[i], h[i])` on every path.
+// Not inlined: the portable kernel compiles into this function, and inlined into the batch
+// loops (three of them, one per phase) it bloats them past what the instruction cache and the
+// register allocator handle well; one call per eight bodies costs nothing in comparison.
+#[inline(never)]
+pub fn rotate_symmetric_lanes(
+    kernel: Kernel,
+    inputs: &LaneInputs,
+    h: [Real; LANES],
+) -> RotatedLanes {
+    match kernel {
+        Kernel::Portable => rotate_symmetric_lanes_in::<F64x4>(Portable, inputs, h),
+        #[cfg(target_arch = "x86_64")]
+        #[expect(
+            unsafe_code,
+            reason = "a call into code compiled for AVX2, proven by the token"
+        )]
+        // SAFETY: the `Avx2` token exists, so the CPU has AVX2, the only requirement of calling
+        // a function compiled with `#[target_feature(enable = "avx2")]`.
+        Kernel::Avx2(cpu) => unsafe { rotate_symmetric_lanes_avx2(cpu, inputs, h) },
+        #[cfg(target_arch = "x86_64")]
+        #[expect(
+            unsafe_code,
+            reason = "a call into code compiled for AVX-512F, proven by the token"
+        )]
+        // SAFETY: the `Avx512` token exists, so the CPU has AVX-512F, the only requirement of
+        // calling a function compiled with `#[target_feature(enable = "avx512f")]`.
+        Kernel::Avx512(cpu) => unsafe { rotate_symmetric_lanes_avx512(cpu, inputs, h) },
     }
-    rotate_symmetric_lanes_portable(inputs, h)
 }
 
-/// The kernel compiled with AVX-512F enabled, on one 512-bit register
-/// ([`Avx8`](super::avx512::Avx8)): the same IEEE operations, so the same bits.
+/// The kernel compiled with AVX-512F enabled, on one 512-bit register ([`Avx8`]).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f")]
-fn rotate_symmetric_lanes_avx512(inputs: &LaneInputs, h: [Real; LANES]) -> RotatedLanes {
-    rotate_symmetric_lanes_in::<super::avx512::Avx8>(inputs, h)
+fn rotate_symmetric_lanes_avx512(
+    cpu: Avx512,
+    inputs: &LaneInputs,
+    h: [Real; LANES],
+) -> RotatedLanes {
+    rotate_symmetric_lanes_in::<Avx8>(cpu, inputs, h)
 }
 
-/// The kernel compiled with AVX enabled, two runs of four bodies in 256-bit registers
-/// ([`Avx4`](super::avx::Avx4)): the same IEEE operations, so the same bits. (One run of eight
-/// as two registers side by side spills the register file and ran 1.7× slower.)
+/// The kernel compiled with AVX2 enabled, two runs of four bodies in 256-bit registers
+/// ([`Avx4`]). (One run of eight as two registers side by side spills the register file.)
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx")]
-fn rotate_symmetric_lanes_avx(inputs: &LaneInputs, h: [Real; LANES]) -> RotatedLanes {
-    rotate_symmetric_lanes_in::<super::avx::Avx4>(inputs, h)
-}
-
-/// The kernel on runs of four, [`F64x4`] (SSE2 pairs on a portable build).
-#[inline(always)]
-fn rotate_symmetric_lanes_portable(inputs: &LaneInputs, h: [Real; LANES]) -> RotatedLanes {
-    rotate_symmetric_lanes_in::<F64x4>(inputs, h)
+#[target_feature(enable = "avx2")]
+fn rotate_symmetric_lanes_avx2(cpu: Avx2, inputs: &LaneInputs, h: [Real; LANES]) -> RotatedLanes {
+    rotate_symmetric_lanes_in::<Avx4>(cpu, inputs, h)
 }
 
 /// Runs the kernel over the batch in runs of `T::WIDTH` bodies: loads each input component of a
 /// run with one vector load, rotates, rounds the results to the engine precision.
 #[inline(always)]
-fn rotate_symmetric_lanes_in<T: Run>(inputs: &LaneInputs, h: [Real; LANES]) -> RotatedLanes {
+fn rotate_symmetric_lanes_in<T: Lane>(
+    cpu: T::Cpu,
+    inputs: &LaneInputs,
+    h: [Real; LANES],
+) -> RotatedLanes {
     let mut wide_h = [0.0; LANES];
     for (wide, h) in wide_h.iter_mut().zip(h) {
         *wide = h.widen();
@@ -345,7 +390,7 @@ fn rotate_symmetric_lanes_in<T: Run>(inputs: &LaneInputs, h: [Real; LANES]) -> R
     };
     let mut start = 0;
     while start < LANES {
-        rotate_run::<T>(inputs, &h, start, &mut out);
+        rotate_run::<T>(cpu, inputs, &h, start, &mut out);
         start += T::WIDTH;
     }
     out
@@ -353,27 +398,34 @@ fn rotate_symmetric_lanes_in<T: Run>(inputs: &LaneInputs, h: [Real; LANES]) -> R
 
 /// The kernel on bodies `start .. start + T::WIDTH` of the batch. Plain indexing, no closures:
 /// inside a `#[target_feature]` function every helper must inline, and a closure is compiled
-/// without the feature (its intrinsics then become calls, 1.8× slower).
+/// without the feature (its intrinsics then become calls).
 #[inline(always)]
 #[allow(clippy::needless_range_loop)]
-fn rotate_run<T: Run>(inputs: &LaneInputs, h: &[f64; LANES], start: usize, out: &mut RotatedLanes) {
+fn rotate_run<T: Lane>(
+    cpu: T::Cpu,
+    inputs: &LaneInputs,
+    h: &[f64; LANES],
+    start: usize,
+    out: &mut RotatedLanes,
+) {
+    let zero = T::splat(cpu, 0.0);
     let mut input = SymmetricInput::<T> {
-        rotation: [T::splat(0.0); 4],
-        omega: [T::splat(0.0); 3],
-        frame: [T::splat(0.0); 4],
-        relabel: [T::splat(0.0); 4],
-        inertia: [T::splat(0.0); 3],
+        rotation: [zero; 4],
+        omega: [zero; 3],
+        frame: [zero; 4],
+        relabel: [zero; 4],
+        inertia: [zero; 3],
     };
     for k in 0..4 {
-        input.rotation[k] = T::load(&inputs.rotation[k][start..]);
-        input.frame[k] = T::load(&inputs.frame[k][start..]);
-        input.relabel[k] = T::load(&inputs.relabel[k][start..]);
+        input.rotation[k] = T::load(cpu, &inputs.rotation[k][start..]);
+        input.frame[k] = T::load(cpu, &inputs.frame[k][start..]);
+        input.relabel[k] = T::load(cpu, &inputs.relabel[k][start..]);
     }
     for k in 0..3 {
-        input.omega[k] = T::load(&inputs.omega[k][start..]);
-        input.inertia[k] = T::load(&inputs.inertia[k][start..]);
+        input.omega[k] = T::load(cpu, &inputs.omega[k][start..]);
+        input.inertia[k] = T::load(cpu, &inputs.inertia[k][start..]);
     }
-    let (q, w) = symmetric_rotation::<T>(&input, T::load(&h[start..]));
+    let (q, w) = symmetric_rotation::<T>(&input, T::load(cpu, &h[start..]));
     // Rounded lane-wise, exactly as `to_real` rounds one body (one conversion per value).
     let mut wide = [0.0; LANES];
     for k in 0..4 {
@@ -393,10 +445,11 @@ fn rotate_run<T: Run>(inputs: &LaneInputs, h: &[f64; LANES], start: usize, out: 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::integrate::KernelPath;
     use crate::mass::Mass;
 
-    /// Every compilation of the lane kernel (portable, and AVX or AVX-512 where the CPU has
-    /// them) and the scalar kernel agree bit for bit, on bodies that exercise every
+    /// Every compilation of the lane kernel the CPU runs (portable, and AVX2 or AVX-512 where
+    /// it has them) and the scalar kernel agree bit for bit, on bodies that exercise every
     /// relabelling, a locked axis, the wide-angle sine path and (lane 6) an angle beyond the
     /// polynomial's range, which must not change its neighbours' bits.
     #[test]
@@ -448,27 +501,15 @@ mod tests {
         }
         let inputs = &inputs;
         let lanes = |r: RotatedLanes| (0..LANES).map(|i| r.lane(i)).collect::<Vec<_>>();
-        assert_eq!(
-            bits(&lanes(rotate_symmetric_lanes_portable(inputs, h))),
-            bits(&expected)
-        );
-        assert_eq!(
-            bits(&lanes(rotate_symmetric_lanes(inputs, h))),
-            bits(&expected)
-        );
-        #[cfg(target_arch = "x86_64")]
-        #[allow(unsafe_code)]
-        {
-            if std::arch::is_x86_feature_detected!("avx") {
-                // SAFETY: AVX is available (checked just above).
-                let avx = unsafe { rotate_symmetric_lanes_avx(inputs, h) };
-                assert_eq!(bits(&lanes(avx)), bits(&expected));
-            }
-            if std::arch::is_x86_feature_detected!("avx512f") {
-                // SAFETY: AVX-512F is available (checked just above).
-                let avx512 = unsafe { rotate_symmetric_lanes_avx512(inputs, h) };
-                assert_eq!(bits(&lanes(avx512)), bits(&expected));
-            }
+        let kernels = Kernel::available();
+        assert_eq!(kernels[0].path(), KernelPath::Portable);
+        for kernel in kernels {
+            assert_eq!(
+                bits(&lanes(rotate_symmetric_lanes(kernel, inputs, h))),
+                bits(&expected),
+                "{}",
+                kernel.path()
+            );
         }
     }
 }

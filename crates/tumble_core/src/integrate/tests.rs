@@ -1,0 +1,220 @@
+//! Unit tests of the step's contract that need no ECS: what counts as a diverged step.
+
+use super::*;
+use crate::error::UNIT_QUATERNION_TOLERANCE;
+use crate::mass::Mass;
+use crate::math::{Quat, Vec3, Widen};
+
+/// A ball spinning so fast that the linearized rotation update `q + ½Δt (ω, 0) q` overflows
+/// `|q|²`: `normalize` then scales by `1/√∞ = 0` and returns the zero quaternion, a finite
+/// state that is no rotation at all.
+fn overspun_ball() -> (BodyState, MassProperties) {
+    let mass = MassProperties::new(Mass::new(1.0).unwrap(), Vec3::ONE).unwrap();
+    let state = BodyState {
+        angular_velocity: Vec3::new(1.0, -0.5, 0.25) * (Real::MAX.sqrt() * 1e3),
+        ..BodyState::default()
+    };
+    (state, mass)
+}
+
+/// A body with an ordinary spin, which every method steps to a valid state.
+fn calm_body(i: usize) -> BodyState {
+    BodyState {
+        position: Vec3::new(i as Real, 0.0, 0.0),
+        rotation: Quat::from_rotation_y(0.3 * i as Real),
+        linear_velocity: Vec3::X,
+        angular_velocity: Vec3::new(0.5, 1.0, -0.2),
+    }
+}
+
+#[test]
+fn the_overspun_ball_steps_to_a_finite_zero_quaternion() {
+    // The premise of the tests below: the old check (finite only) would commit this state.
+    let (mut state, mass) = overspun_ball();
+    Integrator::SymplecticEulerLinear.step(&mut state, &mass, &Wrench::ZERO, 1.0 / 60.0);
+    assert!(state.is_finite());
+    assert_eq!(state.rotation.length(), 0.0);
+    assert!(!state.is_valid());
+}
+
+#[test]
+fn a_non_unit_rotation_after_a_step_is_a_divergence_on_the_scalar_path() {
+    let dt = 1.0 / 60.0;
+    let (before, mass) = overspun_ball();
+    let integrator = Integrator::SymplecticEulerLinear;
+    let mut state = before;
+    assert_eq!(
+        integrator.try_step(&mut state, &mass, &Wrench::ZERO, dt),
+        Err(StepError::Diverged { integrator })
+    );
+    assert_eq!(state, before, "a diverged body keeps its old state");
+    assert_eq!(
+        integrator.try_finish_step(&mut state, &mass, &Wrench::ZERO, dt),
+        Err(StepError::Diverged { integrator })
+    );
+    assert_eq!(state, before);
+}
+
+#[test]
+fn a_non_unit_rotation_after_a_step_is_a_divergence_on_the_batched_path() {
+    let dt = 1.0 / 60.0;
+    let (overspun, ball) = overspun_ball();
+    let integrator = Integrator::SymplecticEulerLinear;
+    let mut states: Vec<BodyState> = (0..5).map(calm_body).collect();
+    states[2] = overspun;
+    let masses = vec![ball; 5];
+    let wrenches = vec![Wrench::ZERO; 5];
+    let mut alone = states.clone();
+    let diverged = integrator.try_step_many(&mut states, &masses, &wrenches, dt);
+    assert_eq!(diverged, vec![2]);
+    assert_eq!(states[2], overspun, "a diverged body keeps its old state");
+    for i in [0, 1, 3, 4] {
+        integrator
+            .try_step(&mut alone[i], &masses[i], &wrenches[i], dt)
+            .unwrap();
+        assert_eq!(states[i], alone[i], "body {i} must be stepped as if alone");
+    }
+    let diverged = integrator.try_finish_step_many(&mut states, &masses, &wrenches, dt);
+    assert_eq!(diverged, vec![2]);
+    assert_eq!(states[2], overspun);
+}
+
+#[test]
+fn is_valid_agrees_with_validate() {
+    let (overspun, _) = overspun_ball();
+    let mut cases = vec![
+        BodyState::default(),
+        calm_body(3),
+        overspun,
+        BodyState::ZEROED,
+    ];
+    for scale in [
+        0.5,
+        1.0 - 2.0 * UNIT_QUATERNION_TOLERANCE,
+        1.0 + 0.5 * UNIT_QUATERNION_TOLERANCE,
+    ] {
+        let mut state = calm_body(1);
+        state.rotation *= scale;
+        cases.push(state);
+    }
+    let mut non_finite = calm_body(2);
+    non_finite.linear_velocity.y = Real::NAN;
+    cases.push(non_finite);
+    for state in cases {
+        assert_eq!(state.is_valid(), state.validate().is_ok(), "{state:?}");
+    }
+}
+
+/// Plain vectors as a [`BodyBatch`], recording diverged bodies.
+struct Bodies {
+    states: Vec<BodyState>,
+    masses: Vec<MassProperties>,
+    wrenches: Vec<Wrench>,
+    diverged: Vec<usize>,
+}
+
+impl BodyBatch for Bodies {
+    fn len(&self) -> usize {
+        self.states.len()
+    }
+    fn read(&mut self, i: usize, state: &mut BodyState) -> Option<Wrench> {
+        state.copy_fields_from(&self.states[i]);
+        Some(self.wrenches[i])
+    }
+    fn mass(&self, i: usize) -> &MassProperties {
+        &self.masses[i]
+    }
+    fn write(&mut self, i: usize, state: &BodyState) {
+        self.states[i] = *state;
+    }
+    fn diverged(&mut self, i: usize) {
+        self.diverged.push(i);
+    }
+}
+
+/// 37 bodies (four full batches of eight and a partial one): every odd axis, spherical bodies,
+/// a locked axis, rotated principal frames, slow and fast spins, some torques.
+fn population() -> Bodies {
+    let n = 37;
+    let mut bodies = Bodies {
+        states: Vec::new(),
+        masses: Vec::new(),
+        wrenches: Vec::new(),
+        diverged: Vec::new(),
+    };
+    for i in 0..n {
+        let f = i as Real / n as Real;
+        let inertia = match i % 6 {
+            0 => Vec3::new(1.0, 2.0 + f, 3.0),
+            1 => Vec3::new(2.0, 1.0, 2.05),
+            2 => Vec3::new(3.0, 3.1, 0.2),
+            3 => Vec3::splat(0.4),
+            4 => Vec3::new(0.0, 1.0, 1.5),
+            _ => Vec3::new(1e-4, 1.0, 1.02),
+        };
+        let mass = MassProperties::new(Mass::new(0.5 + f).unwrap(), inertia)
+            .unwrap()
+            .with_principal_frame(Quat::from_rotation_z(f))
+            .unwrap();
+        bodies.masses.push(mass);
+        bodies.states.push(BodyState {
+            position: Vec3::new(f, -f, 2.0 * f),
+            rotation: Quat::from_rotation_y(7.0 * f) * Quat::from_rotation_x(f),
+            linear_velocity: Vec3::new(1.0, f, 0.0),
+            angular_velocity: Vec3::new(0.3 + 40.0 * f * f, 1.0 - f, 0.3) * (1 + i % 3) as Real,
+        });
+        bodies.wrenches.push(Wrench {
+            force: Vec3::new(0.0, -9.81, 0.0),
+            torque: if i % 7 == 3 { Vec3::Y } else { Vec3::ZERO },
+        });
+    }
+    bodies
+}
+
+/// The bits of every state, in order.
+fn bits(states: &[BodyState]) -> Vec<u64> {
+    states
+        .iter()
+        .flat_map(|s| {
+            [s.position, s.linear_velocity, s.angular_velocity]
+                .into_iter()
+                .flat_map(|v| v.to_array())
+                .chain(s.rotation.to_array())
+                .map(|x| x.widen().to_bits())
+        })
+        .collect()
+}
+
+use simd::Kernel;
+
+#[test]
+fn every_kernel_path_the_cpu_has_gives_the_same_bits_as_the_scalar_step() {
+    let dt = 1.0 / 60.0;
+    let integrator = Integrator::Splitting;
+    let mut scalar = population();
+    for _ in 0..20 {
+        for (i, state) in scalar.states.iter_mut().enumerate() {
+            let (mass, wrench) = (&scalar.masses[i], &scalar.wrenches[i]);
+            integrator.try_step(state, mass, wrench, dt).unwrap();
+            integrator.try_begin_step(state, mass, dt).unwrap();
+            integrator.try_finish_step(state, mass, wrench, dt).unwrap();
+        }
+    }
+    let kernels = Kernel::available();
+    assert!(!kernels.is_empty());
+    for kernel in kernels {
+        let mut batch = population();
+        for _ in 0..20 {
+            for phase in [StepPhase::Whole, StepPhase::Begin, StepPhase::Finish] {
+                integrator.step_batch_on(kernel, phase, &mut batch, dt);
+            }
+        }
+        assert!(batch.diverged.is_empty());
+        assert_eq!(
+            bits(&batch.states),
+            bits(&scalar.states),
+            "{}",
+            kernel.path()
+        );
+    }
+}
