@@ -50,7 +50,7 @@ pub fn run(scene: &Scene, integrator: Integrator, gyroscopic: bool) -> Result<()
                     "scene `{}` has springs, which the rapier comparison does not model (rapier \
                      has no spring force generator); supported: free bodies, gravity, gravity \
                      scale, constant forces (at points) and torques, damping",
-                    terminal_safe(&scene.name())
+                    terminal_safe(scene.name())
                 )));
             }
         }
@@ -117,7 +117,7 @@ pub fn run(scene: &Scene, integrator: Integrator, gyroscopic: bool) -> Result<()
     let result = compare(&comparison, &options, Some(&exact));
     println!(
         "scene {} · tumble `{integrator}` vs rapier 0.36 (gyroscopic {}, 4 substeps) · {} steps of {} s",
-        terminal_safe(&scene.name()),
+        terminal_safe(scene.name()),
         if gyroscopic { "on" } else { "off" },
         options.steps,
         scene.dt()
