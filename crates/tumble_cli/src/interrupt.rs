@@ -1,5 +1,5 @@
 //! SIGINT / SIGTERM (and SIGHUP): a flag that long loops poll, so that they return an error, drop
-//! their temporary file and exit with [`exit::INTERRUPTED`](crate::exit::INTERRUPTED).
+//! their temporary file and exit with [`exit::INTERRUPTED`].
 //!
 //! Only the loops that poll (`run`, `gen`) can stop cleanly. Elsewhere (`report`, `bench`, or a
 //! second Ctrl-C while a loop winds down) the handler exits at once with the same code, as the

@@ -22,7 +22,7 @@
 //! where `F`, `τ` are every load on the body except the springs (gravity, constant forces and
 //! torques, forces game code or its own systems added) and `e_step` is the integrator's energy
 //! error. The `(v_start + v_end)/2` form is the drift–kick–drift displacement exactly, so a
-//! constant force credits exactly the work the step did. Spring damping and [`Damping`] only
+//! constant force credits exactly the work the step did. Spring damping and [`Damping`](crate::components::Damping) only
 //! remove energy and are not credited. The audit keeps the running sum `D = Σ e_step` per group
 //! (the energy the integrator made up; changes game code makes between steps are not part of
 //! it) and rejects the group when
