@@ -191,7 +191,9 @@ mod tests {
         built
             .world
             .resource_mut::<PhysicsSettings>()
-            .set_dt(0.125)
+            // 2⁻⁶ s: exact in binary, and inside the chain's stable region (at 0.125 s its
+            // springs diverge and the audit quarantines the bodies, whose rows then stop).
+            .set_dt(0.015625)
             .unwrap();
         let csv = write(&mut built, 6, 3);
         let rows: Vec<Vec<&str>> = csv
@@ -201,7 +203,7 @@ mod tests {
             .collect();
         assert_eq!(csv.lines().next(), Some(CSV_HEADER));
         assert_eq!(rows.len(), 3 * 3);
-        assert_eq!((rows[8][0], rows[8][1], rows[8][2]), ("6", "0.75", "m3"));
+        assert_eq!((rows[8][0], rows[8][1], rows[8][2]), ("6", "0.09375", "m3"));
         built.world.remove_resource::<PhysicsSettings>();
         let err = write_trajectory(&mut built, 1, NonZeroU64::MIN, std::io::sink(), |_, _| {
             ControlFlow::Continue(())

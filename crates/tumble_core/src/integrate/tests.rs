@@ -150,7 +150,7 @@ fn population() -> Bodies {
             2 => Vec3::new(3.0, 3.1, 0.2),
             3 => Vec3::splat(0.4),
             4 => Vec3::new(0.0, 1.0, 1.5),
-            _ => Vec3::new(1e-4, 1.0, 1.02),
+            _ => Vec3::new(1e-4, 1.0, 1.0001),
         };
         let mass = MassProperties::new(Mass::new(0.5 + f).unwrap(), inertia)
             .unwrap()
