@@ -32,7 +32,8 @@ pub enum BodyErrorKind {
         /// What is wrong with it.
         source: InvalidInput,
     },
-    /// The integrator produced a non-finite state; the body keeps its last finite state.
+    /// The integrator produced a non-finite state or a non-unit rotation; the body keeps its last
+    /// valid state.
     #[error(transparent)]
     Diverged(#[from] StepError),
     /// The integrator created energy: the body's spring group (see [`crate::audit`]) gained more
