@@ -7,6 +7,7 @@ use std::collections::HashMap;
 use bevy_ecs::prelude::*;
 use glam::DVec3;
 use tumble_core::math::{Vec3, Widen};
+use tumble_ecs::components::kinetic_energy_f64;
 use tumble_ecs::prelude::*;
 use tumble_scene::text::terminal_safe;
 
@@ -118,7 +119,7 @@ pub fn totals(world: &mut World) -> (f64, DVec3) {
         let x = t.center_of_mass(m).widen();
         let lin = v.linear.widen();
         let spin = m.world_inertia_mul(t.rotation, v.angular).widen();
-        energy += 0.5 * mass * lin.length_squared() + 0.5 * v.angular.widen().dot(spin);
+        energy += kinetic_energy_f64(t, v, m);
         energy -= mass * scale.map_or(1.0, |s| s.0.widen()) * g.dot(x);
         momentum += x.cross(mass * lin) + spin;
     }
@@ -131,8 +132,7 @@ pub fn totals(world: &mut World) -> (f64, DVec3) {
             SpringEnd::Body { body, anchor } => point(body, anchor),
         };
         if let (Some(pa), Some(pb)) = (point(s.a, s.anchor_a), pb) {
-            let stretch = (pa - pb).widen().length() - s.rest_length.widen();
-            energy += 0.5 * s.stiffness.widen() * stretch * stretch;
+            energy += s.elastic_energy(pa, pb);
         }
     }
     (energy, momentum)

@@ -75,7 +75,7 @@ use tumble_core::math::{Real, Vec3, Widen};
 
 use crate::components::{
     ForceAccumulator, Gravity, GravityScale, Kinematic, MassProps, PhysicsSettings, RigidBody,
-    Static, Transform, Velocity,
+    Static, Transform, Velocity, kinetic_energy_f64,
 };
 use crate::forces::{Spring, SpringEnd, spring_force};
 use crate::systems::Dynamic;
@@ -287,17 +287,8 @@ impl EnergyLedger {
     fn elastic(&self, link: &Link, pose: impl Fn(&Audited) -> Transform + Copy) -> Option<f64> {
         let pa = self.anchor(link.a, pose)?;
         let pb = self.anchor(link.b, pose)?;
-        let stretch = (pa - pb).widen().length() - link.spring.rest_length.widen();
-        Some(0.5 * link.spring.stiffness.widen() * stretch * stretch)
+        Some(link.spring.elastic_energy(pa, pb))
     }
-}
-
-/// Kinetic energy `½m|v|² + ½ωᵀIω` in f64.
-fn kinetic(velocity: &Velocity, transform: &Transform, mass: &MassProps) -> f64 {
-    let v = velocity.linear.widen();
-    let w = velocity.angular;
-    let iw = mass.world_inertia_mul(transform.rotation, w).widen();
-    0.5 * mass.mass().widen() * v.length_squared() + 0.5 * w.widen().dot(iw)
 }
 
 /// Rigid bodies that are not quarantined, whatever their kind (spring ends may be static or
@@ -346,7 +337,7 @@ pub fn audit_energy_start(
             mass: m.mass().widen(),
             parent: i,
         });
-        let energy = kinetic(v, t, m);
+        let energy = kinetic_energy_f64(t, v, m);
         ledger.groups.push(GroupStep {
             start: energy,
             magnitude: energy,
@@ -497,7 +488,7 @@ pub fn audit_energy(
         let v_mean = 0.5 * (v0.linear.widen() + v.linear.widen());
         let w_mean = 0.5 * (v0.angular.widen() + v.angular.widen());
         let work = dt * (force.widen().dot(v_mean) + torque.widen().dot(w_mean));
-        let energy = kinetic(v, t, m);
+        let energy = kinetic_energy_f64(t, v, m);
         let g = &mut ledger.groups[root];
         g.end += energy;
         g.work += work;

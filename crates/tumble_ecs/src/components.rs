@@ -1,7 +1,7 @@
 //! Components and resources: the whole public data model of a tumble world.
 
 use bevy_ecs::prelude::*;
-use tumble_core::math::{Quat, Real, Vec3};
+use tumble_core::math::{Quat, Real, Vec3, Widen};
 
 use tumble_core::{BodyState, Integrator, InvalidInput, MassProperties};
 
@@ -326,6 +326,15 @@ impl Default for PhysicsSettings {
 fn com_offset(rotation: Quat, mass: &MassProps) -> Option<Vec3> {
     let c = mass.local_center_of_mass();
     (c != Vec3::ZERO).then(|| rotation * c)
+}
+
+/// Kinetic energy `½ m |v|² + ½ ωᵀ I ω` (J) of a body, in `f64` (energy balances sum many
+/// bodies; [`tumble_core::invariants::kinetic_energy`] is the same in the engine's precision).
+pub fn kinetic_energy_f64(transform: &Transform, velocity: &Velocity, mass: &MassProps) -> f64 {
+    let v = velocity.linear.widen();
+    let w = velocity.angular;
+    let iw = mass.world_inertia_mul(transform.rotation, w).widen();
+    0.5 * mass.mass().widen() * v.length_squared() + 0.5 * w.widen().dot(iw)
 }
 
 /// Reads a body's core state (centre-of-mass position) from its components.

@@ -6,7 +6,7 @@
 use bevy_ecs::lifecycle::HookContext;
 use bevy_ecs::prelude::*;
 use bevy_ecs::world::DeferredWorld;
-use tumble_core::math::{Real, Vec3};
+use tumble_core::math::{Real, Vec3, Widen};
 
 use crate::components::{
     ForceAccumulator, Gravity, GravityScale, MassProps, RigidBody, Transform, Velocity,
@@ -75,6 +75,15 @@ pub struct Spring {
     pub damping: Real,
     /// Rest length `L₀` (m), `>= 0`.
     pub rest_length: Real,
+}
+
+impl Spring {
+    /// Elastic energy `½ k (|d| − L₀)²` (J) with the anchors at the world points `pa` and `pb`,
+    /// in `f64` (energy balances sum many such terms).
+    pub fn elastic_energy(&self, pa: Vec3, pb: Vec3) -> f64 {
+        let stretch = (pa - pb).widen().length() - self.rest_length.widen();
+        0.5 * self.stiffness.widen() * stretch * stretch
+    }
 }
 
 /// Inserts a zero [`ForceAccumulator`] on every body a generator names, where missing.
