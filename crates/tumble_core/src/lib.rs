@@ -25,6 +25,7 @@ pub mod rotation;
 mod serde_impls;
 #[cfg(any(feature = "parry", feature = "parry-f64"))]
 pub mod shapes;
+pub mod springs;
 pub mod state;
 
 pub use error::{InvalidInput, UNIT_QUATERNION_TOLERANCE};

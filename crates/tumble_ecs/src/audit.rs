@@ -145,6 +145,8 @@ enum End {
 #[derive(Debug, Clone, Copy)]
 struct Link {
     spring: Spring,
+    /// Stepped by the implicit step: its force is not in the accumulators.
+    implicit: bool,
     a: End,
     b: End,
 }
@@ -318,7 +320,7 @@ pub fn audit_energy_start(
     mut ledger: ResMut<EnergyLedger>,
     bodies: Query<(Entity, &Transform, &Velocity, &MassProps), Dynamic>,
     ends: Ends,
-    springs: Query<&Spring>,
+    springs: Query<(&Spring, Has<crate::stiff::ImplicitSpring>)>,
 ) {
     let ledger = &mut *ledger;
     ledger.dt = settings.dt().widen();
@@ -345,7 +347,7 @@ pub fn audit_energy_start(
         });
     }
     ledger.links.clear();
-    for spring in &springs {
+    for (spring, implicit) in &springs {
         let a = end_of(&ledger.index, &ends, spring.a, spring.anchor_a);
         let b = match spring.b {
             SpringEnd::World(p) => End::Fixed(p),
@@ -356,6 +358,7 @@ pub fn audit_energy_start(
         }
         ledger.links.push(Link {
             spring: *spring,
+            implicit,
             a,
             b,
         });
@@ -431,6 +434,9 @@ pub fn audit_external_loads(
     };
     for k in 0..ledger.links.len() {
         let link = ledger.links[k];
+        if link.implicit {
+            continue;
+        }
         let (Some((pa, ua, ca)), Some((pb, ub, cb))) =
             (kinematics(link.a, ledger), kinematics(link.b, ledger))
         else {

@@ -1,6 +1,7 @@
 //! Components and resources: the whole public data model of a tumble world.
 
 use bevy_ecs::prelude::*;
+use crate::stiff::SpringSolver;
 use tumble_core::math::{Quat, Real, Vec3, Widen};
 
 use tumble_core::{BodyState, Integrator, InvalidInput, MassProperties};
@@ -255,13 +256,27 @@ pub struct PhysicsSettings {
     dt: Real,
     /// The integration method for every body of the world.
     pub integrator: Integrator,
+    /// How springs are stepped: [`SpringSolver::Auto`] (the default) steps the spring groups
+    /// that are stiff for `dt` with the energy-conserving implicit step and the others with the
+    /// integrator (see [`crate::stiff`]).
+    pub springs: SpringSolver,
 }
 
 impl PhysicsSettings {
     /// Settings with time step `dt` (s) and the given integrator; rejects `dt ≤ 0` and NaN/Inf.
     pub fn new(dt: Real, integrator: Integrator) -> Result<Self, InvalidInput> {
         tumble_core::error::check_time_step(dt)?;
-        Ok(Self { dt, integrator })
+        Ok(Self {
+            dt,
+            integrator,
+            springs: SpringSolver::Auto,
+        })
+    }
+
+    /// The same settings with springs stepped as `springs` says.
+    pub fn with_springs(mut self, springs: SpringSolver) -> Self {
+        self.springs = springs;
+        self
     }
 
     /// The fixed time step `Δt` (s).
@@ -285,13 +300,15 @@ impl PhysicsSettings {
 struct PhysicsSettingsData {
     dt: Real,
     integrator: Integrator,
+    #[serde(default)]
+    springs: SpringSolver,
 }
 
 #[cfg(feature = "serde")]
 impl TryFrom<PhysicsSettingsData> for PhysicsSettings {
     type Error = InvalidInput;
     fn try_from(d: PhysicsSettingsData) -> Result<Self, InvalidInput> {
-        PhysicsSettings::new(d.dt, d.integrator)
+        Ok(PhysicsSettings::new(d.dt, d.integrator)?.with_springs(d.springs))
     }
 }
 
@@ -301,6 +318,7 @@ impl From<PhysicsSettings> for PhysicsSettingsData {
         Self {
             dt: s.dt,
             integrator: s.integrator,
+            springs: s.springs,
         }
     }
 }
@@ -311,6 +329,7 @@ impl Default for PhysicsSettings {
         Self {
             dt: 1.0 / 60.0,
             integrator: Integrator::default(),
+            springs: SpringSolver::Auto,
         }
     }
 }

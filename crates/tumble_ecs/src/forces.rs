@@ -193,8 +193,12 @@ pub fn spring_force(spring: &Spring, d: Vec3, relative_velocity: Vec3) -> Vec3 {
     -magnitude * n
 }
 
-/// Applies every [`Spring`].
-pub fn apply_springs(springs: Query<&Spring>, mut bodies: ForceTargets) {
+/// Applies every [`Spring`] stepped explicitly (the implicit step of [`crate::stiff`] handles
+/// the others).
+pub fn apply_springs(
+    springs: Query<&Spring, Without<crate::stiff::ImplicitSpring>>,
+    mut bodies: ForceTargets,
+) {
     for spring in &springs {
         match spring.b {
             SpringEnd::World(anchor_b) => {

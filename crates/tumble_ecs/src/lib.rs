@@ -24,6 +24,7 @@ pub mod schedule;
 pub mod snapshot;
 pub mod stability;
 pub mod stepper;
+pub mod stiff;
 pub mod systems;
 mod table;
 pub mod validate;
@@ -41,6 +42,7 @@ pub mod prelude {
     pub use crate::schedule::{PhysicsPlan, PhysicsSchedule, PhysicsSet, Stage};
     pub use crate::stability::{StabilityWarning, check_stability};
     pub use crate::stepper::{FixedStepper, FrameSteps, interpolate};
+    pub use crate::stiff::SpringSolver;
     pub use crate::validate::{BodyError, BodyErrorKind, PhysicsErrors, Rejected};
     pub use tumble_core::math::{Quat, Real, Vec3};
     pub use tumble_core::{Density, Integrator, Mass, MassProperties};

@@ -49,7 +49,7 @@ impl PhysicsRunner {
     /// Advances `world` by one step, re-planning first if the world changed. (In a bare `World`,
     /// call `world.clear_trackers()` once per frame as well.)
     pub fn step(&mut self, world: &mut World) {
-        if PhysicsPlan::of(world) != self.plan {
+        if PhysicsPlan::of(world) != self.plan || crate::stiff::classification_is_stale(world) {
             let plan = PhysicsPlan::for_world(world);
             tracing::debug!(from = %self.plan, to = %plan, "physics re-planned");
             self.schedule = plan.build_schedule();

@@ -32,6 +32,7 @@ use crate::forces::{
     ConstantForce, ConstantTorque, Spring, apply_constant_forces, apply_constant_torques,
     apply_gravity, apply_springs,
 };
+use crate::stiff::{ImplicitBody, solve_implicit_springs};
 use crate::systems::{
     HalfDrifted, begin_step, discard_fixed_body_forces, integrate_with_forces,
     integrate_without_forces,
@@ -71,6 +72,8 @@ pub enum Stage {
     Springs,
     /// [`audit_external_loads`].
     AuditExternalLoads,
+    /// [`solve_implicit_springs`].
+    SolveImplicitSprings,
     /// [`integrate_with_forces`].
     IntegrateWithForces,
     /// [`integrate_without_forces`].
@@ -83,7 +86,7 @@ pub enum Stage {
 
 impl Stage {
     /// Every stage, in the order a step runs them.
-    pub const ALL: [Stage; 11] = [
+    pub const ALL: [Stage; 12] = [
         Stage::AuditEnergyStart,
         Stage::BeginStep,
         Stage::Gravity,
@@ -91,6 +94,7 @@ impl Stage {
         Stage::ConstantTorques,
         Stage::Springs,
         Stage::AuditExternalLoads,
+        Stage::SolveImplicitSprings,
         Stage::IntegrateWithForces,
         Stage::IntegrateWithoutForces,
         Stage::DiscardFixedBodyForces,
@@ -111,6 +115,7 @@ impl Stage {
             Stage::ConstantForces => "apply_constant_forces",
             Stage::ConstantTorques => "apply_constant_torques",
             Stage::Springs => "apply_springs",
+            Stage::SolveImplicitSprings => "solve_implicit_springs",
             Stage::IntegrateWithForces => "integrate_with_forces",
             Stage::IntegrateWithoutForces => "integrate_without_forces",
             Stage::DiscardFixedBodyForces => "discard_fixed_body_forces",
@@ -126,6 +131,8 @@ impl Stage {
 /// - `apply_gravity` only with a [`Gravity`] resource and dynamic bodies with accumulators
 ///   (bodies without one get gravity inside `integrate_without_forces`, at no extra pass);
 /// - one system per kind of force generator that exists;
+/// - `solve_implicit_springs` only if a spring group is stepped implicitly (see
+///   [`crate::stiff`]);
 /// - `integrate_with_forces` / `integrate_without_forces` only if there are dynamic bodies with
 ///   / without an accumulator ([`Static`] and [`Kinematic`] bodies are never integrated);
 /// - `discard_fixed_body_forces` only if a static or kinematic body has an accumulator.
@@ -147,6 +154,7 @@ struct Contents {
     constant_forces: bool,
     constant_torques: bool,
     springs: bool,
+    implicit_bodies: bool,
 }
 
 impl Contents {
@@ -162,11 +170,13 @@ impl Contents {
         let force = world.component_id::<ConstantForce>();
         let torque = world.component_id::<ConstantTorque>();
         let spring = world.component_id::<Spring>();
+        let implicit = world.component_id::<ImplicitBody>();
         let mut out = Contents::default();
         for archetype in world.archetypes().iter().filter(|a| !a.is_empty()) {
             let has = |c: Option<ComponentId>| c.is_some_and(|c| archetype.contains(c));
             if has(body) {
                 let is_fixed = fixed.iter().any(|&c| has(c));
+                out.implicit_bodies |= !is_fixed && has(implicit);
                 match (is_fixed, has(acc)) {
                     (false, true) => out.dynamic_with_accumulator = true,
                     (false, false) => out.dynamic_without_accumulator = true,
@@ -184,11 +194,13 @@ impl Contents {
 
 impl PhysicsPlan {
     /// Plans the step for `world`: [`of`](Self::of) after inserting default
-    /// [`PhysicsSettings`] (if missing) and the bookkeeping resource, with settings outside the
+    /// [`PhysicsSettings`] (if missing) and the bookkeeping resource, classifying the springs
+    /// (explicit or implicit, see [`crate::stiff::classify_springs`]), with settings outside the
     /// integrator's stable region reported through `tracing` (see
     /// [`check_stability`](crate::stability::check_stability)).
     pub fn for_world(world: &mut World) -> Self {
         world.get_resource_or_init::<PhysicsSettings>();
+        crate::stiff::classify_springs(world);
         for warning in crate::stability::check_stability(world) {
             tracing::warn!("{warning}");
         }
@@ -234,6 +246,9 @@ impl PhysicsPlan {
         }
         if audit && c.dynamic_with_accumulator {
             stages.push(Stage::AuditExternalLoads);
+        }
+        if c.implicit_bodies {
+            stages.push(Stage::SolveImplicitSprings);
         }
         if c.dynamic_with_accumulator {
             stages.push(Stage::IntegrateWithForces);
@@ -290,6 +305,7 @@ impl PhysicsPlan {
                 Stage::Gravity => PhysicsSet::Gravity,
                 Stage::AuditExternalLoads
                 | Stage::AuditEnergy
+                | Stage::SolveImplicitSprings
                 | Stage::IntegrateWithForces
                 | Stage::IntegrateWithoutForces
                 | Stage::DiscardFixedBodyForces => PhysicsSet::Integrate,
@@ -316,6 +332,7 @@ fn add_stage(schedule: &mut Schedule, stage: Stage, set: PhysicsSet, after: Opti
         Stage::ConstantForces => apply_constant_forces.into_configs(),
         Stage::ConstantTorques => apply_constant_torques.into_configs(),
         Stage::Springs => apply_springs.into_configs(),
+        Stage::SolveImplicitSprings => solve_implicit_springs.into_configs(),
         Stage::IntegrateWithForces => integrate_with_forces.into_configs(),
         Stage::IntegrateWithoutForces => integrate_without_forces.into_configs(),
         Stage::DiscardFixedBodyForces => discard_fixed_body_forces.into_configs(),

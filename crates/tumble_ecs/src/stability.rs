@@ -151,7 +151,7 @@ pub fn check_stability(world: &mut World) -> Vec<StabilityWarning> {
     let dt = settings.dt();
     let mut warnings = Vec::new();
     let springs: Vec<(Entity, Spring)> = world
-        .query::<(Entity, &Spring)>()
+        .query_filtered::<(Entity, &Spring), Without<crate::stiff::ImplicitSpring>>()
         .iter(world)
         .map(|(e, s)| (e, *s))
         .collect();

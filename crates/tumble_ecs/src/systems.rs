@@ -12,6 +12,7 @@ use crate::components::{
     RigidBody, Static, Transform, Velocity,
 };
 use crate::parallel::Parallelism;
+use crate::stiff::ImplicitBody;
 use crate::table::{Bodies, Loads, step_table};
 use crate::validate::{BodyError, Rejected, reject};
 
@@ -71,7 +72,7 @@ pub fn begin_step(
             &MassProps,
             &ForceAccumulator,
         ),
-        Dynamic,
+        (Dynamic, Without<ImplicitBody>),
     >,
 ) {
     if !settings.integrator.samples_forces_at_midpoint() {
@@ -120,7 +121,7 @@ pub fn integrate_with_forces(
             &mut ForceAccumulator,
             Option<&Damping>,
         ),
-        Dynamic,
+        (Dynamic, Without<ImplicitBody>),
     >,
 ) {
     let phase = if drifted.0 {

@@ -55,6 +55,10 @@ pub enum BodyErrorKind {
         /// Bodies in the group.
         group: usize,
     },
+    /// The implicit step of the body's stiff spring group failed (see [`crate::stiff`]); the
+    /// group keeps its state at the start of the step.
+    #[error("stiff spring group: {0}")]
+    ImplicitSprings(tumble_core::springs::ImplicitSpringError),
     /// The body was already quarantined in a restored snapshot, for this reason.
     #[error("quarantined before the snapshot: {0}")]
     Restored(String),

@@ -1,0 +1,783 @@
+//! The energy-conserving implicit step of a group of rigid bodies joined by springs.
+//!
+//! # The scheme
+//!
+//! Per body, with `h = Δt`, principal moments `I`, the orientation `Q` (principal frame → world),
+//! the body-frame angular momentum `Π = I Ω`, and as unknowns the mean linear velocity `v̄` and the
+//! mean body-frame angular velocity `Ω̄` of the step:
+//!
+//! ```text
+//! x₁ = x₀ + h v̄                     v₁ = 2 v̄ − v₀
+//! Q₁ = Q₀ cay(h Ω̄)                  Π₁ = 2 I Ω̄ − Π₀
+//! m (v̄ − v₀)               = ½ h (F_ext + Σ F̄)
+//! I Ω̄ − Π₀ + ½ h Ω̄ × I Ω̄   = ½ h (T_ext + Σ b × Q₀ᵀ F̄)
+//! ```
+//!
+//! `cay(w)` is the Cayley rotation (angle `2 atan(|w|/2)` about `w`; quaternion `(w/2, 1)`
+//! normalized), so `cay(hΩ̄) a − a = h Ω̄ × b` exactly with `b = (a + cay(hΩ̄) a)/2` for every body
+//! point `a`. The spring force is Gonzalez's discrete gradient of `V = ½ k (ℓ − L₀)²`:
+//!
+//! ```text
+//! F̄ = −k (ℓ̄ − L₀)/ℓ̄ · d̄,   d̄ = (d₀ + d₁)/2,   ℓ̄ = (ℓ₀ + ℓ₁)/2
+//! ```
+//!
+//! on end `a` (and `−F̄` on end `b`), with the torque `b × Q₀ᵀF̄` about the *mean* anchor `b`.
+//!
+//! **Why it conserves energy at any step.** The translational kinetic energy changes by
+//! `m v̄·(v₁ − v₀) = h v̄·ΣF`; the rotational by `½(Π₀ + Π₁)·I⁻¹(Π₁ − Π₀) = Ω̄·(Π₁ − Π₀) = h Ω̄·T`
+//! (the gyroscopic term is orthogonal to `Ω̄`). So the work on an anchor is
+//! `F̄·(h v̄ + Q₀(h Ω̄ × b)) = F̄·Δp`, the anchor's exact displacement, and summed over both ends
+//! `F̄·Δd = −k (ℓ̄ − L₀)/ℓ̄ · (ℓ₁² − ℓ₀²)/2 = −ΔV`. Kinetic plus elastic energy is therefore
+//! conserved exactly, for any stiffness and step, up to the solver's tolerance; a constant force
+//! through the centre of mass does exactly its work `h v̄·F`. Linear momentum is conserved too (the
+//! pair forces cancel). The scheme is symmetric (swapping the ends of the step and `h → −h`
+//! maps it to itself), hence second order. On a linear spring it is the implicit midpoint rule:
+//! unit amplification and the phase `2 atan(ωh/2)` per step, so a spring far too stiff for the
+//! step oscillates slower than it should, bounded, with its energy kept.
+//!
+//! Torque-free, it is the implicit midpoint rule on Euler's equations with a Cayley attitude
+//! update, which conserves `|Π|`, the kinetic energy and the world angular momentum `Q Π`.
+//!
+//! # The solve
+//!
+//! The unknowns `(v̄, Ω̄)` of all bodies of the group solve a nonlinear system by Newton's method
+//! with an approximate Jacobian: the mass and gyroscopic blocks exactly, each spring's coupling
+//! as `¼ Gᵀ K G` with `K = k (m̂m̂ᵀ + max(1 − L₀/ℓ̄, 0)(1 − m̂m̂ᵀ))` (the spring's stiffness,
+//! its compressive geometric part dropped so the coupling stays positive) and `G` the anchor's
+//! Jacobian. The linear systems are solved by BiCGSTAB with a block-Jacobi preconditioner;
+//! a step that does not reduce the residual is halved. Iteration stops when the Newton update
+//! is below [`ImplicitSpringSolver::tolerance`] in the kinetic-energy norm, relative to the
+//! group's energy.
+
+use glam::{DMat3, DQuat, DVec3};
+use thiserror::Error;
+
+use super::linear::{Block, Krylov, block_mul, invert};
+use crate::mass::MassProperties;
+use crate::math::{Narrow, Real, Vec3, Widen};
+use crate::state::{BodyState, Wrench};
+
+/// One body of a spring group as the implicit step sees it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GroupBody {
+    /// The state (centre-of-mass position), replaced by the state at the end of the step.
+    pub state: BodyState,
+    /// Mass properties.
+    pub mass: MassProperties,
+    /// Force (through the centre of mass) and torque (world frame) held constant over the step:
+    /// gravity, constant forces and whatever game code added.
+    pub load: Wrench,
+}
+
+/// The second end of a [`GroupSpring`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum LinkEnd {
+    /// A point of another body of the group: its index and the anchor in body coordinates
+    /// (relative to the body origin, as [`GroupSpring::anchor_a`]).
+    Body {
+        /// Index into the group's bodies.
+        index: usize,
+        /// Anchor in that body's coordinates.
+        anchor: Vec3,
+    },
+    /// A point fixed in the world over the step (a world anchor, or a static or kinematic body).
+    Fixed(Vec3),
+}
+
+/// An undamped linear spring of the group (damping is a separate flow, outside this step).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GroupSpring {
+    /// Index of the first body.
+    pub a: usize,
+    /// Anchor on `a` in body coordinates (relative to the body origin, not the centre of mass).
+    pub anchor_a: Vec3,
+    /// The other end.
+    pub b: LinkEnd,
+    /// Stiffness `k` (N/m).
+    pub stiffness: Real,
+    /// Rest length `L₀` (m).
+    pub rest_length: Real,
+}
+
+/// Why an implicit spring step failed (the bodies keep their states).
+#[derive(Debug, Clone, Copy, PartialEq, Error)]
+pub enum ImplicitSpringError {
+    /// Newton's method did not reach the tolerance.
+    #[error(
+        "implicit spring step did not converge in {iterations} iterations (update {update:.3e} \
+         of the energy scale, tolerance {tolerance:.1e})"
+    )]
+    NotConverged {
+        /// Newton iterations taken.
+        iterations: usize,
+        /// Size of the last update relative to the energy scale.
+        update: f64,
+        /// The tolerance it had to reach.
+        tolerance: f64,
+    },
+    /// A value became NaN or infinite.
+    #[error("implicit spring step produced a non-finite value")]
+    NonFinite,
+    /// A spring names a body index outside the group.
+    #[error("spring names body {index} of a group of {len}")]
+    BadIndex {
+        /// The index.
+        index: usize,
+        /// The group's size.
+        len: usize,
+    },
+}
+
+/// How a step went.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct SolveStats {
+    /// Newton iterations.
+    pub newton_iterations: usize,
+    /// BiCGSTAB iterations, summed over the Newton iterations.
+    pub linear_iterations: usize,
+    /// Times a step was split in two because Newton's method did not converge.
+    pub splits: usize,
+}
+
+/// How many times a step may be halved, recursively, before the implicit step gives up
+/// (`2^MAX_SPLITS` pieces at most).
+pub const MAX_SPLITS: u32 = 8;
+
+/// A body's data for one step, in `f64`, principal frame.
+#[derive(Debug, Clone, Copy, Default)]
+struct Start {
+    x: DVec3,
+    v: DVec3,
+    /// Principal frame → world at the start.
+    q: DQuat,
+    r: DMat3,
+    /// Body-frame momentum `Π₀ = I Ω₀`.
+    pi: DVec3,
+    mass: f64,
+    inertia: DVec3,
+    /// 1 for a free axis, 0 for a locked (zero-moment) one.
+    free: DVec3,
+    force: DVec3,
+    torque: DVec3,
+    /// Inertia scale of the locked-axis rows (keeps the block well conditioned).
+    lock_scale: f64,
+}
+
+/// One spring end after the start geometry is known.
+#[derive(Debug, Clone, Copy, Default)]
+struct End {
+    /// Body index, or `usize::MAX` for a fixed end.
+    body: usize,
+    /// Anchor relative to the centre of mass, principal frame.
+    local: DVec3,
+    /// A fixed end's world point.
+    fixed: DVec3,
+}
+
+#[derive(Debug, Clone, Copy, Default)]
+struct Link {
+    ends: [End; 2],
+    k: f64,
+    rest: f64,
+    d0: DVec3,
+    l0: f64,
+}
+
+/// What the residual pass leaves for the Jacobian: per spring, the mean anchors and stiffness.
+#[derive(Debug, Clone, Copy, Default)]
+struct Linearized {
+    /// Mean anchors `b` (principal frame) of both ends.
+    b: [DVec3; 2],
+    /// `−2 ∂F̄/∂d₁ = k ((1 − L₀/ℓ̄) 1 + (L₀/ℓ̄²) d̄ n₁ᵀ)` (world frame).
+    k: DMat3,
+    /// The force on end `a`, `F̄`.
+    force: DVec3,
+}
+
+/// The implicit spring step with its scratch memory (reused, so a step does not allocate once
+/// the buffers have grown to the group's size).
+#[derive(Debug, Clone)]
+pub struct ImplicitSpringSolver {
+    /// Relative tolerance of the Newton update in the kinetic-energy norm (default `1e-10`).
+    pub tolerance: f64,
+    /// Newton iterations of one solve before the step is split (default 20; see [`Self::step`]).
+    pub max_newton: usize,
+    starts: Vec<Start>,
+    links: Vec<Link>,
+    lin: Vec<Linearized>,
+    z: Vec<f64>,
+    trial: Vec<f64>,
+    residual: Vec<f64>,
+    trial_residual: Vec<f64>,
+    delta: Vec<f64>,
+    rhs: Vec<f64>,
+    blocks: Vec<Block>,
+    preconditioner: Vec<Block>,
+    cayley: Vec<DQuat>,
+    /// Per body, `(1 − [hΩ̄/2]×)⁻¹`: the derivative of the Cayley rotation (see `evaluate`).
+    cayley_derivative: Vec<DMat3>,
+    krylov: Krylov,
+}
+
+impl Default for ImplicitSpringSolver {
+    fn default() -> Self {
+        Self {
+            tolerance: 1e-10,
+            max_newton: 20,
+            starts: Vec::new(),
+            links: Vec::new(),
+            lin: Vec::new(),
+            z: Vec::new(),
+            trial: Vec::new(),
+            residual: Vec::new(),
+            trial_residual: Vec::new(),
+            delta: Vec::new(),
+            rhs: Vec::new(),
+            blocks: Vec::new(),
+            preconditioner: Vec::new(),
+            cayley: Vec::new(),
+            cayley_derivative: Vec::new(),
+            krylov: Krylov::default(),
+        }
+    }
+}
+
+/// Largest change of `h|Ω̄|` (rad) of any body in one Newton iteration.
+const MAX_TURN: f64 = 0.5;
+
+/// The Cayley rotation `cay(w)` as a unit quaternion: `(w/2, 1)` normalized.
+#[inline]
+fn cayley(w: DVec3) -> DQuat {
+    let half = 0.5 * w;
+    DQuat::from_xyzw(half.x, half.y, half.z, 1.0).normalize()
+}
+
+fn v3(z: &[f64]) -> DVec3 {
+    DVec3::new(z[0], z[1], z[2])
+}
+
+fn put(z: &mut [f64], v: DVec3) {
+    z[0] = v.x;
+    z[1] = v.y;
+    z[2] = v.z;
+}
+
+fn add(z: &mut [f64], v: DVec3) {
+    z[0] += v.x;
+    z[1] += v.y;
+    z[2] += v.z;
+}
+
+impl ImplicitSpringSolver {
+    /// Advances `bodies` by one step `dt` under `springs` and their loads (see the module docs).
+    /// On error the bodies keep their states.
+    ///
+    /// Where Newton's method does not converge from the start of the step (a step so large that
+    /// the bodies turn by radians in it), the step is split in two halves, recursively, up to
+    /// [`MAX_SPLITS`] times: each half is the same energy-conserving map, so the composition
+    /// conserves energy too (and stays symmetric).
+    pub fn step(
+        &mut self,
+        bodies: &mut [GroupBody],
+        springs: &[GroupSpring],
+        dt: Real,
+    ) -> Result<SolveStats, ImplicitSpringError> {
+        let mut stats = SolveStats::default();
+        self.advance(bodies, springs, dt.widen(), 0, &mut stats)?;
+        Ok(stats)
+    }
+
+    fn advance(
+        &mut self,
+        bodies: &mut [GroupBody],
+        springs: &[GroupSpring],
+        h: f64,
+        depth: u32,
+        stats: &mut SolveStats,
+    ) -> Result<(), ImplicitSpringError> {
+        match self.solve(bodies, springs, h, stats) {
+            Err(ImplicitSpringError::NotConverged { .. }) if depth < MAX_SPLITS => {
+                stats.splits += 1;
+                self.advance(bodies, springs, 0.5 * h, depth + 1, stats)?;
+                self.advance(bodies, springs, 0.5 * h, depth + 1, stats)
+            }
+            other => other,
+        }
+    }
+
+    /// One Newton solve of the whole step `h`.
+    fn solve(
+        &mut self,
+        bodies: &mut [GroupBody],
+        springs: &[GroupSpring],
+        h: f64,
+        stats: &mut SolveStats,
+    ) -> Result<(), ImplicitSpringError> {
+        self.prepare(bodies, springs)?;
+        let n = bodies.len() * 6;
+        self.z.clear();
+        for s in &self.starts {
+            let omega = s.free * (s.pi / s.inertia.max(DVec3::splat(f64::MIN_POSITIVE)));
+            self.z.extend_from_slice(&[s.v.x, s.v.y, s.v.z, omega.x, omega.y, omega.z]);
+        }
+        for buffer in [
+            &mut self.residual,
+            &mut self.trial_residual,
+            &mut self.delta,
+            &mut self.trial,
+            &mut self.rhs,
+        ] {
+            buffer.clear();
+            buffer.resize(n, 0.0);
+        }
+        let scale = self.energy_scale(h);
+        let mut norm = self.evaluate(h);
+        let mut update = f64::INFINITY;
+        let mut iterations = 0;
+        while iterations < self.max_newton {
+            iterations += 1;
+            stats.newton_iterations += 1;
+            self.build_preconditioner(h);
+            for (b, r) in self.rhs.iter_mut().zip(&self.residual) {
+                *b = -r;
+            }
+            let rhs = std::mem::take(&mut self.rhs);
+            let mut delta = std::mem::take(&mut self.delta);
+            let mut krylov = std::mem::take(&mut self.krylov);
+            stats.linear_iterations += krylov.solve(
+                &rhs,
+                &mut delta,
+                1e-9,
+                400,
+                |u, out| self.apply_jacobian(h, u, out),
+                |u, out| self.apply_preconditioner(u, out),
+            );
+            self.krylov = krylov;
+            self.rhs = rhs;
+            // Backtrack on the residual norm: a full Newton step can overshoot far from the
+            // solution (large rotations make the spring geometry strongly nonlinear).
+            // Trust region on the rotation: an update may change any body's Cayley angle
+            // `2 atan(h|Ω̄|/2)` by at most `MAX_TURN` (radians), so Newton does not jump across
+            // the region where the map from Ω̄ to the rotation is far from linear.
+            let mut step: f64 = 1.0;
+            for (d, z) in delta.chunks_exact(6).zip(self.z.chunks_exact(6)) {
+                let w = h * v3(&z[3..]).length();
+                let allowed = MAX_TURN * (1.0 + 0.25 * w * w);
+                let change = h * v3(&d[3..]).length();
+                if change > allowed {
+                    step = step.min(allowed / change);
+                }
+            }
+            let mut accepted = false;
+            for _ in 0..12 {
+                for i in 0..n {
+                    self.trial[i] = self.z[i] + step * delta[i];
+                }
+                std::mem::swap(&mut self.z, &mut self.trial);
+                std::mem::swap(&mut self.residual, &mut self.trial_residual);
+                let trial_norm = self.evaluate(h);
+                if trial_norm.is_finite() && trial_norm <= norm {
+                    norm = trial_norm;
+                    accepted = true;
+                    break;
+                }
+                std::mem::swap(&mut self.z, &mut self.trial);
+                std::mem::swap(&mut self.residual, &mut self.trial_residual);
+                step *= 0.5;
+            }
+            let full = (self.kinetic_norm(&delta) / scale).sqrt();
+            self.delta = delta;
+            if !accepted {
+                // No decrease at any step length: converged if the proposed update is already at
+                // the tolerance (the residual is at round-off), failed otherwise.
+                update = full;
+                break;
+            }
+            update = step * full;
+            if update <= self.tolerance {
+                break;
+            }
+        }
+        if !update.is_finite() || self.z.iter().any(|v| !v.is_finite()) {
+            return Err(ImplicitSpringError::NonFinite);
+        }
+        if update > self.tolerance {
+            return Err(ImplicitSpringError::NotConverged {
+                iterations,
+                update,
+                tolerance: self.tolerance,
+            });
+        }
+        self.finish(h, bodies)
+    }
+
+    /// Reads the bodies and springs into the `f64` principal-frame working data.
+    fn prepare(
+        &mut self,
+        bodies: &[GroupBody],
+        springs: &[GroupSpring],
+    ) -> Result<(), ImplicitSpringError> {
+        self.starts.clear();
+        for body in bodies {
+            let m = &body.mass;
+            let q = (body.state.rotation * m.principal_frame()).widen().normalize();
+            let inertia = m.principal_inertia().widen();
+            let free = DVec3::select(inertia.cmpgt(DVec3::ZERO), DVec3::ONE, DVec3::ZERO);
+            let omega = q.inverse() * body.state.angular_velocity.widen();
+            self.starts.push(Start {
+                x: body.state.position.widen(),
+                v: body.state.linear_velocity.widen(),
+                q,
+                r: DMat3::from_quat(q),
+                pi: free * inertia * omega,
+                mass: m.mass().widen(),
+                inertia,
+                free,
+                force: body.load.force.widen(),
+                torque: body.load.torque.widen(),
+                lock_scale: inertia.max_element(),
+            });
+        }
+        self.links.clear();
+        let len = bodies.len();
+        for spring in springs {
+            let end_of = |index: usize, anchor: Vec3| -> Result<End, ImplicitSpringError> {
+                let body = bodies
+                    .get(index)
+                    .ok_or(ImplicitSpringError::BadIndex { index, len })?;
+                let m = &body.mass;
+                let local = m.principal_frame().widen().inverse()
+                    * (anchor - m.local_center_of_mass()).widen();
+                Ok(End {
+                    body: index,
+                    local,
+                    fixed: DVec3::ZERO,
+                })
+            };
+            let a = end_of(spring.a, spring.anchor_a)?;
+            let b = match spring.b {
+                LinkEnd::Body { index, anchor } => end_of(index, anchor)?,
+                LinkEnd::Fixed(p) => End {
+                    body: usize::MAX,
+                    local: DVec3::ZERO,
+                    fixed: p.widen(),
+                },
+            };
+            let mut link = Link {
+                ends: [a, b],
+                k: spring.stiffness.widen(),
+                rest: spring.rest_length.widen(),
+                ..Link::default()
+            };
+            link.d0 = self.anchor_start(&link.ends[0]) - self.anchor_start(&link.ends[1]);
+            link.l0 = link.d0.length();
+            self.links.push(link);
+        }
+        self.lin.clear();
+        self.lin.resize(self.links.len(), Linearized::default());
+        Ok(())
+    }
+
+    fn anchor_start(&self, end: &End) -> DVec3 {
+        match self.starts.get(end.body) {
+            Some(s) => s.x + s.q * end.local,
+            None => end.fixed,
+        }
+    }
+
+    /// The group's energy scale (J): kinetic + elastic energy at the start plus the work the
+    /// loads can do in a step, so the tolerance is relative to what the step moves.
+    fn energy_scale(&self, h: f64) -> f64 {
+        let kinetic: f64 = self
+            .starts
+            .iter()
+            .map(|s| {
+                let omega = s.free * s.pi / s.inertia.max(DVec3::splat(f64::MIN_POSITIVE));
+                0.5 * s.mass * s.v.length_squared() + 0.5 * s.pi.dot(omega)
+            })
+            .sum();
+        let elastic: f64 = self
+            .links
+            .iter()
+            .map(|l| 0.5 * l.k * (l.l0 - l.rest).powi(2))
+            .sum();
+        let loads: f64 = self
+            .starts
+            .iter()
+            .map(|s| h * h * (s.force.length_squared() / s.mass))
+            .sum();
+        (kinetic + elastic + loads).max(f64::MIN_POSITIVE)
+    }
+
+    /// `Σ m |δv|² + δΩ·I δΩ`: twice the kinetic energy of an update (J).
+    fn kinetic_norm(&self, delta: &[f64]) -> f64 {
+        let sum: f64 = self
+            .starts
+            .iter()
+            .zip(delta.chunks_exact(6))
+            .map(|(s, d)| {
+                let dv = v3(&d[..3]);
+                let dw = v3(&d[3..]);
+                s.mass * dv.length_squared() + dw.dot(s.inertia * dw)
+            })
+            .sum();
+        sum
+    }
+
+    /// Computes the residual at `self.z` into `self.residual` (and the linearization for the
+    /// Jacobian) and returns its norm, scaled per body by `1/√m`, `1/√I`.
+    fn evaluate(&mut self, h: f64) -> f64 {
+        self.cayley.clear();
+        self.cayley_derivative.clear();
+        for (i, s) in self.starts.iter().enumerate() {
+            let z = &self.z[6 * i..6 * i + 6];
+            let vbar = v3(&z[..3]);
+            let wbar = s.free * v3(&z[3..]);
+            self.cayley.push(cayley(h * wbar));
+            // From (1 − [w/2]×) cay(w) a = (1 + [w/2]×) a: d(cay(w) a) = −(1 − [w/2]×)⁻¹ [b]× dw,
+            // and (1 − [u]×)⁻¹ = 1 + ([u]× + [u]×²)/(1 + |u|²).
+            let u = skew(0.5 * h * wbar);
+            let uu = (0.5 * h * wbar).length_squared();
+            self.cayley_derivative
+                .push(DMat3::IDENTITY + (u + u * u) * (1.0 / (1.0 + uu)));
+            let r = &mut self.residual[6 * i..6 * i + 6];
+            put(&mut r[..3], s.mass * (vbar - s.v) - 0.5 * h * s.force);
+            // External torque in the principal frame at the mean of the two orientations.
+            let q1 = self.cayley[i];
+            let torque = 0.5 * (s.q.inverse() * s.torque + (s.q * q1).inverse() * s.torque);
+            let iw = s.inertia * wbar;
+            let rot = iw - s.pi + 0.5 * h * wbar.cross(iw) - 0.5 * h * torque;
+            // A locked axis has no equation of motion: its row pins Ω̄ to 0.
+            let rot = DVec3::select(
+                s.free.cmpgt(DVec3::ZERO),
+                rot,
+                s.lock_scale * v3(&z[3..]),
+            );
+            put(&mut r[3..], rot);
+        }
+        for (link, lin) in self.links.iter().zip(self.lin.iter_mut()) {
+            let mut p1 = [DVec3::ZERO; 2];
+            for (e, end) in link.ends.iter().enumerate() {
+                match self.starts.get(end.body) {
+                    Some(s) => {
+                        let z = &self.z[6 * end.body..6 * end.body + 6];
+                        let rotated = self.cayley[end.body] * end.local;
+                        lin.b[e] = 0.5 * (end.local + rotated);
+                        p1[e] = s.x + h * v3(&z[..3]) + s.q * rotated;
+                    }
+                    None => p1[e] = end.fixed,
+                }
+            }
+            let d1 = p1[0] - p1[1];
+            let l1 = d1.length();
+            let dbar = 0.5 * (link.d0 + d1);
+            let lbar = 0.5 * (link.l0 + l1);
+            let force = if lbar > 0.0 {
+                let ratio = (lbar - link.rest) / lbar;
+                lin.k = DMat3::from_diagonal(DVec3::splat(link.k * ratio));
+                if l1 > 0.0 {
+                    lin.k += (link.k * link.rest / (lbar * lbar * l1)) * outer(dbar, d1);
+                }
+                -link.k * ratio * dbar
+            } else {
+                lin.k = DMat3::from_diagonal(DVec3::splat(link.k));
+                DVec3::ZERO
+            };
+            lin.force = force;
+            for (e, end) in link.ends.iter().enumerate() {
+                if let Some(s) = self.starts.get(end.body) {
+                    let f = if e == 0 { force } else { -force };
+                    let torque = s.free * lin.b[e].cross(s.r.transpose() * f);
+                    let r = &mut self.residual[6 * end.body..6 * end.body + 6];
+                    add(&mut r[..3], -0.5 * h * f);
+                    add(&mut r[3..], -0.5 * h * torque);
+                }
+            }
+        }
+        self.starts
+            .iter()
+            .zip(self.residual.chunks_exact(6))
+            .map(|(s, r)| {
+                let inv_i = DVec3::ONE / s.inertia.max(DVec3::splat(s.lock_scale));
+                v3(&r[..3]).length_squared() / s.mass + v3(&r[3..]).dot(inv_i * v3(&r[3..]))
+            })
+            .sum::<f64>()
+    }
+
+    /// The mass and gyroscopic 6×6 block of body `i` at the current iterate.
+    fn body_block(&self, h: f64, i: usize) -> Block {
+        let s = &self.starts[i];
+        let w = s.free * v3(&self.z[6 * i + 3..6 * i + 6]);
+        let mut block = [[0.0; 6]; 6];
+        for a in 0..3 {
+            block[a][a] = s.mass;
+        }
+        // ∂/∂Ω̄ of I Ω̄ + ½ h Ω̄ × I Ω̄ = I + ½ h ([Ω̄]× I − [I Ω̄]×).
+        let inertia = DMat3::from_diagonal(s.inertia);
+        let gyro = 0.5 * h * (skew(w) * inertia - skew(s.inertia * w));
+        let m = inertia + gyro;
+        for a in 0..3 {
+            if s.free[a] > 0.0 {
+                for c in 0..3 {
+                    block[3 + a][3 + c] = m.col(c)[a];
+                }
+            } else {
+                block[3 + a][3 + a] = s.lock_scale;
+            }
+        }
+        block
+    }
+
+    /// `G u` for one spring end: the change of the anchor's end position `x₁ + Q₀ cay(hΩ̄) a`,
+    /// `h δv − h Q₀ (1 − [hΩ̄/2]×)⁻¹ (b × δΩ)`.
+    fn end_jacobian(&self, h: f64, body: usize, b: DVec3, du: &[f64]) -> DVec3 {
+        let s = &self.starts[body];
+        let turn = self.cayley_derivative[body] * (s.free * v3(&du[3..])).cross(b);
+        h * v3(&du[..3]) + h * (s.r * turn)
+    }
+
+    /// `Gᵀ f`: the generalized force of a world force `f` at the end (force; principal torque).
+    fn end_transpose(&self, h: f64, body: usize, b: DVec3, f: DVec3) -> (DVec3, DVec3) {
+        let s = &self.starts[body];
+        (h * f, h * s.free * b.cross(s.r.transpose() * f))
+    }
+
+    /// `out = J u` with the approximate Jacobian of the module docs.
+    fn apply_jacobian(&self, h: f64, u: &[f64], out: &mut [f64]) {
+        for (i, block) in self.blocks.iter().enumerate() {
+            let y = block_mul(block, &u[6 * i..6 * i + 6]);
+            out[6 * i..6 * i + 6].copy_from_slice(&y);
+        }
+        for (link, lin) in self.links.iter().zip(&self.lin) {
+            let mut dd = DVec3::ZERO;
+            for (e, end) in link.ends.iter().enumerate() {
+                if end.body < self.starts.len() {
+                    let du = &u[6 * end.body..6 * end.body + 6];
+                    let g = self.end_jacobian(h, end.body, lin.b[e], du);
+                    dd += if e == 0 { g } else { -g };
+                }
+            }
+            let f = 0.25 * h * (lin.k * dd) / h;
+            for (e, end) in link.ends.iter().enumerate() {
+                if end.body < self.starts.len() {
+                    let (lin_part, rot_part) =
+                        self.end_transpose(h, end.body, lin.b[e], if e == 0 { f } else { -f });
+                    let o = &mut out[6 * end.body..6 * end.body + 6];
+                    add(&mut o[..3], lin_part);
+                    add(&mut o[3..], rot_part);
+                }
+            }
+        }
+    }
+
+    /// The body blocks of the Jacobian at the current iterate, and the block-Jacobi
+    /// preconditioner: each body's block plus its springs' diagonal coupling `¼ GᵀKG`, inverted
+    /// (a diagonal scaled by the mass and inertia where singular).
+    fn build_preconditioner(&mut self, h: f64) {
+        let mut blocks = std::mem::take(&mut self.blocks);
+        blocks.clear();
+        blocks.extend((0..self.starts.len()).map(|i| self.body_block(h, i)));
+        // The torque arm `b` turns with Ω̄ too: ∂(−½h b × Q₀ᵀf)/∂Ω̄ = −¼h² [Q₀ᵀf]× M [b]×,
+        // with M the Cayley derivative (a body's own block; not symmetric).
+        for (link, lin) in self.links.iter().zip(&self.lin) {
+            for (e, end) in link.ends.iter().enumerate() {
+                let Some(s) = self.starts.get(end.body) else {
+                    continue;
+                };
+                let f = if e == 0 { lin.force } else { -lin.force };
+                let term = -0.25
+                    * h
+                    * h
+                    * (skew(s.r.transpose() * f) * self.cayley_derivative[end.body] * skew(lin.b[e]));
+                let block = &mut blocks[end.body];
+                for a in 0..3 {
+                    for c in 0..3 {
+                        if s.free[a] > 0.0 && s.free[c] > 0.0 {
+                            block[3 + a][3 + c] += term.col(c)[a];
+                        }
+                    }
+                }
+            }
+        }
+        let mut preconditioner = std::mem::take(&mut self.preconditioner);
+        preconditioner.clear();
+        preconditioner.extend_from_slice(&blocks);
+        for (link, lin) in self.links.iter().zip(&self.lin) {
+            for (e, end) in link.ends.iter().enumerate() {
+                if end.body >= self.starts.len() {
+                    continue;
+                }
+                let block = &mut preconditioner[end.body];
+                // Column c of ¼ Gᵀ K G, from the unit update e_c.
+                for c in 0..6 {
+                    let mut unit = [0.0; 6];
+                    unit[c] = 1.0;
+                    let g = self.end_jacobian(h, end.body, lin.b[e], &unit);
+                    let (lp, rp) = self.end_transpose(h, end.body, lin.b[e], 0.25 * (lin.k * g));
+                    for a in 0..3 {
+                        block[a][c] += lp[a];
+                        block[3 + a][c] += rp[a];
+                    }
+                }
+            }
+        }
+        for (s, block) in self.starts.iter().zip(preconditioner.iter_mut()) {
+            *block = invert(block).unwrap_or_else(|| {
+                let mut d = [[0.0; 6]; 6];
+                for (a, row) in d.iter_mut().enumerate() {
+                    row[a] = 1.0 / if a < 3 { s.mass } else { s.lock_scale };
+                }
+                d
+            });
+        }
+        self.blocks = blocks;
+        self.preconditioner = preconditioner;
+    }
+
+    fn apply_preconditioner(&self, u: &[f64], out: &mut [f64]) {
+        for (i, p) in self.preconditioner.iter().enumerate() {
+            let y = block_mul(p, &u[6 * i..6 * i + 6]);
+            out[6 * i..6 * i + 6].copy_from_slice(&y);
+        }
+    }
+
+    /// Writes the end-of-step states from the converged `(v̄, Ω̄)`.
+    fn finish(&self, h: f64, bodies: &mut [GroupBody]) -> Result<(), ImplicitSpringError> {
+        let mut out = Vec::with_capacity(bodies.len());
+        for (i, (s, body)) in self.starts.iter().zip(bodies.iter()).enumerate() {
+            let z = &self.z[6 * i..6 * i + 6];
+            let vbar = v3(&z[..3]);
+            let wbar = s.free * v3(&z[3..]);
+            let q1 = (s.q * cayley(h * wbar)).normalize();
+            let pi1 = s.free * (2.0 * s.inertia * wbar - s.pi);
+            let omega1 = s.free * pi1 / s.inertia.max(DVec3::splat(f64::MIN_POSITIVE));
+            let rotation = (q1 * body.mass.principal_frame().widen().inverse()).normalize();
+            let state = BodyState {
+                position: (s.x + h * vbar).narrow(),
+                rotation: rotation.narrow().normalize(),
+                linear_velocity: (2.0 * vbar - s.v).narrow(),
+                angular_velocity: (q1 * omega1).narrow(),
+            };
+            if !state.is_valid() {
+                return Err(ImplicitSpringError::NonFinite);
+            }
+            out.push(state);
+        }
+        for (body, state) in bodies.iter_mut().zip(out) {
+            body.state = state;
+        }
+        Ok(())
+    }
+}
+
+fn skew(v: DVec3) -> DMat3 {
+    DMat3::from_cols(
+        DVec3::new(0.0, v.z, -v.y),
+        DVec3::new(-v.z, 0.0, v.x),
+        DVec3::new(v.y, -v.x, 0.0),
+    )
+}
+
+fn outer(a: DVec3, b: DVec3) -> DMat3 {
+    DMat3::from_cols(a * b.x, a * b.y, a * b.z)
+}

@@ -1,0 +1,390 @@
+//! Stiff springs: which spring groups the implicit step takes, and the system that steps them.
+//!
+//! The explicit (drift–kick–drift) spring step is cheap but keeps a spring's energy only to about
+//! `(ωΔt)²/4` of it and diverges at `ωΔt ≥ 2`. A group of bodies joined by springs (a connected
+//! component of the spring graph over dynamic bodies) whose stiffest spring can reach
+//! `ωΔt ≥` [`IMPLICIT_OMEGA_DT`] is stepped instead by the energy-conserving implicit step of
+//! [`tumble_core::springs::implicit`], as a whole: stable at any stiffness, with kinetic plus
+//! elastic energy conserved exactly and no numerical damping. `ω` is bounded above with the
+//! anchors' lever arms (`ω² = k Σ (1/m + |r|² max I⁻¹)`), so a group is never stiffer than the
+//! classification assumed. Soft groups pay nothing: their bodies stay on the explicit path.
+//!
+//! [`PhysicsSettings::springs`](crate::components::PhysicsSettings::springs) overrides the choice
+//! for a world ([`SpringSolver`]). The classification is made when the schedule is planned and
+//! redone when the time step, the setting or the number of springs changes (a
+//! [`PhysicsRunner`](crate::runner::PhysicsRunner) notices); after changing a spring's stiffness
+//! or a body's mass in place, re-insert the spring (or plan again) to re-classify.
+//!
+//! Bodies of an implicit group are marked [`ImplicitBody`] and their springs [`ImplicitSpring`]:
+//! the half drift and the explicit integrate systems skip them, `apply_springs` skips their
+//! springs, and [`solve_implicit_springs`] steps them, reading every other load (gravity,
+//! constant forces, game forces) from their accumulators, held constant over the step.
+
+use bevy_ecs::entity::EntityHashMap;
+use bevy_ecs::prelude::*;
+use tumble_core::math::Real;
+use tumble_core::springs::{
+    GroupBody, GroupSpring, IMPLICIT_OMEGA_DT, ImplicitSpringSolver, LinkEnd,
+    inverse_effective_mass_bound, omega_dt_bound,
+};
+
+use crate::components::{
+    ForceAccumulator, MassProps, PhysicsSettings, RigidBody, Transform, Velocity, body_state,
+    write_body_state,
+};
+use crate::forces::{Spring, SpringEnd};
+use crate::systems::Dynamic;
+use crate::validate::{BodyError, BodyErrorKind, reject};
+
+/// How a world steps its springs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(rename_all = "lowercase")
+)]
+pub enum SpringSolver {
+    /// Implicit for the groups that can reach `ωΔt ≥` [`IMPLICIT_OMEGA_DT`], explicit for the
+    /// others (the default).
+    #[default]
+    Auto,
+    /// Every spring explicit (drift–kick–drift force): cheapest; diverges at `ωΔt ≥ 2`.
+    Explicit,
+    /// Every spring group implicit: energy-conserving at any stiffness.
+    Implicit,
+}
+
+impl SpringSolver {
+    /// Every setting, in declaration order.
+    pub const ALL: [SpringSolver; 3] = [
+        SpringSolver::Auto,
+        SpringSolver::Explicit,
+        SpringSolver::Implicit,
+    ];
+
+    /// The name used in scene files and on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            SpringSolver::Auto => "auto",
+            SpringSolver::Explicit => "explicit",
+            SpringSolver::Implicit => "implicit",
+        }
+    }
+}
+
+impl std::fmt::Display for SpringSolver {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for SpringSolver {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        SpringSolver::ALL
+            .into_iter()
+            .find(|m| m.name() == s)
+            .ok_or_else(|| "expected one of `auto`, `explicit`, `implicit`".to_owned())
+    }
+}
+
+/// Marks a spring stepped by the implicit step.
+#[derive(Component, Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct ImplicitSpring;
+
+/// Marks a body of a spring group stepped by the implicit step.
+#[derive(Component, Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct ImplicitBody;
+
+/// What the classification was made for; a change re-classifies.
+#[derive(Resource, Debug, Clone, Copy, PartialEq)]
+pub struct SpringClassification {
+    dt: Real,
+    solver: SpringSolver,
+    springs: usize,
+}
+
+/// Number of spring entities, from the archetypes (no query state needed).
+fn spring_count(world: &World) -> usize {
+    let Some(id) = world.component_id::<Spring>() else {
+        return 0;
+    };
+    world
+        .archetypes()
+        .iter()
+        .filter(|a| a.contains(id))
+        .map(|a| a.len() as usize)
+        .sum()
+}
+
+/// True when [`classify_springs`] must run again: the time step, the setting or the number of
+/// springs changed since it last ran.
+pub fn classification_is_stale(world: &World) -> bool {
+    let settings = world
+        .get_resource::<PhysicsSettings>()
+        .copied()
+        .unwrap_or_default();
+    let springs = spring_count(world);
+    match world.get_resource::<SpringClassification>() {
+        None => springs > 0,
+        Some(c) => c.dt != settings.dt() || c.solver != settings.springs || c.springs != springs,
+    }
+}
+
+fn find(parent: &mut [usize], mut i: usize) -> usize {
+    while parent[i] != i {
+        parent[i] = parent[parent[i]];
+        i = parent[i];
+    }
+    i
+}
+
+/// Decides which spring groups are stepped implicitly and marks them (see the module docs).
+pub fn classify_springs(world: &mut World) {
+    let settings = world
+        .get_resource::<PhysicsSettings>()
+        .copied()
+        .unwrap_or_default();
+    let dt = settings.dt();
+    let springs: Vec<(Entity, Spring)> = world
+        .query::<(Entity, &Spring)>()
+        .iter(world)
+        .map(|(e, s)| (e, *s))
+        .collect();
+    let mut dynamic = world.query_filtered::<(Entity, &MassProps), Dynamic>();
+    let mut index = EntityHashMap::default();
+    let mut masses = Vec::new();
+    for (entity, mass) in dynamic.iter(world) {
+        index.insert(entity, masses.len());
+        masses.push(*mass);
+    }
+    let mut parent: Vec<usize> = (0..masses.len()).collect();
+    let mut stiff_group = vec![false; masses.len()];
+    let mut spring_root = Vec::with_capacity(springs.len());
+    for (_, spring) in &springs {
+        let a = index.get(&spring.a).copied();
+        let b = match spring.b {
+            SpringEnd::Body { body, .. } => index.get(&body).copied(),
+            SpringEnd::World(_) => None,
+        };
+        let bound = |end: Option<usize>, anchor| {
+            end.map_or(0.0, |i| inverse_effective_mass_bound(&masses[i], anchor))
+        };
+        let anchor_b = match spring.b {
+            SpringEnd::Body { anchor, .. } => anchor,
+            SpringEnd::World(_) => tumble_core::math::Vec3::ZERO,
+        };
+        let omega_dt = omega_dt_bound(
+            spring.stiffness,
+            [bound(a, spring.anchor_a), bound(b, anchor_b)],
+            dt,
+        );
+        let stiff = match settings.springs {
+            SpringSolver::Auto => omega_dt >= IMPLICIT_OMEGA_DT,
+            SpringSolver::Implicit => true,
+            SpringSolver::Explicit => false,
+        };
+        let root = match (a, b) {
+            (Some(i), Some(j)) => {
+                let (ri, rj) = (find(&mut parent, i), find(&mut parent, j));
+                let merged = stiff_group[ri] || stiff_group[rj];
+                parent[ri] = rj;
+                stiff_group[rj] = merged;
+                Some(rj)
+            }
+            (Some(i), None) | (None, Some(i)) => Some(find(&mut parent, i)),
+            (None, None) => None,
+        };
+        if let Some(r) = root {
+            stiff_group[r] |= stiff;
+        }
+        spring_root.push(root);
+    }
+    let mut implicit_spring = Vec::with_capacity(springs.len());
+    for root in spring_root {
+        let stiff = root.is_some_and(|r| {
+            let r = find(&mut parent, r);
+            stiff_group[r]
+        });
+        implicit_spring.push(stiff);
+    }
+    let mut implicit_body = vec![false; masses.len()];
+    for (i, flag) in implicit_body.iter_mut().enumerate() {
+        let r = find(&mut parent, i);
+        *flag = stiff_group[r];
+    }
+    for ((entity, _), stiff) in springs.iter().zip(implicit_spring) {
+        let has = world.get::<ImplicitSpring>(*entity).is_some();
+        if stiff && !has {
+            world.entity_mut(*entity).insert(ImplicitSpring);
+        } else if !stiff && has {
+            world.entity_mut(*entity).remove::<ImplicitSpring>();
+        }
+    }
+    let bodies: Vec<Entity> = world
+        .query_filtered::<Entity, With<RigidBody>>()
+        .iter(world)
+        .collect();
+    for entity in bodies {
+        let stiff = index.get(&entity).is_some_and(|&i| implicit_body[i]);
+        let has = world.get::<ImplicitBody>(entity).is_some();
+        if stiff && !has {
+            world.entity_mut(entity).insert(ImplicitBody);
+        } else if !stiff && has {
+            world.entity_mut(entity).remove::<ImplicitBody>();
+        }
+    }
+    let springs = spring_count(world);
+    world.insert_resource(SpringClassification {
+        dt,
+        solver: settings.springs,
+        springs,
+    });
+}
+
+/// Scratch memory of [`solve_implicit_springs`], kept between steps.
+#[derive(Default)]
+pub struct ImplicitScratch {
+    solver: ImplicitSpringSolver,
+    index: EntityHashMap<usize>,
+    entities: Vec<Entity>,
+    parent: Vec<usize>,
+    group_of: Vec<usize>,
+    bodies: Vec<GroupBody>,
+    springs: Vec<GroupSpring>,
+    /// Per body of the current group, its index among all implicit bodies.
+    members: Vec<usize>,
+    local: Vec<usize>,
+    /// Every implicit body of the world, in query order.
+    all: Vec<GroupBody>,
+}
+
+/// Steps every implicit spring group with the energy-conserving implicit step (see
+/// [`tumble_core::springs::implicit`]), consuming the bodies' accumulators. A group whose solve
+/// fails keeps its state and is quarantined.
+pub fn solve_implicit_springs(
+    settings: Res<PhysicsSettings>,
+    mut scratch: Local<ImplicitScratch>,
+    mut commands: Commands,
+    springs: Query<&Spring, With<ImplicitSpring>>,
+    mut bodies: Query<
+        (
+            Entity,
+            &mut Transform,
+            &mut Velocity,
+            &MassProps,
+            &mut ForceAccumulator,
+        ),
+        (Dynamic, With<ImplicitBody>),
+    >,
+    others: Query<&Transform, (With<RigidBody>, Without<ImplicitBody>)>,
+) {
+    let s = &mut *scratch;
+    s.index.clear();
+    s.entities.clear();
+    s.parent.clear();
+    s.all.clear();
+    for (entity, t, v, m, mut acc) in &mut bodies {
+        s.index.insert(entity, s.entities.len());
+        s.parent.push(s.entities.len());
+        s.entities.push(entity);
+        s.all.push(GroupBody {
+            state: body_state(&t, &v, m),
+            mass: m.0,
+            load: acc.take(),
+        });
+    }
+    let end_index = |index: &EntityHashMap<usize>, spring: &Spring| {
+        let a = index.get(&spring.a).copied();
+        let b = match spring.b {
+            SpringEnd::Body { body, .. } => index.get(&body).copied(),
+            SpringEnd::World(_) => None,
+        };
+        (a, b)
+    };
+    for spring in &springs {
+        if let (Some(i), Some(j)) = end_index(&s.index, spring) {
+            let (ri, rj) = (find(&mut s.parent, i), find(&mut s.parent, j));
+            s.parent[ri] = rj;
+        }
+    }
+    s.group_of.clear();
+    for i in 0..s.entities.len() {
+        let r = find(&mut s.parent, i);
+        s.group_of.push(r);
+    }
+    s.local.clear();
+    s.local.resize(s.entities.len(), usize::MAX);
+    let dt = settings.dt();
+    // Groups in order of their first member (query order: deterministic).
+    for root in 0..s.entities.len() {
+        if s.group_of[root] != root {
+            continue;
+        }
+        s.members.clear();
+        s.bodies.clear();
+        for i in 0..s.entities.len() {
+            if s.group_of[i] == root {
+                s.local[i] = s.members.len();
+                s.members.push(i);
+                s.bodies.push(s.all[i]);
+            }
+        }
+        s.springs.clear();
+        for spring in &springs {
+            let (a, b) = end_index(&s.index, spring);
+            // Orient each spring so that its first end is a member of this group.
+            let (first, anchor_first, second) = match (a, b, spring.b) {
+                (Some(i), _, _) if s.group_of[i] == root => (i, spring.anchor_a, spring.b),
+                (_, Some(j), SpringEnd::Body { anchor, .. }) if s.group_of[j] == root => {
+                    (j, anchor, SpringEnd::Body {
+                        body: spring.a,
+                        anchor: spring.anchor_a,
+                    })
+                }
+                _ => continue,
+            };
+            let end = match second {
+                SpringEnd::World(p) => LinkEnd::Fixed(p),
+                SpringEnd::Body { body, anchor } => match s.index.get(&body) {
+                    Some(&k) => LinkEnd::Body {
+                        index: s.local[k],
+                        anchor,
+                    },
+                    None => match others.get(body) {
+                        // A static, kinematic or quarantined body holds its anchor still.
+                        Ok(t) => LinkEnd::Fixed(t.transform_point(anchor)),
+                        Err(_) => continue,
+                    },
+                },
+            };
+            s.springs.push(GroupSpring {
+                a: s.local[first],
+                anchor_a: anchor_first,
+                b: end,
+                stiffness: spring.stiffness,
+                rest_length: spring.rest_length,
+            });
+        }
+        match s.solver.step(&mut s.bodies, &s.springs, dt) {
+            Ok(_) => {
+                for (k, &i) in s.members.iter().enumerate() {
+                    if let Ok((_, mut t, mut v, m, _)) = bodies.get_mut(s.entities[i]) {
+                        write_body_state(&s.bodies[k].state, m, &mut t, &mut v);
+                    }
+                }
+            }
+            Err(error) => {
+                for &i in &s.members {
+                    reject(
+                        &mut commands,
+                        BodyError {
+                            entity: s.entities[i],
+                            kind: BodyErrorKind::ImplicitSprings(error),
+                        },
+                    );
+                }
+            }
+        }
+    }
+}

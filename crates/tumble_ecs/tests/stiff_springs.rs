@@ -1,0 +1,185 @@
+//! Stiff springs through the whole step (default settings): a two-body spring and a chain of
+//! asymmetric bodies at off-centre anchors keep their total energy at every `ωΔt` from 0.5 to
+//! 100, without numerical damping; the choice of method is the planner's, and can be forced.
+
+use bevy_ecs::prelude::*;
+use tumble_core::math::{Quat, Real, Vec3};
+use tumble_core::{Mass, MassProperties};
+use tumble_ecs::components::kinetic_energy_f64;
+use tumble_ecs::prelude::*;
+
+const DT: Real = 1.0 / 60.0;
+
+fn body(world: &mut World, position: Vec3, rotation: Quat, inertia: Vec3, v: Vec3, w: Vec3) -> Entity {
+    let mass = MassProperties::new(Mass::new(1.0).unwrap(), inertia).unwrap();
+    world
+        .spawn((
+            RigidBody,
+            MassProps(mass),
+            Transform {
+                translation: position,
+                rotation,
+            },
+            Velocity {
+                linear: v,
+                angular: w,
+            },
+        ))
+        .id()
+}
+
+/// Kinetic + elastic energy (J).
+fn energy(world: &mut World) -> f64 {
+    let mut bodies = world.query::<(&Transform, &Velocity, &MassProps)>();
+    let kinetic: f64 = bodies
+        .iter(world)
+        .map(|(t, v, m)| kinetic_energy_f64(t, v, m))
+        .sum();
+    let springs: Vec<Spring> = world.query::<&Spring>().iter(world).copied().collect();
+    let mut poses = world.query::<&Transform>();
+    let elastic: f64 = springs
+        .iter()
+        .map(|s| {
+            let pa = poses.get(world, s.a).unwrap().transform_point(s.anchor_a);
+            let pb = match s.b {
+                SpringEnd::World(p) => p,
+                SpringEnd::Body { body, anchor } => {
+                    poses.get(world, body).unwrap().transform_point(anchor)
+                }
+            };
+            s.elastic_energy(pa, pb)
+        })
+        .sum();
+    kinetic + elastic
+}
+
+/// Two unit masses (asymmetric, off-centre anchors), stiffness from the nominal
+/// `√(k/μ)Δt = omega_dt` with `μ = ½`, stretched 20 % past the rest length and spinning.
+fn two_bodies(world: &mut World, omega_dt: Real) {
+    let inertia = Vec3::new(0.02, 0.03, 0.04);
+    let a = body(world, Vec3::ZERO, Quat::IDENTITY, inertia, Vec3::ZERO, Vec3::new(0.3, 0.2, 0.1));
+    let b = body(
+        world,
+        Vec3::new(1.2, 0.0, 0.0),
+        Quat::from_rotation_z(0.2),
+        inertia,
+        Vec3::new(0.0, 0.1, 0.0),
+        Vec3::new(-0.1, 0.0, 0.4),
+    );
+    world.spawn(Spring {
+        a,
+        anchor_a: Vec3::new(0.1, 0.05, 0.0),
+        b: SpringEnd::Body {
+            body: b,
+            anchor: Vec3::new(-0.1, 0.0, 0.05),
+        },
+        stiffness: 0.5 * (omega_dt / DT).powi(2),
+        damping: 0.0,
+        rest_length: 0.8,
+    });
+}
+
+/// A chain of `n` asymmetric bodies at off-centre anchors, the first tied to the world, each
+/// spring stretched 10 %.
+fn chain(world: &mut World, n: usize, omega_dt: Real) {
+    let inertia = Vec3::new(0.02, 0.03, 0.04);
+    let k = 0.5 * (omega_dt / DT).powi(2);
+    let bodies: Vec<Entity> = (0..n)
+        .map(|i| {
+            let x = i as Real;
+            body(
+                world,
+                Vec3::new(x, 0.02 * x, 0.0),
+                Quat::from_rotation_z(0.1 * x),
+                inertia,
+                Vec3::new(0.0, 0.05, 0.0),
+                Vec3::new(0.2, -0.1, 0.3),
+            )
+        })
+        .collect();
+    world.spawn(Spring {
+        a: bodies[0],
+        anchor_a: Vec3::new(-0.1, 0.05, 0.0),
+        b: SpringEnd::World(Vec3::new(-1.0, 0.0, 0.0)),
+        stiffness: k,
+        damping: 0.0,
+        rest_length: 0.8,
+    });
+    for pair in bodies.windows(2) {
+        world.spawn(Spring {
+            a: pair[0],
+            anchor_a: Vec3::new(0.1, 0.05, 0.0),
+            b: SpringEnd::Body {
+                body: pair[1],
+                anchor: Vec3::new(-0.1, -0.05, 0.02),
+            },
+            stiffness: k,
+            damping: 0.0,
+            rest_length: 0.72,
+        });
+    }
+}
+
+/// Runs `steps` steps with default settings; returns (max |E − E₀|/E₀, final (E − E₀)/E₀, plan).
+fn run(build: impl Fn(&mut World), steps: usize) -> (f64, f64, String) {
+    let mut world = World::new();
+    world.insert_resource(Parallelism::SINGLE_THREAD);
+    build(&mut world);
+    let e0 = energy(&mut world);
+    let mut physics = PhysicsRunner::new(&mut world);
+    let mut worst: f64 = 0.0;
+    let mut last = 0.0;
+    for _ in 0..steps {
+        physics.step(&mut world);
+        let e = energy(&mut world);
+        assert!(e.is_finite());
+        last = (e - e0) / e0;
+        worst = worst.max(last.abs());
+    }
+    let errors = world.get_resource::<PhysicsErrors>().map(|e| e.0.clone());
+    assert!(errors.as_ref().is_none_or(Vec::is_empty), "{errors:?}");
+    for t in world.query::<&Transform>().iter(&world) {
+        assert!((t.rotation.length() - 1.0).abs() < 1e-5);
+    }
+    (worst, last, physics.plan().to_string())
+}
+
+/// The bound: energy within 5 % at every step and at the end, at every `ωΔt`.
+#[test]
+fn stiff_springs_keep_their_energy_at_every_omega_dt() {
+    for omega_dt in [0.5, 1.0, 2.0, 5.0, 10.0, 30.0, 100.0] {
+        // Fewer steps where each step needs many Newton iterations (debug build).
+        let steps = if omega_dt >= 30.0 { 60 } else { 300 };
+        for (name, n) in [("two bodies", 0), ("chain", 6)] {
+            let (worst, last, plan) = if n == 0 {
+                run(|w| two_bodies(w, omega_dt), steps)
+            } else {
+                run(|w| chain(w, n, omega_dt), steps)
+            };
+            eprintln!("{name} ωΔt {omega_dt}: max {worst:.2e}, final {last:.2e}, plan {plan}");
+            assert!(plan.contains("solve_implicit_springs"), "{name} ωΔt {omega_dt}: {plan}");
+            assert!(worst <= 0.05 && last.abs() <= 0.05, "{name} ωΔt {omega_dt}: {worst} {last}");
+        }
+    }
+}
+
+/// Soft springs stay on the explicit path (they pay nothing), `explicit` forces it and is then
+/// predicted unstable where it is, and `implicit` forces the implicit step.
+#[test]
+fn the_planner_picks_the_spring_method_and_can_be_overridden() {
+    let plan = |omega_dt: Real, springs: SpringSolver| {
+        let mut world = World::new();
+        world.insert_resource(PhysicsSettings::default().with_springs(springs));
+        two_bodies(&mut world, omega_dt);
+        let plan = PhysicsPlan::for_world(&mut world);
+        let warned = check_stability(&mut world)
+            .iter()
+            .any(|w| matches!(w, StabilityWarning::StiffSpring { .. }));
+        (plan.contains(Stage::SolveImplicitSprings), plan.contains(Stage::Springs), warned)
+    };
+    // The soft spring: nominal 0.05, with the lever arms still below the threshold.
+    assert_eq!(plan(0.05, SpringSolver::Auto), (false, true, false));
+    assert_eq!(plan(0.05, SpringSolver::Implicit), (true, true, false));
+    assert_eq!(plan(5.0, SpringSolver::Auto), (true, true, false));
+    assert_eq!(plan(5.0, SpringSolver::Explicit), (false, true, true));
+}
