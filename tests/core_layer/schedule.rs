@@ -245,6 +245,19 @@ fn a_world_needing_everything_plans_every_stage_in_order() {
         body: pulled,
         torque: Vec3::Y,
     });
+    // A spring far too stiff for the step: its group takes the implicit step.
+    let stiff = [world.spawn(RigidBody).id(), world.spawn(RigidBody).id()];
+    world.spawn(Spring {
+        a: stiff[0],
+        anchor_a: Vec3::ZERO,
+        b: SpringEnd::Body {
+            body: stiff[1],
+            anchor: Vec3::ZERO,
+        },
+        stiffness: 1e8,
+        damping: 0.0,
+        rest_length: 1.0,
+    });
     let plan = PhysicsPlan::for_world(&mut world);
     assert_eq!(plan.stages(), &Stage::ALL[..]);
     assert_eq!(Stage::ALL.len(), Stage::COUNT);

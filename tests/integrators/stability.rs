@@ -6,11 +6,15 @@ use tumble::math::{Real, Vec3};
 
 use tumble::prelude::*;
 
-fn spring_world(omega_dt: Real, integrator: Integrator) -> (World, Entity) {
+fn spring_world(omega_dt: Real, integrator: Integrator, springs: SpringSolver) -> (World, Entity) {
     let (dt, m) = (1.0 / 60.0 as Real, 2.0 as Real);
     let k = m * (omega_dt / dt).powi(2);
     let mut world = World::new();
-    world.insert_resource(PhysicsSettings::new(dt, integrator).unwrap());
+    world.insert_resource(
+        PhysicsSettings::new(dt, integrator)
+            .unwrap()
+            .with_springs(springs),
+    );
     let body = world
         .spawn((
             RigidBody,
@@ -49,7 +53,7 @@ fn spring_warning_matches_divergence() {
         Integrator::Lclamp,
     ] {
         for omega_dt in [0.5 as Real, 1.5, 1.95, 2.05, 2.5] {
-            let (mut world, body) = spring_world(omega_dt, integrator);
+            let (mut world, body) = spring_world(omega_dt, integrator, SpringSolver::Explicit);
             let warned = check_stability(&mut world)
                 .iter()
                 .any(|w| matches!(w, StabilityWarning::StiffSpring { .. }));
@@ -59,6 +63,13 @@ fn spring_warning_matches_divergence() {
                 "{integrator} at ωΔt = {omega_dt}: warned {warned}, diverged {blew_up}"
             );
             assert_eq!(warned, omega_dt >= 2.0);
+            // By default the stiff ones take the implicit step: no warning, no divergence.
+            let (mut world, body) = spring_world(omega_dt, integrator, SpringSolver::Auto);
+            assert!(check_stability(&mut world).is_empty());
+            assert!(
+                !diverges(&mut world, body, 2000),
+                "{integrator} at ωΔt = {omega_dt}"
+            );
         }
     }
 }

@@ -95,6 +95,10 @@ pub struct RunArgs {
     /// Override the integrator.
     #[arg(long)]
     pub integrator: Option<OsString>,
+    /// Override how springs are stepped: `auto` (implicit for stiff spring groups), `explicit`
+    /// or `implicit`.
+    #[arg(long)]
+    pub springs: Option<OsString>,
     /// Write the trajectory to this CSV file, `-` for stdout (the summary then goes to stderr).
     #[arg(long)]
     pub out: Option<PathBuf>,

@@ -33,11 +33,18 @@ const VALUE_BYTES: u64 = if size_of::<Real>() == 4 { 16 } else { 25 };
 
 /// Names the command-line flag behind an error in an overridden world setting, so the message
 /// does not point at a line of a file the user never wrote.
-fn override_error(e: SceneError, dt: Option<f64>, steps: Option<u64>, integrator: bool) -> Failure {
+fn override_error(
+    e: SceneError,
+    dt: Option<f64>,
+    steps: Option<u64>,
+    integrator: bool,
+    springs: bool,
+) -> Failure {
     let flag = match e.field.as_str() {
         "world.dt" if dt.is_some() => "--dt",
         "world.steps" if steps.is_some() => "--steps",
         "world.integrator" if integrator => "--integrator",
+        "world.springs" if springs => "--springs",
         _ => return e.into(),
     };
     Failure::new(exit::ERROR, format!("{flag}: {}", e.message))
@@ -67,18 +74,24 @@ pub fn run(args: RunArgs) -> Result<(), Failure> {
         .integrator
         .map(|v| crate::utf8("--integrator", v))
         .transpose()?;
+    let springs = args
+        .springs
+        .map(|v| crate::utf8("--springs", v))
+        .transpose()?;
     let loaded = crate::load(&args.scene)?;
     let mut scene = Scene::parse(&loaded.file, &loaded.text)?;
-    if steps.is_some() || args.dt.is_some() || integrator.is_some() {
+    if steps.is_some() || args.dt.is_some() || integrator.is_some() || springs.is_some() {
         // Overrides are applied to the file model, then validated like the file itself.
         let mut model = scene.file().clone();
         model.world.steps = steps.unwrap_or(model.world.steps);
         model.world.dt = args.dt.unwrap_or(model.world.dt);
         let overridden = integrator.is_some();
         model.world.integrator = integrator.or(model.world.integrator);
+        let springs_overridden = springs.is_some();
+        model.world.springs = springs.or(model.world.springs);
         let text = tumble_scene::to_toml_string(&model)?;
         scene = Scene::parse(&loaded.file, &text)
-            .map_err(|e| override_error(e, args.dt, steps, overridden))?;
+            .map_err(|e| override_error(e, args.dt, steps, overridden, springs_overridden))?;
     }
     let mut built = scene.build();
     if args.plan {

@@ -153,8 +153,18 @@ fn non_utf8_arguments_are_named_and_non_utf8_paths_work() {
 
 #[test]
 fn warnings_reach_stderr_and_follow_rust_log_and_the_flags() {
-    // √(k/μ)Δt ≈ 9 for this chain: the planner warns before the run.
-    let args = ["run", "spring_chain", "--dt", "0.2", "--steps", "3"];
+    // √(k/μ)Δt ≈ 9 for this chain: with the explicit spring step the planner warns before the
+    // run (by default the implicit step takes such a chain, see below).
+    let args = [
+        "run",
+        "spring_chain",
+        "--dt",
+        "0.2",
+        "--steps",
+        "3",
+        "--springs",
+        "explicit",
+    ];
     let output = tumble().args(args).output().unwrap();
     let text = stderr(&output);
     assert!(
@@ -185,6 +195,8 @@ fn a_rejected_body_exits_3_and_its_rows_stop() {
             "0.2",
             "--steps",
             "50",
+            "--springs",
+            "explicit",
             "--allow-unstable",
             "--out",
         ])
@@ -222,7 +234,15 @@ fn a_predicted_divergence_is_refused_with_exit_4_unless_allowed() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("chain.csv");
     let output = tumble()
-        .args(["run", "spring_chain", "--dt", "0.2", "--out"])
+        .args([
+            "run",
+            "spring_chain",
+            "--dt",
+            "0.2",
+            "--springs",
+            "explicit",
+            "--out",
+        ])
         .arg(&out)
         .output()
         .unwrap();
@@ -244,6 +264,8 @@ fn a_predicted_divergence_is_refused_with_exit_4_unless_allowed() {
             "0.2",
             "--steps",
             "5",
+            "--springs",
+            "explicit",
             "--allow-unstable",
         ])
         .output()
@@ -254,6 +276,27 @@ fn a_predicted_divergence_is_refused_with_exit_4_unless_allowed() {
         text.contains("body `m1` quarantined at step 1: energy grew")
             && text.contains("it keeps its last valid state: position [1.2"),
         "{text}"
+    );
+}
+
+/// By default the same chain at the same step takes the implicit spring step: no warning, no
+/// quarantine, exit 0, and (undamped but for its dampers) its energy does not grow.
+#[test]
+fn by_default_a_stiff_chain_runs_on_the_implicit_step() {
+    let output = tumble()
+        .args(["run", "spring_chain", "--dt", "0.2", "--steps", "200"])
+        .output()
+        .unwrap();
+    assert!(output.status.success(), "{}", stderr(&output));
+    assert!(!stderr(&output).contains("WARN"), "{}", stderr(&output));
+    let plan = tumble()
+        .args(["run", "spring_chain", "--dt", "0.2", "--plan"])
+        .output()
+        .unwrap();
+    assert!(
+        String::from_utf8_lossy(&plan.stdout).contains("solve_implicit_springs"),
+        "{}",
+        String::from_utf8_lossy(&plan.stdout)
     );
 }
 

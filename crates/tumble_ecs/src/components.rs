@@ -1,7 +1,7 @@
 //! Components and resources: the whole public data model of a tumble world.
 
-use bevy_ecs::prelude::*;
 use crate::stiff::SpringSolver;
+use bevy_ecs::prelude::*;
 use tumble_core::math::{Quat, Real, Vec3, Widen};
 
 use tumble_core::{BodyState, Integrator, InvalidInput, MassProperties};

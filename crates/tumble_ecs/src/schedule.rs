@@ -32,7 +32,7 @@ use crate::forces::{
     ConstantForce, ConstantTorque, Spring, apply_constant_forces, apply_constant_torques,
     apply_gravity, apply_springs,
 };
-use crate::stiff::{ImplicitBody, solve_implicit_springs};
+use crate::stiff::{ImplicitBody, ImplicitSpring, solve_implicit_springs};
 use crate::systems::{
     HalfDrifted, begin_step, discard_fixed_body_forces, integrate_with_forces,
     integrate_without_forces,
@@ -154,6 +154,8 @@ struct Contents {
     constant_forces: bool,
     constant_torques: bool,
     springs: bool,
+    /// Springs the explicit path applies (not marked implicit).
+    explicit_springs: bool,
     implicit_bodies: bool,
 }
 
@@ -171,22 +173,25 @@ impl Contents {
         let torque = world.component_id::<ConstantTorque>();
         let spring = world.component_id::<Spring>();
         let implicit = world.component_id::<ImplicitBody>();
+        let implicit_spring = world.component_id::<ImplicitSpring>();
         let mut out = Contents::default();
         for archetype in world.archetypes().iter().filter(|a| !a.is_empty()) {
             let has = |c: Option<ComponentId>| c.is_some_and(|c| archetype.contains(c));
             if has(body) {
                 let is_fixed = fixed.iter().any(|&c| has(c));
                 out.implicit_bodies |= !is_fixed && has(implicit);
-                match (is_fixed, has(acc)) {
+                // Implicit bodies take their whole step in `solve_implicit_springs`.
+                match (is_fixed || has(implicit), has(acc)) {
                     (false, true) => out.dynamic_with_accumulator = true,
                     (false, false) => out.dynamic_without_accumulator = true,
-                    (true, true) => out.fixed_with_accumulator = true,
-                    (true, false) => {}
+                    (true, true) if is_fixed => out.fixed_with_accumulator = true,
+                    (true, _) => {}
                 }
             }
             out.constant_forces |= has(force);
             out.constant_torques |= has(torque);
             out.springs |= has(spring);
+            out.explicit_springs |= has(spring) && !has(implicit_spring);
         }
         out
     }
@@ -218,7 +223,8 @@ impl PhysicsPlan {
             .integrator;
         let midpoint = integrator.samples_forces_at_midpoint();
         let c = Contents::of(world);
-        let dynamic = c.dynamic_with_accumulator || c.dynamic_without_accumulator;
+        let dynamic =
+            c.dynamic_with_accumulator || c.dynamic_without_accumulator || c.implicit_bodies;
         let audit = dynamic
             && world
                 .get_resource::<EnergyAudit>()
@@ -232,7 +238,8 @@ impl PhysicsPlan {
         if midpoint && c.dynamic_with_accumulator {
             stages.push(Stage::BeginStep);
         }
-        if world.contains_resource::<Gravity>() && c.dynamic_with_accumulator {
+        if world.contains_resource::<Gravity>() && (c.dynamic_with_accumulator || c.implicit_bodies)
+        {
             stages.push(Stage::Gravity);
         }
         if c.constant_forces {
@@ -241,10 +248,10 @@ impl PhysicsPlan {
         if c.constant_torques {
             stages.push(Stage::ConstantTorques);
         }
-        if c.springs {
+        if c.explicit_springs {
             stages.push(Stage::Springs);
         }
-        if audit && c.dynamic_with_accumulator {
+        if audit && (c.dynamic_with_accumulator || c.implicit_bodies) {
             stages.push(Stage::AuditExternalLoads);
         }
         if c.implicit_bodies {

@@ -144,11 +144,17 @@ fn nutation_factor(inertia: Vec3) -> Real {
 }
 
 /// Checks the world's springs and spins against the selected integrator's stable region.
+/// Springs stepped implicitly (see [`crate::stiff`]; classified here if needed) are never
+/// reported: the implicit step is stable at any stiffness.
 pub fn check_stability(world: &mut World) -> Vec<StabilityWarning> {
     let Some(settings) = world.get_resource::<PhysicsSettings>().copied() else {
         return Vec::new();
     };
     let dt = settings.dt();
+    // Springs the implicit step takes are stable at any ωΔt: classify first.
+    if crate::stiff::classification_is_stale(world) {
+        crate::stiff::classify_springs(world);
+    }
     let mut warnings = Vec::new();
     let springs: Vec<(Entity, Spring)> = world
         .query_filtered::<(Entity, &Spring), Without<crate::stiff::ImplicitSpring>>()

@@ -336,12 +336,14 @@ pub fn solve_implicit_springs(
             // Orient each spring so that its first end is a member of this group.
             let (first, anchor_first, second) = match (a, b, spring.b) {
                 (Some(i), _, _) if s.group_of[i] == root => (i, spring.anchor_a, spring.b),
-                (_, Some(j), SpringEnd::Body { anchor, .. }) if s.group_of[j] == root => {
-                    (j, anchor, SpringEnd::Body {
+                (_, Some(j), SpringEnd::Body { anchor, .. }) if s.group_of[j] == root => (
+                    j,
+                    anchor,
+                    SpringEnd::Body {
                         body: spring.a,
                         anchor: spring.anchor_a,
-                    })
-                }
+                    },
+                ),
                 _ => continue,
             };
             let end = match second {

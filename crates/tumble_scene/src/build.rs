@@ -171,8 +171,15 @@ impl Scene {
                     })?
             }
         };
+        let springs = match &w.springs {
+            None => SpringSolver::default(),
+            Some(name) => name
+                .parse()
+                .map_err(|e: String| ck.error("world", None, "springs", e))?,
+        };
         let settings = PhysicsSettings::new(dt, integrator)
-            .map_err(|e| ck.error("world", None, "dt", e.to_string()))?;
+            .map_err(|e| ck.error("world", None, "dt", e.to_string()))?
+            .with_springs(springs);
         if let Some(why) = bad_text(&parsed.name) {
             return Err(ck.top_error("name", why));
         }

@@ -32,6 +32,10 @@ pub struct WorldDef {
     /// Integrator name (default: `splitting`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub integrator: Option<String>,
+    /// How springs are stepped: `auto` (default: implicit for the groups that are stiff for
+    /// `dt`), `explicit` or `implicit`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub springs: Option<String>,
     /// Uniform gravity; absent means no gravity system at all.
     #[serde(
         default,

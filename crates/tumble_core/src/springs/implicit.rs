@@ -318,7 +318,8 @@ impl ImplicitSpringSolver {
         self.z.clear();
         for s in &self.starts {
             let omega = s.free * (s.pi / s.inertia.max(DVec3::splat(f64::MIN_POSITIVE)));
-            self.z.extend_from_slice(&[s.v.x, s.v.y, s.v.z, omega.x, omega.y, omega.z]);
+            self.z
+                .extend_from_slice(&[s.v.x, s.v.y, s.v.z, omega.x, omega.y, omega.z]);
         }
         for buffer in [
             &mut self.residual,
@@ -420,7 +421,9 @@ impl ImplicitSpringSolver {
         self.starts.clear();
         for body in bodies {
             let m = &body.mass;
-            let q = (body.state.rotation * m.principal_frame()).widen().normalize();
+            let q = (body.state.rotation * m.principal_frame())
+                .widen()
+                .normalize();
             let inertia = m.principal_inertia().widen();
             let free = DVec3::select(inertia.cmpgt(DVec3::ZERO), DVec3::ONE, DVec3::ZERO);
             let omega = q.inverse() * body.state.angular_velocity.widen();
@@ -548,11 +551,7 @@ impl ImplicitSpringSolver {
             let iw = s.inertia * wbar;
             let rot = iw - s.pi + 0.5 * h * wbar.cross(iw) - 0.5 * h * torque;
             // A locked axis has no equation of motion: its row pins Ω̄ to 0.
-            let rot = DVec3::select(
-                s.free.cmpgt(DVec3::ZERO),
-                rot,
-                s.lock_scale * v3(&z[3..]),
-            );
+            let rot = DVec3::select(s.free.cmpgt(DVec3::ZERO), rot, s.lock_scale * v3(&z[3..]));
             put(&mut r[3..], rot);
         }
         for (link, lin) in self.links.iter().zip(self.lin.iter_mut()) {
@@ -688,7 +687,9 @@ impl ImplicitSpringSolver {
                 let term = -0.25
                     * h
                     * h
-                    * (skew(s.r.transpose() * f) * self.cayley_derivative[end.body] * skew(lin.b[e]));
+                    * (skew(s.r.transpose() * f)
+                        * self.cayley_derivative[end.body]
+                        * skew(lin.b[e]));
                 let block = &mut blocks[end.body];
                 for a in 0..3 {
                     for c in 0..3 {

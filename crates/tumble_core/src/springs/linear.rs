@@ -159,7 +159,11 @@ mod tests {
         let mut m = [[0.0; 6]; 6];
         for (i, row) in m.iter_mut().enumerate() {
             for (j, v) in row.iter_mut().enumerate() {
-                *v = if i == j { 4.0 + i as f64 } else { 0.3 * (i as f64 - j as f64) };
+                *v = if i == j {
+                    4.0 + i as f64
+                } else {
+                    0.3 * (i as f64 - j as f64)
+                };
             }
         }
         let inv = invert(&m).unwrap();

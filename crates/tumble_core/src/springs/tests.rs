@@ -22,7 +22,8 @@ fn body(mass: Real, inertia: Vec3, position: Vec3, rotation: Quat, v: Vec3, w: V
 }
 
 fn anchor_world(b: &GroupBody, local: Vec3) -> DVec3 {
-    b.state.position.widen() + b.state.rotation.widen() * (local - b.mass.local_center_of_mass()).widen()
+    b.state.position.widen()
+        + b.state.rotation.widen() * (local - b.mass.local_center_of_mass()).widen()
 }
 
 /// Kinetic + elastic energy (J), in f64.
@@ -109,7 +110,9 @@ fn a_stiff_asymmetric_chain_keeps_its_energy_at_every_omega_dt() {
         let mut newton = 0;
         let mut splits = 0;
         for _ in 0..steps {
-            let stats = solver.step(&mut bodies, &springs, dt).unwrap_or_else(|e| panic!("ωΔt {omega_dt}: {e}"));
+            let stats = solver
+                .step(&mut bodies, &springs, dt)
+                .unwrap_or_else(|e| panic!("ωΔt {omega_dt}: {e}"));
             newton += stats.newton_iterations;
             splits += stats.splits;
             let e = energy(&bodies, &springs);
@@ -119,7 +122,10 @@ fn a_stiff_asymmetric_chain_keeps_its_energy_at_every_omega_dt() {
         // state to `Real` each step, a random walk of `steps` such errors (√steps), with a
         // factor 10 of headroom.
         let bound = 10.0 * (steps as f64).sqrt() * (per_step_rounding() + solver.tolerance);
-        eprintln!("ωΔt {omega_dt}: worst relative energy error {worst:.3e} (bound {bound:.1e}), mean Newton {:.1}, splits {splits}", newton as f64 / steps as f64);
+        eprintln!(
+            "ωΔt {omega_dt}: worst relative energy error {worst:.3e} (bound {bound:.1e}), mean Newton {:.1}, splits {splits}",
+            newton as f64 / steps as f64
+        );
         assert!(worst <= bound, "ωΔt {omega_dt}: {worst:e} > {bound:e}");
         for b in &bodies {
             assert!(b.state.is_valid());
