@@ -371,8 +371,8 @@ impl ImplicitSpringSolver {
             }
             let mut accepted = false;
             for _ in 0..12 {
-                for i in 0..n {
-                    self.trial[i] = self.z[i] + step * delta[i];
+                for ((t, z), d) in self.trial.iter_mut().zip(&self.z).zip(&delta) {
+                    *t = z + step * d;
                 }
                 std::mem::swap(&mut self.z, &mut self.trial);
                 std::mem::swap(&mut self.residual, &mut self.trial_residual);
@@ -608,8 +608,8 @@ impl ImplicitSpringSolver {
         let s = &self.starts[i];
         let w = s.free * v3(&self.z[6 * i + 3..6 * i + 6]);
         let mut block = [[0.0; 6]; 6];
-        for a in 0..3 {
-            block[a][a] = s.mass;
+        for (a, row) in block.iter_mut().take(3).enumerate() {
+            row[a] = s.mass;
         }
         // ∂/∂Ω̄ of I Ω̄ + ½ h Ω̄ × I Ω̄ = I + ½ h ([Ω̄]× I − [I Ω̄]×).
         let inertia = DMat3::from_diagonal(s.inertia);

@@ -125,8 +125,8 @@ impl Krylov {
                 self.s[i] = self.r[i] - alpha * self.v[i];
             }
             if dot(&self.s, &self.s).sqrt() <= target {
-                for i in 0..n {
-                    x[i] += alpha * self.y[i];
+                for (xi, yi) in x.iter_mut().zip(&self.y) {
+                    *xi += alpha * yi;
                 }
                 return iteration;
             }
@@ -138,8 +138,8 @@ impl Krylov {
             } else {
                 0.0
             };
-            for i in 0..n {
-                x[i] += alpha * self.y[i] + omega * self.z[i];
+            for (i, xi) in x.iter_mut().enumerate() {
+                *xi += alpha * self.y[i] + omega * self.z[i];
                 self.r[i] = self.s[i] - omega * self.t[i];
             }
             if dot(&self.r, &self.r).sqrt() <= target || omega == 0.0 {
@@ -168,7 +168,7 @@ mod tests {
         }
         let inv = invert(&m).unwrap();
         for j in 0..6 {
-            let column: Vec<f64> = (0..6).map(|i| inv[i][j]).collect();
+            let column: Vec<f64> = inv.iter().map(|row| row[j]).collect();
             let e = block_mul(&m, &column);
             for (i, v) in e.iter().enumerate() {
                 let want = if i == j { 1.0 } else { 0.0 };
@@ -184,7 +184,7 @@ mod tests {
         let n = 60;
         let apply = |u: &[f64], out: &mut [f64]| {
             for i in 0..n {
-                let left = if i > 0 { -1.0 * u[i - 1] } else { 0.0 };
+                let left = if i > 0 { -u[i - 1] } else { 0.0 };
                 let right = if i + 1 < n { -0.5 * u[i + 1] } else { 0.0 };
                 out[i] = 3.0 * u[i] + left + right;
             }
