@@ -52,6 +52,11 @@ const BUNDLED: &[(&str, &str)] = &[
     ),
     ("far_away", include_str!("../../../scenes/far_away.toml")),
     ("long_run", include_str!("../../../scenes/long_run.toml")),
+    (
+        "stiff_chain",
+        include_str!("../../../scenes/stiff_chain.toml"),
+    ),
+    ("cloth", include_str!("../../../scenes/cloth.toml")),
 ];
 
 fn main() -> ExitCode {

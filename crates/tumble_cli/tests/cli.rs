@@ -133,6 +133,8 @@ fn scenes_lists_the_bundled_scenes_and_plan_prints_the_systems() {
         "spring_chain",
         "thin_rod",
         "long_run",
+        "stiff_chain",
+        "cloth",
     ] {
         assert!(text.contains(name), "{text}");
     }

@@ -50,6 +50,18 @@ fn every_bundled_scene_has_exactly_the_systems_it_needs() {
             "audit_energy_start → audit_external_loads → solve_implicit_springs → audit_energy",
         ),
     ];
+    let expected = expected.into_iter().chain([
+        // Stiff on purpose (√(k/μ)Δt = 10): implicit, and gravity for the cloth.
+        (
+            "stiff_chain",
+            "audit_energy_start → audit_external_loads → solve_implicit_springs → audit_energy",
+        ),
+        (
+            "cloth",
+            "audit_energy_start → apply_gravity → audit_external_loads → solve_implicit_springs → \
+             audit_energy",
+        ),
+    ]);
     for (scene, systems) in expected {
         let (plan, count) = plan_of(scene);
         assert_eq!(plan, systems, "{scene}");

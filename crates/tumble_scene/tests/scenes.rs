@@ -22,7 +22,7 @@ fn bundled_scenes_load_build_and_round_trip() {
         assert_eq!(built.bodies.len(), scene.file().bodies.len());
         count += 1;
     }
-    assert!(count >= 9, "bundled scenes: {count}");
+    assert!(count >= 11, "bundled scenes: {count}");
 }
 
 /// Every file in `tests/bad/` is rejected with the line, field and message listed in

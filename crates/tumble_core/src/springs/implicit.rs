@@ -217,6 +217,8 @@ pub struct ImplicitSpringSolver {
     /// Per body, `(1 − [hΩ̄/2]×)⁻¹`: the derivative of the Cayley rotation (see `evaluate`).
     cayley_derivative: Vec<DMat3>,
     krylov: Krylov,
+    /// The guess [`step`](Self::step) keeps for itself (one group stepped again and again).
+    own_guess: Vec<f64>,
 }
 
 impl Default for ImplicitSpringSolver {
@@ -238,12 +240,19 @@ impl Default for ImplicitSpringSolver {
             cayley: Vec::new(),
             cayley_derivative: Vec::new(),
             krylov: Krylov::default(),
+            own_guess: Vec::new(),
         }
     }
 }
 
 /// Largest change of `h|Ω̄|` (rad) of any body in one Newton iteration.
 const MAX_TURN: f64 = 0.5;
+
+/// A Newton iteration whose accepted step length is below this fraction of the full update…
+const STAGNANT_STEP: f64 = 0.02;
+
+/// …and that lowers the residual norm by less than this fraction counts as stagnating.
+const STAGNANT_DECREASE: f64 = 0.01;
 
 /// The Cayley rotation `cay(w)` as a unit quaternion: `(w/2, 1)` normalized.
 #[inline]
@@ -282,8 +291,29 @@ impl ImplicitSpringSolver {
         springs: &[GroupSpring],
         dt: Real,
     ) -> Result<SolveStats, ImplicitSpringError> {
+        let mut guess = std::mem::take(&mut self.own_guess);
+        guess.clear();
+        let result = self.step_from(bodies, springs, dt, &mut guess);
+        self.own_guess = guess;
+        result
+    }
+
+    /// [`step`](Self::step), with Newton's method also tried from `guess`: the mean velocities
+    /// `(v̄, Ω̄)` (six numbers per body) of an earlier step of the same group, which `step_from`
+    /// replaces with this step's. Along a fast, steady motion the mean velocities change little
+    /// from step to step, so the previous step's are a far better start than the current
+    /// velocities; the start with the smaller residual is taken, so a stale guess costs one
+    /// residual evaluation and nothing else. The result does not depend on the guess beyond
+    /// the solver's tolerance.
+    pub fn step_from(
+        &mut self,
+        bodies: &mut [GroupBody],
+        springs: &[GroupSpring],
+        dt: Real,
+        guess: &mut Vec<f64>,
+    ) -> Result<SolveStats, ImplicitSpringError> {
         let mut stats = SolveStats::default();
-        self.advance(bodies, springs, dt.widen(), 0, &mut stats)?;
+        self.advance(bodies, springs, dt.widen(), 0, guess, &mut stats)?;
         Ok(stats)
     }
 
@@ -293,13 +323,14 @@ impl ImplicitSpringSolver {
         springs: &[GroupSpring],
         h: f64,
         depth: u32,
+        guess: &mut Vec<f64>,
         stats: &mut SolveStats,
     ) -> Result<(), ImplicitSpringError> {
-        match self.solve(bodies, springs, h, stats) {
+        match self.solve(bodies, springs, h, guess, stats) {
             Err(ImplicitSpringError::NotConverged { .. }) if depth < MAX_SPLITS => {
                 stats.splits += 1;
-                self.advance(bodies, springs, 0.5 * h, depth + 1, stats)?;
-                self.advance(bodies, springs, 0.5 * h, depth + 1, stats)
+                self.advance(bodies, springs, 0.5 * h, depth + 1, guess, stats)?;
+                self.advance(bodies, springs, 0.5 * h, depth + 1, guess, stats)
             }
             other => other,
         }
@@ -311,6 +342,7 @@ impl ImplicitSpringSolver {
         bodies: &mut [GroupBody],
         springs: &[GroupSpring],
         h: f64,
+        guess: &mut Vec<f64>,
         stats: &mut SolveStats,
     ) -> Result<(), ImplicitSpringError> {
         self.prepare(bodies, springs)?;
@@ -333,6 +365,16 @@ impl ImplicitSpringSolver {
         }
         let scale = self.energy_scale(h);
         let mut norm = self.evaluate(h);
+        if guess.len() == n && guess.iter().all(|g| g.is_finite()) {
+            std::mem::swap(&mut self.z, guess);
+            let from_guess = self.evaluate(h);
+            if from_guess < norm {
+                norm = from_guess;
+            } else {
+                std::mem::swap(&mut self.z, guess);
+                norm = self.evaluate(h);
+            }
+        }
         let mut update = f64::INFINITY;
         let mut iterations = 0;
         while iterations < self.max_newton {
@@ -370,6 +412,7 @@ impl ImplicitSpringSolver {
                 }
             }
             let mut accepted = false;
+            let mut stagnating = false;
             for _ in 0..12 {
                 for ((t, z), d) in self.trial.iter_mut().zip(&self.z).zip(&delta) {
                     *t = z + step * d;
@@ -378,6 +421,8 @@ impl ImplicitSpringSolver {
                 std::mem::swap(&mut self.residual, &mut self.trial_residual);
                 let trial_norm = self.evaluate(h);
                 if trial_norm.is_finite() && trial_norm <= norm {
+                    stagnating =
+                        step < STAGNANT_STEP && trial_norm > (1.0 - STAGNANT_DECREASE) * norm;
                     norm = trial_norm;
                     accepted = true;
                     break;
@@ -398,6 +443,12 @@ impl ImplicitSpringSolver {
             if update <= self.tolerance {
                 break;
             }
+            if stagnating {
+                // Stuck on a tiny step in a valley of the residual that holds no solution
+                // nearby: typically the bodies must turn by about π or more within the step,
+                // which one Cayley rotation cannot. Give up now; the caller splits the step.
+                break;
+            }
         }
         if !update.is_finite() || self.z.iter().any(|v| !v.is_finite()) {
             return Err(ImplicitSpringError::NonFinite);
@@ -409,7 +460,10 @@ impl ImplicitSpringSolver {
                 tolerance: self.tolerance,
             });
         }
-        self.finish(h, bodies)
+        self.finish(h, bodies)?;
+        guess.clear();
+        guess.extend_from_slice(&self.z);
+        Ok(())
     }
 
     /// Reads the bodies and springs into the `f64` principal-frame working data.

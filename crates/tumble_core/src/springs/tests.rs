@@ -106,7 +106,9 @@ fn a_stiff_asymmetric_chain_keeps_its_energy_at_every_omega_dt() {
         let e0 = energy(&bodies, &springs);
         let mut solver = ImplicitSpringSolver::default();
         let mut worst: f64 = 0.0;
-        let steps = 2000;
+        // The violent cases (the bodies turn by radians per step, so the step is split) are
+        // slow in a debug build: fewer steps there.
+        let steps = if omega_dt > 2.0 { 100 } else { 1000 };
         let mut newton = 0;
         let mut splits = 0;
         for _ in 0..steps {
