@@ -33,9 +33,36 @@ use crate::math::Real;
 /// which the components document as invalid) is treated as 0: no decay, never growth.
 #[inline]
 pub fn decay(x: Real) -> Real {
+    1.0 / (1.0 + growth(x))
+}
+
+/// `1 − decay(x)`: the fraction of the velocity the flow removes over `x = λτ`, computed without
+/// the cancellation of `1 − decay(x)` at small `x` (in `f32`, `x = 10⁻⁴` would lose three
+/// digits of the decrement, a bias in the damping rate rather than round-off):
+///
+/// ```text
+/// decrement(x) = p / (1 + p),    p = x + x²/2 + x³/6
+/// ```
+///
+/// In `[0, 1)` for finite `x ≥ 0`, 1 at `x = +∞`, 0 for negative or NaN `x`. Apply a damping
+/// flow as `u ← u − decrement(λτ) u` (the same value as `decay(λτ) u`, rounded better).
+#[inline]
+pub fn decrement(x: Real) -> Real {
+    let p = growth(x);
+    if p < 1.0 {
+        p / (1.0 + p)
+    } else {
+        // No cancellation once decay ≤ ½, and p = +∞ gives 1 instead of ∞/∞.
+        1.0 - 1.0 / (1.0 + p)
+    }
+}
+
+/// `p = x + x²/2 + x³/6` (the cubic Taylor polynomial of `eˣ` minus 1) for `x ≥ 0`; negative
+/// and NaN `x` count as 0. Overflows to `+∞` beyond `x ≈ 10¹³` in `f32` (decay 0).
+#[inline]
+fn growth(x: Real) -> Real {
     let x = x.max(0.0);
-    // Horner form of 1 + x + x²/2 + x³/6; overflows to +∞ (decay 0) for x beyond ~1e13 in f32.
-    1.0 / (1.0 + x * (1.0 + x * (0.5 + x * (1.0 / 6.0))))
+    x * (1.0 + x * (0.5 + x * (1.0 / 6.0)))
 }
 
 #[cfg(test)]
@@ -57,6 +84,15 @@ mod tests {
             assert!(d > 0.0 && d <= 1.0 && d <= previous, "decay({x}) = {d}");
             previous = d;
         }
+        for x in [0.0, 1e-6, 1e-3, 0.7, 5.0, 1e20, Real::INFINITY] {
+            let (d, r) = (decay(x), decrement(x));
+            assert!((0.0..=1.0).contains(&r), "decrement({x}) = {r}");
+            assert!((d + r - 1.0).abs() <= Real::EPSILON, "x = {x}: {d} + {r}");
+        }
+        // The decrement keeps its relative accuracy where 1 − decay(x) cancels.
+        let x: Real = 1e-4;
+        let exact = -(-to_f64(x)).exp_m1();
+        assert!((to_f64(decrement(x)) / exact - 1.0).abs() < 4.0 * to_f64(Real::EPSILON));
         // Error ≈ x⁴/24 for small x (the next Taylor term): check the order, above round-off.
         for x in [0.05_f64, 0.1, 0.2] {
             let err = (to_f64(decay(x as Real)) - (-x).exp()).abs();

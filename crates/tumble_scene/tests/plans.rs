@@ -38,8 +38,8 @@ fn every_bundled_scene_has_exactly_the_systems_it_needs() {
         ),
         (
             "spring_chain",
-            "audit_energy_start → begin_step → apply_springs → audit_external_loads → \
-             integrate_with_forces → audit_energy",
+            "audit_energy_start → damp_springs_start → begin_step → apply_springs → \
+             audit_external_loads → integrate_with_forces → damp_springs_end → audit_energy",
         ),
         (
             "mass_ratio",
