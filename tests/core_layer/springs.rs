@@ -150,7 +150,6 @@ fn damped_oscillator(
     dt: Real,
     steps: usize,
 ) -> Vec<(f64, f64)> {
-    use tumble::bevy_ecs::prelude::*;
     let mut world = world_with(dt, integrator);
     let body = world
         .spawn((

@@ -14,7 +14,7 @@
 //! massive and contributes 0), whose flow over `τ` is `u(τ) = e^{−cτ/m_eff} u`. It is applied as
 //! the impulse `P = m_eff (e^{−cτ/m_eff} − 1) u` along `n` at anchor `a` and `−P n` at anchor `b`
 //! (with the torques `r × (±P n)`), the exponential replaced by
-//! [`decrement`](tumble_core::damping::decrement) (`1 − e^{−x}` to `O(x⁴)`, never above 1, no
+//! [`decrement`] (`1 − e^{−x}` to `O(x⁴)`, never above 1, no
 //! platform `exp`). The kinetic energy changes by `½ m_eff u² (f² − 1) ≤ 0`, `f ∈ [0, 1]` the
 //! decay factor: a damper never adds energy, however large `cΔt`.
 //!
@@ -127,13 +127,17 @@ impl Anchor {
 }
 
 /// The damper's impulse along `n` on end `a` over `τ`, given `w = 1/m_eff` and the relative
-/// anchor velocity `u` along `n`: `P = −(1 − e^{−cτw}) u / w`.
+/// anchor velocity `u` along `n`: `P = −(1 − e^{−cτw}) u / w`. Zero when both ends are fixed
+/// (`w = 0`) and when `u` or `w` is not finite (bad data game code wrote between steps: the
+/// integrate systems quarantine that body, and the damper must not carry the NaN to the other
+/// end first).
 #[inline]
 fn impulse(damping: Real, tau: Real, w: Real, u: Real) -> Real {
-    if !(w > 0.0) {
-        return 0.0;
+    if w.is_finite() && w > 0.0 && u.is_finite() {
+        -decrement(damping * tau * w) * u / w
+    } else {
+        0.0
     }
-    -decrement(damping * tau * w) * u / w
 }
 
 /// The damper flow of one spring over `τ` (nothing for an undamped spring, a degenerate axis
