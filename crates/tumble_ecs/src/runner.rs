@@ -9,10 +9,11 @@ use crate::schedule::{PhysicsPlan, SpringQuery};
 
 /// Runs one physics step per [`step`](Self::step), re-planning when the world changed: when it
 /// gains or loses a [`Gravity`](crate::components::Gravity) resource, a kind of force generator,
-/// its first damped spring or its last,
+/// its first damped spring or its last (a damping coefficient changed in place counts),
 /// dynamic bodies with or without accumulators, static or kinematic bodies, or when the
 /// integrator changes between a kick–drift and a drift–kick–drift method. Re-planning is one pass
-/// over the archetypes per step; the schedule is rebuilt only when the plan differs.
+/// over the archetypes per step, plus, in a world with springs, a read of their damping
+/// coefficients up to the first damped one; the schedule is rebuilt only when the plan differs.
 ///
 /// ```
 /// use bevy_ecs::prelude::World;
