@@ -13,9 +13,8 @@
 //! (world inverse inertia; a world anchor, a [`Static`] or a [`Kinematic`] end is infinitely
 //! massive and contributes 0), whose flow over `τ` is `u(τ) = e^{−cτ/m_eff} u`. It is applied as
 //! the impulse `P = m_eff (e^{−cτ/m_eff} − 1) u` along `n` at anchor `a` and `−P n` at anchor `b`
-//! (with the torques `r × (±P n)`), the exponential replaced by
-//! [`decrement`] (`1 − e^{−x}` to `O(x⁴)`, never above 1, no
-//! platform `exp`). The kinetic energy changes by `½ m_eff u² (f² − 1) ≤ 0`, `f ∈ [0, 1]` the
+//! (with the torques `r × (±P n)`), the exponential replaced by [`decrement`] (`1 − e^{−x}` to
+//! `O(x⁴)`, never above 1, no platform `exp`). The kinetic energy changes by `½ m_eff u² (f² − 1) ≤ 0`, `f ∈ [0, 1]` the
 //! decay factor: a damper never adds energy, however large `cΔt`.
 //!
 //! Springs that share a body are swept one after another: at the start of the step in query
