@@ -4,6 +4,7 @@
 mod integrators {
     pub mod batch;
     pub mod convergence;
+    pub mod damping;
     pub mod extremes;
     pub mod gyroscopic;
     pub mod harness;

@@ -233,7 +233,7 @@ fn a_world_needing_everything_plans_every_stage_in_order() {
             anchor: Vec3::ZERO,
         },
         stiffness: 10.0,
-        damping: 0.0,
+        damping: 0.5,
         rest_length: 1.0,
     });
     world.spawn(ConstantForce {
@@ -261,4 +261,37 @@ fn a_world_needing_everything_plans_every_stage_in_order() {
     let plan = PhysicsPlan::for_world(&mut world);
     assert_eq!(plan.stages(), &Stage::ALL[..]);
     assert_eq!(Stage::ALL.len(), Stage::COUNT);
+}
+
+/// The spring dampers' two stages are planned only while some spring has `damping > 0`, and the
+/// runner notices a damper switched on or off in place.
+#[test]
+fn damper_stages_only_with_a_damped_spring() {
+    let mut world = world_with(0.01, Integrator::Splitting);
+    let body = world.spawn((RigidBody, ForceAccumulator::default())).id();
+    let spring = |damping| Spring {
+        a: body,
+        anchor_a: Vec3::ZERO,
+        b: SpringEnd::World(Vec3::X),
+        stiffness: 10.0,
+        damping,
+        rest_length: 0.5,
+    };
+    let undamped = world.spawn(spring(0.0)).id();
+    let damper = [Stage::DampSpringsStart, Stage::DampSpringsEnd];
+    let mut physics = PhysicsRunner::new(&mut world);
+    physics.step(&mut world);
+    assert!(damper.iter().all(|&s| !physics.plan().contains(s)));
+    world.get_mut::<Spring>(undamped).unwrap().damping = 0.2;
+    physics.step(&mut world);
+    assert_eq!(
+        physics.plan().to_string(),
+        "audit_energy_start → damp_springs_start → begin_step → apply_springs → \
+         audit_external_loads → integrate_with_forces → damp_springs_end → audit_energy"
+    );
+    assert_eq!(physics.replans(), 1);
+    world.get_mut::<Spring>(undamped).unwrap().damping = 0.0;
+    physics.step(&mut world);
+    assert!(damper.iter().all(|&s| !physics.plan().contains(s)));
+    assert_eq!(physics.replans(), 2);
 }

@@ -12,6 +12,7 @@
 //!   `R I_b⁻¹ Rᵀ` is applied by rotating into the principal frame, never inverted numerically.
 //! - A zero principal moment locks that axis (its inverse is 0), never NaN.
 
+pub mod damping;
 pub mod error;
 pub mod exact;
 pub mod integrate;

@@ -22,8 +22,9 @@
 //! where `F`, `τ` are every load on the body except the springs (gravity, constant forces and
 //! torques, forces game code or its own systems added) and `e_step` is the integrator's energy
 //! error. The `(v_start + v_end)/2` form is the drift–kick–drift displacement exactly, so a
-//! constant force credits exactly the work the step did. Spring damping and [`Damping`](crate::components::Damping) only
-//! remove energy and are not credited. The audit keeps the running sum `D = Σ e_step` per group
+//! constant force credits exactly the work the step did. Spring dampers and
+//! [`Damping`](crate::components::Damping) are velocity flows at the start and end of the step
+//! ([`crate::damping`]); they only remove energy, are not credited, and lower `D`. The audit keeps the running sum `D = Σ e_step` per group
 //! (the energy the integrator made up; changes game code makes between steps are not part of
 //! it) and rejects the group when
 //!
@@ -407,12 +408,14 @@ pub fn audit_energy_start(
 }
 
 /// Before the integration (after every force system): records each audited body's load
-/// without the springs, `F = ΣF − F_springs`, `τ = Στ − τ_springs`, with the spring forces
-/// evaluated exactly as [`apply_springs`](crate::forces::apply_springs) did on the same state.
+/// without the springs, `F = ΣF − F_springs`, `τ = Στ − τ_springs`, with the springs' elastic
+/// forces evaluated exactly as [`apply_springs`](crate::forces::apply_springs) did on the same
+/// state. (Spring dampers are not forces in the accumulators: they are the velocity flow of
+/// [`crate::damping`], an energy loss the balance sees and never flags.)
 pub fn audit_external_loads(
     mut ledger: ResMut<EnergyLedger>,
     accumulators: Query<(Entity, &ForceAccumulator), Dynamic>,
-    states: Query<(&Transform, &Velocity, &MassProps), Dynamic>,
+    states: Query<(&Transform, &MassProps), Dynamic>,
 ) {
     let ledger = &mut *ledger;
     for (entity, acc) in &accumulators {
@@ -420,16 +423,13 @@ pub fn audit_external_loads(
             ledger.bodies[i].load = (acc.force, acc.torque);
         }
     }
-    // Anchor point, its velocity and the centre of mass, on the (half-drifted) state the force
-    // systems saw.
-    let kinematics = |end: End, ledger: &EnergyLedger| match end {
-        End::Audited(i, local) => states.get(ledger.bodies[i].entity).ok().map(|(t, v, m)| {
-            let com = t.center_of_mass(m);
-            let p = t.transform_point(local);
-            (p, v.linear + v.angular.cross(p - com), com)
-        }),
-        // A world anchor has no velocity; a static body's anchor neither.
-        End::Fixed(p) => Some((p, Vec3::ZERO, p)),
+    // Anchor point and the centre of mass, on the (half-drifted) state the force systems saw.
+    let anchor = |end: End, ledger: &EnergyLedger| match end {
+        End::Audited(i, local) => states
+            .get(ledger.bodies[i].entity)
+            .ok()
+            .map(|(t, m)| (t.transform_point(local), t.center_of_mass(m))),
+        End::Fixed(p) => Some((p, p)),
         End::Kinematic | End::Inactive => None,
     };
     for k in 0..ledger.links.len() {
@@ -437,12 +437,11 @@ pub fn audit_external_loads(
         if link.implicit {
             continue;
         }
-        let (Some((pa, ua, ca)), Some((pb, ub, cb))) =
-            (kinematics(link.a, ledger), kinematics(link.b, ledger))
+        let (Some((pa, ca)), Some((pb, cb))) = (anchor(link.a, ledger), anchor(link.b, ledger))
         else {
             continue;
         };
-        let f = spring_force(&link.spring, pa - pb, ua - ub);
+        let f = spring_force(&link.spring, pa - pb);
         if let End::Audited(i, _) = link.a {
             let load = &mut ledger.bodies[i].load;
             load.0 -= f;

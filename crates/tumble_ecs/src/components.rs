@@ -223,8 +223,19 @@ impl Default for GravityScale {
     }
 }
 
-/// Velocity damping, Padé form as rapier and avian use it: `v ← v / (1 + Δt c_lin)`,
-/// `ω ← ω / (1 + Δt c_ang)` after each step. Coefficients in 1/s, `>= 0`.
+/// Velocity damping `v̇ = −c_lin v`, `ω̇ = −c_ang ω`, as a flow of its own, Strang-split around
+/// the step: for half a step before it and half a step after it,
+///
+/// ```text
+/// v ← decay(c_lin Δt/2) v,   ω ← decay(c_ang Δt/2) ω,   decay(x) = 1/(1 + x + x²/2 + x³/6)
+/// ```
+///
+/// (`decay(x) = e^{−x} + O(x⁴)`, in `(0, 1]`, no platform `exp`: see
+/// [`tumble_core::damping`]). The symmetric split keeps the drift–kick–drift integrators second
+/// order, and the velocities only shrink, for any `cΔt`. Coefficients in 1/s, `>= 0`.
+///
+/// rapier and avian apply the Padé form `v ← v / (1 + Δt c)` once after the velocity update
+/// (first order); the two agree to `O(c²Δt²)` per step.
 #[derive(Component, Debug, Clone, Copy, PartialEq, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Damping {

@@ -59,6 +59,14 @@ pub enum SpringEnd {
 /// anchor velocity `u = ṗ_a − ṗ_b`, the force on `a` is
 /// `F_a = −(k (|d| − L₀) + c (u·n)) n` and `b` receives `−F_a`, each at its anchor (so with the
 /// matching torques). At `|d| = 0` the direction is undefined and no force is applied.
+///
+/// The two parts are integrated differently. The elastic force `−k (|d| − L₀) n` is a force
+/// generator ([`apply_springs`], sampled where the integrator samples forces). The damper
+/// `−c (u·n) n` is a velocity flow of its own, exact for this spring alone
+/// (`u·n ← e^{−cτ/m_eff} u·n` with the effective mass of the two anchors along `n`), applied
+/// for half a step before and half a step after the step (see [`crate::damping`]): the damped
+/// step stays second order with the drift–kick–drift integrators and never adds energy, for any
+/// `c Δt`.
 #[derive(Component, Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[component(on_insert = ensure_accumulators)]
@@ -71,7 +79,7 @@ pub struct Spring {
     pub b: SpringEnd,
     /// Stiffness `k` (N/m), `>= 0`.
     pub stiffness: Real,
-    /// Damping `c` (N·s/m), `>= 0`.
+    /// Damping `c` (N·s/m), `>= 0`, along the spring's axis (see [`crate::damping`]).
     pub damping: Real,
     /// Rest length `L₀` (m), `>= 0`.
     pub rest_length: Real,
@@ -166,35 +174,30 @@ pub fn apply_constant_torques(generators: Query<&ConstantTorque>, mut bodies: Fo
     }
 }
 
-/// World anchor point and its velocity `ṗ = v + ω × (p − x)` for a body-local anchor.
+/// World anchor point and the centre of mass, for a body-local anchor.
 #[inline]
-fn anchor_kinematics(
-    transform: &Transform,
-    velocity: &Velocity,
-    mass: &MassProps,
-    local: Vec3,
-) -> (Vec3, Vec3, Vec3) {
-    let com = transform.center_of_mass(mass);
-    let point = transform.transform_point(local);
-    let point_velocity = velocity.linear + velocity.angular.cross(point - com);
-    (point, point_velocity, com)
+fn anchor_point(transform: &Transform, mass: &MassProps, local: Vec3) -> (Vec3, Vec3) {
+    (
+        transform.transform_point(local),
+        transform.center_of_mass(mass),
+    )
 }
 
-/// Spring force on end `a`: `−(k (|d| − L₀) + c (u·n)) n`, zero when `|d| = 0`.
+/// Elastic spring force on end `a`, `−k (|d| − L₀) n` with `d = p_a − p_b`, `n = d/|d|`; zero
+/// when `|d| = 0`. The damper is not a force here: it is the velocity flow of
+/// [`crate::damping`].
 #[inline]
-pub fn spring_force(spring: &Spring, d: Vec3, relative_velocity: Vec3) -> Vec3 {
+pub fn spring_force(spring: &Spring, d: Vec3) -> Vec3 {
     let length = d.length();
     if length <= 0.0 {
         return Vec3::ZERO;
     }
     let n = d / length;
-    let magnitude = spring.stiffness * (length - spring.rest_length)
-        + spring.damping * relative_velocity.dot(n);
-    -magnitude * n
+    -(spring.stiffness * (length - spring.rest_length)) * n
 }
 
-/// Applies every [`Spring`] stepped explicitly (the implicit step of [`crate::stiff`] handles
-/// the others).
+/// Applies every [`Spring`]'s elastic force, for the springs stepped explicitly (the implicit
+/// step of [`crate::stiff`] handles the others; every damper is [`crate::damping`]'s).
 pub fn apply_springs(
     springs: Query<&Spring, Without<crate::stiff::ImplicitSpring>>,
     mut bodies: ForceTargets,
@@ -202,22 +205,22 @@ pub fn apply_springs(
     for spring in &springs {
         match spring.b {
             SpringEnd::World(anchor_b) => {
-                let Ok((t, v, m, mut acc)) = bodies.get_mut(spring.a) else {
+                let Ok((t, _, m, mut acc)) = bodies.get_mut(spring.a) else {
                     continue;
                 };
-                let (pa, ua, com) = anchor_kinematics(t, v, m, spring.anchor_a);
-                let f = spring_force(spring, pa - anchor_b, ua);
+                let (pa, com) = anchor_point(t, m, spring.anchor_a);
+                let f = spring_force(spring, pa - anchor_b);
                 acc.add_force_at_point(f, pa, com);
             }
             SpringEnd::Body { body, anchor } => {
-                let Ok([(ta, va, ma, mut acc_a), (tb, vb, mb, mut acc_b)]) =
+                let Ok([(ta, _, ma, mut acc_a), (tb, _, mb, mut acc_b)]) =
                     bodies.get_many_mut([spring.a, body])
                 else {
                     continue;
                 };
-                let (pa, ua, com_a) = anchor_kinematics(ta, va, ma, spring.anchor_a);
-                let (pb, ub, com_b) = anchor_kinematics(tb, vb, mb, anchor);
-                let f = spring_force(spring, pa - pb, ua - ub);
+                let (pa, com_a) = anchor_point(ta, ma, spring.anchor_a);
+                let (pb, com_b) = anchor_point(tb, mb, anchor);
+                let f = spring_force(spring, pa - pb);
                 acc_a.add_force_at_point(f, pa, com_a);
                 acc_b.add_force_at_point(-f, pb, com_b);
             }

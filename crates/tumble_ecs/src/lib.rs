@@ -14,6 +14,7 @@
 
 pub mod audit;
 pub mod components;
+pub mod damping;
 pub mod forces;
 pub mod parallel;
 #[cfg(feature = "bevy_app")]

@@ -5,13 +5,15 @@ use std::fmt;
 use bevy_ecs::prelude::*;
 use bevy_ecs::schedule::Schedule;
 
-use crate::schedule::PhysicsPlan;
+use crate::schedule::{PhysicsPlan, SpringQuery};
 
 /// Runs one physics step per [`step`](Self::step), re-planning when the world changed: when it
 /// gains or loses a [`Gravity`](crate::components::Gravity) resource, a kind of force generator,
+/// its first damped spring or its last (a damping coefficient changed in place counts),
 /// dynamic bodies with or without accumulators, static or kinematic bodies, or when the
 /// integrator changes between a kick–drift and a drift–kick–drift method. Re-planning is one pass
-/// over the archetypes per step; the schedule is rebuilt only when the plan differs.
+/// over the archetypes per step, plus, in a world with springs, a read of their damping
+/// coefficients up to the first damped one; the schedule is rebuilt only when the plan differs.
 ///
 /// ```
 /// use bevy_ecs::prelude::World;
@@ -32,6 +34,9 @@ pub struct PhysicsRunner {
     plan: PhysicsPlan,
     schedule: Schedule,
     replans: u64,
+    /// The springs, read by every re-planning (whether any is damped): kept so that planning
+    /// every step builds no query.
+    springs: Option<SpringQuery>,
 }
 
 impl PhysicsRunner {
@@ -43,13 +48,16 @@ impl PhysicsRunner {
             plan,
             schedule,
             replans: 0,
+            springs: None,
         }
     }
 
     /// Advances `world` by one step, re-planning first if the world changed. (In a bare `World`,
     /// call `world.clear_trackers()` once per frame as well.)
     pub fn step(&mut self, world: &mut World) {
-        if PhysicsPlan::of(world) != self.plan || crate::stiff::classification_is_stale(world) {
+        if PhysicsPlan::of_with(world, &mut self.springs) != self.plan
+            || crate::stiff::classification_is_stale(world)
+        {
             let plan = PhysicsPlan::for_world(world);
             tracing::debug!(from = %self.plan, to = %plan, "physics re-planned");
             self.schedule = plan.build_schedule();

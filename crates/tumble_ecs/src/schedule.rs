@@ -3,8 +3,10 @@
 //! One step runs these sets in order:
 //!
 //! 0. [`PhysicsSet::Prepare`] — in audited worlds, the energy audit's start (see
-//!    [`crate::audit`]); for drift–kick–drift integrators (`splitting`, `yoshida4`, `rk4`), half
-//!    a drift, so forces are sampled at the midpoint of the step.
+//!    [`crate::audit`]); with damped springs, the first half-step of the spring dampers' flow
+//!    (`damp_springs_start`, see [`crate::damping`]); for drift–kick–drift integrators
+//!    (`splitting`, `yoshida4`, `rk4`), the first half-step of the [`Damping`] flow and half a
+//!    drift, so forces are sampled at the midpoint of the step.
 //! 1. [`PhysicsSet::Gravity`] — `m g s` into each accumulator; only if a [`Gravity`] resource
 //!    exists.
 //! 2. [`PhysicsSet::Forces`] — force generators that exist in the world (constant forces,
@@ -13,8 +15,17 @@
 //! 3. [`PhysicsSet::Integrate`] — the selected integrator. It *consumes* each accumulator (reads
 //!    and zeroes it in the same pass, so there is no separate "clear forces" pass and a force
 //!    added before a step is applied exactly once) and renormalizes each quaternion as part of
-//!    the rotation update (so there is no separate "renormalize" pass either). In audited
-//!    worlds the audit reads the loads just before and closes the energy balance just after.
+//!    the rotation update (so there is no separate "renormalize" pass either), with the
+//!    [`Damping`] flow for half a step after (and, for a whole step, before). Then, with damped
+//!    springs, the second half-step of the spring dampers' flow (`damp_springs_end`, the springs
+//!    in reverse order). In audited worlds the audit reads the loads just before the integration
+//!    and closes the energy balance at the very end.
+//!
+//! Damping is thus a flow of its own, split symmetrically around the conservative step,
+//! `D(Δt/2) ∘ step ∘ D(Δt/2)`: second order with the drift–kick–drift methods, and never a gain
+//! of energy (see [`tumble_core::damping`]).
+//!
+//! [`Damping`]: crate::components::Damping
 
 use std::fmt;
 
@@ -23,11 +34,13 @@ use bevy_ecs::prelude::*;
 use bevy_ecs::schedule::{ScheduleBuildSettings, ScheduleLabel};
 
 use bevy_ecs::component::ComponentId;
+use bevy_ecs::world::WorldId;
 
 use crate::audit::{
     EnergyAudit, EnergyLedger, audit_energy, audit_energy_start, audit_external_loads,
 };
 use crate::components::{ForceAccumulator, Gravity, Kinematic, PhysicsSettings, RigidBody, Static};
+use crate::damping::{damp_springs_end, damp_springs_start, is_damped};
 use crate::forces::{
     ConstantForce, ConstantTorque, Spring, apply_constant_forces, apply_constant_torques,
     apply_gravity, apply_springs,
@@ -45,13 +58,15 @@ pub struct PhysicsSchedule;
 /// The ordered stages of one physics step.
 #[derive(SystemSet, Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum PhysicsSet {
-    /// First half-drift of drift–kick–drift integrators.
+    /// Start of the step: the audit's start, the first half of the damping flows, the first
+    /// half-drift of drift–kick–drift integrators.
     Prepare,
     /// Gravity into the accumulators.
     Gravity,
     /// Force generators and user force systems.
     Forces,
-    /// Integration (consumes accumulators, renormalizes rotations).
+    /// Integration (consumes accumulators, renormalizes rotations), the second half of the
+    /// damping flows, the audit's balance.
     Integrate,
 }
 
@@ -60,6 +75,8 @@ pub enum PhysicsSet {
 pub enum Stage {
     /// [`audit_energy_start`].
     AuditEnergyStart,
+    /// [`damp_springs_start`]: the spring dampers' flow over the first half step.
+    DampSpringsStart,
     /// [`begin_step`].
     BeginStep,
     /// [`apply_gravity`].
@@ -80,14 +97,18 @@ pub enum Stage {
     IntegrateWithoutForces,
     /// [`discard_fixed_body_forces`].
     DiscardFixedBodyForces,
+    /// [`damp_springs_end`]: the spring dampers' flow over the second half step, in reverse
+    /// order.
+    DampSpringsEnd,
     /// [`audit_energy`].
     AuditEnergy,
 }
 
 impl Stage {
     /// Every stage, in the order a step runs them.
-    pub const ALL: [Stage; 12] = [
+    pub const ALL: [Stage; 14] = [
         Stage::AuditEnergyStart,
+        Stage::DampSpringsStart,
         Stage::BeginStep,
         Stage::Gravity,
         Stage::ConstantForces,
@@ -98,6 +119,7 @@ impl Stage {
         Stage::IntegrateWithForces,
         Stage::IntegrateWithoutForces,
         Stage::DiscardFixedBodyForces,
+        Stage::DampSpringsEnd,
         Stage::AuditEnergy,
     ];
 
@@ -110,6 +132,8 @@ impl Stage {
             Stage::AuditEnergyStart => "audit_energy_start",
             Stage::AuditExternalLoads => "audit_external_loads",
             Stage::AuditEnergy => "audit_energy",
+            Stage::DampSpringsStart => "damp_springs_start",
+            Stage::DampSpringsEnd => "damp_springs_end",
             Stage::BeginStep => "begin_step",
             Stage::Gravity => "apply_gravity",
             Stage::ConstantForces => "apply_constant_forces",
@@ -133,13 +157,16 @@ impl Stage {
 /// - one system per kind of force generator that exists;
 /// - `solve_implicit_springs` only if a spring group is stepped implicitly (see
 ///   [`crate::stiff`]);
+/// - `damp_springs_start` / `damp_springs_end` only if a [`Spring`] has `damping > 0` (one pass
+///   over the springs' damping coefficients, stopping at the first damped one);
 /// - `integrate_with_forces` / `integrate_without_forces` only if there are dynamic bodies with
 ///   / without an accumulator ([`Static`] and [`Kinematic`] bodies are never integrated);
 /// - `discard_fixed_body_forces` only if a static or kinematic body has an accumulator.
 ///
-/// [`PhysicsPlan::of`] is cheap (one pass over the archetypes, no allocation: the stages live
-/// inline), so [`PhysicsRunner`](crate::runner::PhysicsRunner) re-plans every step and rebuilds
-/// the schedule only when the plan changes.
+/// [`PhysicsPlan::of`] is cheap (one pass over the archetypes, and over the springs when there
+/// are any; the stages live inline), so [`PhysicsRunner`](crate::runner::PhysicsRunner)
+/// re-plans every step and rebuilds the schedule only when the plan changes; the runner keeps
+/// its spring query between steps, so its re-planning does not allocate.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct PhysicsPlan {
     stages: ArrayVec<Stage, { Stage::COUNT }>,
@@ -157,7 +184,12 @@ struct Contents {
     /// Springs the explicit path applies (not marked implicit).
     explicit_springs: bool,
     implicit_bodies: bool,
+    damped_springs: bool,
 }
+
+/// The query [`PhysicsPlan`] reads the springs' damping coefficients through, with the world it
+/// was built for.
+pub(crate) type SpringQuery = (WorldId, QueryState<&'static Spring>);
 
 impl Contents {
     /// One pass over the non-empty archetypes.
@@ -198,6 +230,23 @@ impl Contents {
 }
 
 impl PhysicsPlan {
+    /// [`of`](Self::of) with the springs read through `springs`, a query kept by the caller
+    /// (so that planning every step does not build a query every step). A query built for
+    /// another world is replaced.
+    pub(crate) fn of_with(world: &World, springs: &mut Option<SpringQuery>) -> Self {
+        let mut c = Contents::of(world);
+        if c.springs {
+            if springs.as_ref().is_none_or(|(id, _)| *id != world.id()) {
+                *springs = world.try_query::<&Spring>().map(|q| (world.id(), q));
+            }
+            // Stops at the first damped spring.
+            c.damped_springs = springs
+                .as_mut()
+                .is_some_and(|(_, q)| q.iter(world).any(is_damped));
+        }
+        Self::from_contents(world, c)
+    }
+
     /// Plans the step for `world`: [`of`](Self::of) after inserting default
     /// [`PhysicsSettings`] (if missing) and the bookkeeping resource, classifying the springs
     /// (explicit or implicit, see [`crate::stiff::classify_springs`]), with settings outside the
@@ -216,13 +265,17 @@ impl PhysicsPlan {
 
     /// The plan for `world` as it is now, without side effects.
     pub fn of(world: &World) -> Self {
+        Self::of_with(world, &mut None)
+    }
+
+    /// The plan for a world holding `c`.
+    fn from_contents(world: &World, c: Contents) -> Self {
         let integrator = world
             .get_resource::<PhysicsSettings>()
             .copied()
             .unwrap_or_default()
             .integrator;
         let midpoint = integrator.samples_forces_at_midpoint();
-        let c = Contents::of(world);
         let dynamic =
             c.dynamic_with_accumulator || c.dynamic_without_accumulator || c.implicit_bodies;
         let audit = dynamic
@@ -234,6 +287,9 @@ impl PhysicsPlan {
         let mut stages = ArrayVec::new();
         if audit {
             stages.push(Stage::AuditEnergyStart);
+        }
+        if c.damped_springs {
+            stages.push(Stage::DampSpringsStart);
         }
         if midpoint && c.dynamic_with_accumulator {
             stages.push(Stage::BeginStep);
@@ -265,6 +321,9 @@ impl PhysicsPlan {
         }
         if c.fixed_with_accumulator {
             stages.push(Stage::DiscardFixedBodyForces);
+        }
+        if c.damped_springs {
+            stages.push(Stage::DampSpringsEnd);
         }
         if audit {
             stages.push(Stage::AuditEnergy);
@@ -308,14 +367,17 @@ impl PhysicsPlan {
         let mut previous: Option<Stage> = None;
         for &stage in &self.stages {
             let set = match stage {
-                Stage::AuditEnergyStart | Stage::BeginStep => PhysicsSet::Prepare,
+                Stage::AuditEnergyStart | Stage::DampSpringsStart | Stage::BeginStep => {
+                    PhysicsSet::Prepare
+                }
                 Stage::Gravity => PhysicsSet::Gravity,
                 Stage::AuditExternalLoads
                 | Stage::AuditEnergy
                 | Stage::SolveImplicitSprings
                 | Stage::IntegrateWithForces
                 | Stage::IntegrateWithoutForces
-                | Stage::DiscardFixedBodyForces => PhysicsSet::Integrate,
+                | Stage::DiscardFixedBodyForces
+                | Stage::DampSpringsEnd => PhysicsSet::Integrate,
                 _ => PhysicsSet::Forces,
             };
             add_stage(&mut schedule, stage, set, previous);
@@ -334,6 +396,8 @@ fn add_stage(schedule: &mut Schedule, stage: Stage, set: PhysicsSet, after: Opti
         Stage::AuditEnergyStart => audit_energy_start.into_configs(),
         Stage::AuditExternalLoads => audit_external_loads.into_configs(),
         Stage::AuditEnergy => audit_energy.into_configs(),
+        Stage::DampSpringsStart => damp_springs_start.into_configs(),
+        Stage::DampSpringsEnd => damp_springs_end.into_configs(),
         Stage::BeginStep => begin_step.into_configs(),
         Stage::Gravity => apply_gravity.into_configs(),
         Stage::ConstantForces => apply_constant_forces.into_configs(),

@@ -7,7 +7,8 @@
 //! - **Springs.** Every method here advances positions with a symplectic kick–drift or
 //!   drift–kick–drift update, whose harmonic oscillator is stable iff `ω Δt < 2`, `ω = √(k/μ)`
 //!   with `μ` the reduced mass of the two ends (the body's mass for a world anchor). Damping is
-//!   ignored (it only helps).
+//!   ignored: it is a separate flow that only shrinks velocities, at any `cΔt`
+//!   ([`crate::damping`]).
 //! - **Explicit gyroscopic term** (`symplectic-euler`, `symplectic-euler-linear`). About a
 //!   principal axis `i` the torque-free motion nutates at `Ω² = ω² (I_j − I_i)(I_k − I_i)/(I_j I_k)`;
 //!   forward Euler multiplies each such oscillation by `√(1 + Ω²Δt²)` per step, a growth rate of

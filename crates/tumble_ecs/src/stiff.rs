@@ -29,11 +29,12 @@ use tumble_core::springs::{
 };
 
 use crate::components::{
-    ForceAccumulator, MassProps, PhysicsSettings, RigidBody, Transform, Velocity, body_state,
+    Damping, ForceAccumulator, MassProps, PhysicsSettings, RigidBody, Transform, Velocity, body_state,
     write_body_state,
 };
 use crate::forces::{Spring, SpringEnd};
 use crate::systems::Dynamic;
+use crate::table::damp;
 use crate::validate::{BodyError, BodyErrorKind, reject};
 
 /// How a world steps its springs.
@@ -274,6 +275,7 @@ pub fn solve_implicit_springs(
             &mut Velocity,
             &MassProps,
             &mut ForceAccumulator,
+            Option<&Damping>,
         ),
         (Dynamic, With<ImplicitBody>),
     >,
@@ -284,7 +286,14 @@ pub fn solve_implicit_springs(
     s.entities.clear();
     s.parent.clear();
     s.all.clear();
-    for (entity, t, v, m, mut acc) in &mut bodies {
+    let dt = settings.dt();
+    for (entity, t, mut v, m, mut acc, damping) in &mut bodies {
+        // `Damping` is a flow of its own, half a step before the step and half after (see
+        // `tumble_core::damping`), as on the explicit path.
+        if let Some(d) = damping {
+            let v = &mut *v;
+            damp(d, 0.5 * dt, &mut v.linear, &mut v.angular);
+        }
         s.index.insert(entity, s.entities.len());
         s.parent.push(s.entities.len());
         s.entities.push(entity);
@@ -315,7 +324,6 @@ pub fn solve_implicit_springs(
     }
     s.local.clear();
     s.local.resize(s.entities.len(), usize::MAX);
-    let dt = settings.dt();
     // Groups in order of their first member (query order: deterministic).
     for root in 0..s.entities.len() {
         if s.group_of[root] != root {
@@ -371,8 +379,12 @@ pub fn solve_implicit_springs(
         match s.solver.step(&mut s.bodies, &s.springs, dt) {
             Ok(_) => {
                 for (k, &i) in s.members.iter().enumerate() {
-                    if let Ok((_, mut t, mut v, m, _)) = bodies.get_mut(s.entities[i]) {
+                    if let Ok((_, mut t, mut v, m, _, damping)) = bodies.get_mut(s.entities[i]) {
                         write_body_state(&s.bodies[k].state, m, &mut t, &mut v);
+                        if let Some(d) = damping {
+                            let v = &mut *v;
+                            damp(d, 0.5 * dt, &mut v.linear, &mut v.angular);
+                        }
                     }
                 }
             }

@@ -55,9 +55,9 @@ pub fn discard_fixed_body_forces(
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct HalfDrifted(pub bool);
 
-/// First phase of a drift–kick–drift step for bodies with a [`ForceAccumulator`]: half a drift
-/// before the force systems run, so forces are sampled at the midpoint. Does nothing for methods
-/// that sample forces at the start of the step. Bodies without an accumulator feel no
+/// First phase of a drift–kick–drift step for bodies with a [`ForceAccumulator`]: the first half
+/// of the [`Damping`] flow, then half a drift before the force systems run, so forces are sampled
+/// at the midpoint. Does nothing for methods that sample forces at the start of the step. Bodies without an accumulator feel no
 /// state-dependent force and take their whole step in [`integrate_without_forces`].
 pub fn begin_step(
     settings: Res<PhysicsSettings>,
@@ -71,6 +71,7 @@ pub fn begin_step(
             &mut Velocity,
             &MassProps,
             &ForceAccumulator,
+            Option<&Damping>,
         ),
         (Dynamic, Without<ImplicitBody>),
     >,
@@ -81,13 +82,13 @@ pub fn begin_step(
     drifted.0 = true;
     let parallelism = parallelism.map_or_else(Parallelism::default, |p| *p);
     let mut errors = Vec::new();
-    for (entities, mut t, mut v, masses, accs) in dense(bodies.contiguous_iter_mut()) {
+    for (entities, mut t, mut v, masses, accs, dampings) in dense(bodies.contiguous_iter_mut()) {
         let bodies = Bodies {
             entities,
             transforms: &mut t,
             velocities: &mut v,
             masses,
-            dampings: None,
+            dampings,
             loads: Loads::Checked(accs),
         };
         step_table(
@@ -105,7 +106,8 @@ pub fn begin_step(
 ///
 /// For a drift–kick–drift method this finishes the step that [`begin_step`] began; if the
 /// schedule was planned without `begin_step` (the integrator was changed afterwards) it takes the
-/// whole step with the forces sampled at the start, and warns once.
+/// whole step with the forces sampled at the start, and warns once. A whole step applies both
+/// halves of the [`Damping`] flow around it, a finished one the second half after it.
 pub fn integrate_with_forces(
     settings: Res<PhysicsSettings>,
     parallelism: Option<Res<Parallelism>>,
@@ -156,7 +158,8 @@ pub fn integrate_with_forces(
 }
 
 /// Integrates bodies without a [`ForceAccumulator`]: free motion, plus gravity when a
-/// [`Gravity`] resource exists (a uniform field needs no accumulator).
+/// [`Gravity`] resource exists (a uniform field needs no accumulator), with the [`Damping`] flow
+/// for half a step before and after.
 pub fn integrate_without_forces(
     settings: Res<PhysicsSettings>,
     parallelism: Option<Res<Parallelism>>,

@@ -9,6 +9,7 @@
 use std::sync::Mutex;
 
 use bevy_ecs::prelude::*;
+use tumble_core::damping::decrement;
 use tumble_core::math::{Real, Vec3};
 use tumble_core::prefetch::prefetch;
 use tumble_core::{BodyBatch, BodyState, Integrator, MassProperties, StepPhase, Wrench};
@@ -127,9 +128,13 @@ impl<'a> Bodies<'a> {
 /// whose step diverges keeps its state; both are reported in `errors`.
 struct TableBatch<'a, 'e> {
     bodies: Bodies<'a>,
-    /// Damping applies after the phases that end a step.
-    damp: bool,
-    dt: Real,
+    /// [`Damping`]'s first half-step flow applies to the velocity read by the phases that begin
+    /// a step (`Begin`, `Whole`), its second to the velocity written by the phases that end one
+    /// (`Finish`, `Whole`).
+    damp_read: bool,
+    damp_write: bool,
+    /// Half the step, `Δt/2`: the span of each damping flow.
+    half_dt: Real,
     integrator: Integrator,
     errors: &'e mut Vec<BodyError>,
 }
@@ -147,6 +152,16 @@ impl BodyBatch for TableBatch<'_, '_> {
         match check_body(transform, velocity, None).and_then(|()| bodies.loads.take(i, mass)) {
             Ok(wrench) => {
                 state.copy_fields_from(&body_state(transform, velocity, mass));
+                if self.damp_read
+                    && let Some(d) = bodies.dampings.map(|d| &d[i])
+                {
+                    damp(
+                        d,
+                        self.half_dt,
+                        &mut state.linear_velocity,
+                        &mut state.angular_velocity,
+                    );
+                }
                 Some(wrench)
             }
             Err(kind) => {
@@ -179,12 +194,10 @@ impl BodyBatch for TableBatch<'_, '_> {
         let bodies = &mut self.bodies;
         let (transform, velocity) = (&mut bodies.transforms[i], &mut bodies.velocities[i]);
         write_body_state(state, &bodies.masses[i], transform, velocity);
-        if self.damp
+        if self.damp_write
             && let Some(d) = bodies.dampings.map(|d| &d[i])
         {
-            // Padé damping v ← v / (1 + Δt c): unconditionally stable, as in rapier and avian.
-            velocity.linear /= 1.0 + self.dt * d.linear;
-            velocity.angular /= 1.0 + self.dt * d.angular;
+            damp(d, self.half_dt, &mut velocity.linear, &mut velocity.angular);
         }
     }
 
@@ -195,6 +208,15 @@ impl BodyBatch for TableBatch<'_, '_> {
             kind: BodyErrorKind::Diverged(tumble_core::StepError::Diverged { integrator }),
         });
     }
+}
+
+/// [`Damping`]'s flow over `τ`: `v ← decay(c_lin τ) v`, `ω ← decay(c_ang τ) ω`, written as
+/// `v − decrement(c τ) v` (see [`tumble_core::damping`]). Outside the core's step, in the
+/// adapter's `read` and `write`, so every kernel path of the batch sees the same bits.
+#[inline(always)]
+pub(crate) fn damp(damping: &Damping, tau: Real, linear: &mut Vec3, angular: &mut Vec3) {
+    *linear -= decrement(damping.linear * tau) * *linear;
+    *angular -= decrement(damping.angular * tau) * *angular;
 }
 
 /// Steps every body of `bodies` through `phase` with the core's batched step (bit-identical
@@ -208,8 +230,9 @@ fn step_bodies(
     let found = errors.len();
     let mut batch = TableBatch {
         bodies,
-        damp: phase != StepPhase::Begin,
-        dt: settings.dt(),
+        damp_read: phase != StepPhase::Finish,
+        damp_write: phase != StepPhase::Begin,
+        half_dt: 0.5 * settings.dt(),
         integrator: settings.integrator,
         errors,
     };

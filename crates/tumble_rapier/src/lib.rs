@@ -14,7 +14,8 @@
 //! - **Poses**: tumble's [`BodyState::position`](tumble_core::BodyState) is the centre of mass;
 //!   the rapier body origin is placed at `x − R c` so both centres of mass coincide. Linear
 //!   velocity is the centre-of-mass velocity and angular velocity is world-frame in both.
-//! - **Damping**: both use the Padé form `v ← v / (1 + Δt c)` after the velocity update.
+//! - **Damping**: tumble's `Damping` maps to rapier's linear and angular damping, same
+//!   coefficients. They are integrated differently (see below).
 //! - **Forces**: rapier's user forces persist until reset and a force at a point is turned into a
 //!   torque when it is added, so every step the loads are reset and re-added at the current pose,
 //!   which matches tumble's generators (sampled once per step).
@@ -34,6 +35,11 @@
 //!   and 4 substeps its projectile is closer to the exact parabola than one symplectic Euler step.
 //! - **Force sampling**: tumble's drift–kick–drift methods sample forces at mid-step; rapier at
 //!   the start of the (sub)step.
+//! - **Damping**: rapier applies the Padé form `v ← v / (1 + Δt c)` once per (sub)step, after
+//!   the velocity update (first order); tumble applies the flow `v ← e^{−cΔt/2} v` (a rational
+//!   approximation of it) half a step before and half a step after its step (second order, see
+//!   `tumble_core::damping`). Per step they agree to `O(c²Δt²)`: after a time `t` a damped
+//!   velocity differs by about `c²Δt t/2` relative.
 //! - **Velocity caps**: rapier clamps linear velocity to `normalized_max_linear_velocity` (scaled
 //!   by the length unit); tumble never clamps. Scenes here stay far below the cap.
 

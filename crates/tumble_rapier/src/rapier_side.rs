@@ -77,6 +77,8 @@ impl RapierScene {
                 .angvel(vec_in(body.state.angular_velocity))
                 .additional_mass_properties(props)
                 .gravity_scale(real_in(body.gravity_scale))
+                // Same coefficients; rapier damps with the Padé form after its velocity update
+                // (first order), tumble with a flow split around the step (second order).
                 .linear_damping(real_in(body.linear_damping))
                 .angular_damping(real_in(body.angular_damping))
                 .gyroscopic_forces_enabled(gyroscopic)

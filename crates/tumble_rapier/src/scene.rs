@@ -28,9 +28,10 @@ pub struct ComparisonBody {
     pub state: BodyState,
     /// Gravity scale (1 = normal).
     pub gravity_scale: Real,
-    /// Padé linear damping coefficient (1/s).
+    /// Linear damping coefficient (1/s): tumble's `Damping` (a split flow), rapier's linear
+    /// damping (Padé, `v ← v/(1 + Δt c)`; see the crate docs for the difference).
     pub linear_damping: Real,
-    /// Padé angular damping coefficient (1/s).
+    /// Angular damping coefficient (1/s), mapped as the linear one.
     pub angular_damping: Real,
     /// Constant loads.
     pub loads: Vec<Load>,

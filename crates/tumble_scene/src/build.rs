@@ -44,9 +44,9 @@ pub struct SceneBody {
     pub state: tumble_core::BodyState,
     /// Gravity scale.
     pub gravity_scale: Real,
-    /// Padé linear damping (1/s).
+    /// Linear damping `c_lin` (1/s) of the body's `Damping`.
     pub linear_damping: Real,
-    /// Padé angular damping (1/s).
+    /// Angular damping `c_ang` (1/s) of the body's `Damping`.
     pub angular_damping: Real,
 }
 

@@ -107,10 +107,10 @@ pub struct BodyDef {
     /// Gravity scale (default 1).
     #[serde(default = "one")]
     pub gravity_scale: f64,
-    /// Padé linear damping (1/s).
+    /// Linear damping `c_lin` (1/s): `v̇ = −c_lin v`, the body's `Damping`.
     #[serde(default, skip_serializing_if = "is_zero")]
     pub linear_damping: f64,
-    /// Padé angular damping (1/s).
+    /// Angular damping `c_ang` (1/s): `ω̇ = −c_ang ω`, the body's `Damping`.
     #[serde(default, skip_serializing_if = "is_zero")]
     pub angular_damping: f64,
 }

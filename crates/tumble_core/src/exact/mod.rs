@@ -3,6 +3,8 @@
 //! - [`projectile`]: uniform acceleration, `x = x₀ + v₀t + ½gt²`;
 //! - [`harmonic_spring`] / [`HarmonicSpring`]: undamped spring, `x = x₀ cos ωt + (v₀/ω) sin ωt`,
 //!   `ω = √(k/m)`;
+//! - [`damped_spring`] / [`DampedSpring`]: damped oscillator `m ẍ + c ẋ + k x = 0`, under-,
+//!   critically and over-damped, `x = e^{−γt}(x₀ C(t) + (v₀ + γx₀) S(t))`, `γ = c/(2m)`;
 //! - [`TorqueFreeTop`]: the torque-free rigid body through Jacobi elliptic functions (Landau &
 //!   Lifshitz, *Mechanics*, §37), with the symmetric top and steady spins in closed form;
 //! - [`elliptic`]: the Jacobi functions `sn, cn, dn` and the integrals `K(m)`, `F(φ | m)` it
@@ -15,7 +17,9 @@ pub mod top;
 use thiserror::Error;
 
 pub use elliptic::{complete_k, incomplete_f, jacobi_amplitude, jacobi_sn_cn_dn};
-pub use linear::{HarmonicSpring, harmonic_spring, projectile};
+pub use linear::{
+    DampedSpring, DampingRegime, HarmonicSpring, damped_spring, harmonic_spring, projectile,
+};
 pub use top::{TopMotion, TorqueFreeTop};
 
 /// Largest accepted `||q₀| − 1|` of an initial orientation; it is renormalized on input.
@@ -44,6 +48,9 @@ pub enum ExactError {
         /// The mass given (kg).
         mass: f64,
     },
+    /// Spring damping must be finite and `>= 0`.
+    #[error("spring damping must be finite and >= 0, got c = {0}")]
+    BadDamping(f64),
 }
 
 #[cfg(test)]
