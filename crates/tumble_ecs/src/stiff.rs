@@ -29,8 +29,8 @@ use tumble_core::springs::{
 };
 
 use crate::components::{
-    Damping, ForceAccumulator, MassProps, PhysicsSettings, RigidBody, Transform, Velocity, body_state,
-    write_body_state,
+    Damping, ForceAccumulator, MassProps, PhysicsSettings, RigidBody, Transform, Velocity,
+    body_state, write_body_state,
 };
 use crate::forces::{Spring, SpringEnd};
 use crate::systems::Dynamic;
