@@ -4,7 +4,9 @@
 //!
 //! Two mechanisms matter for free bodies and springs:
 //!
-//! - **Springs.** Every method here advances positions with a symplectic kick–drift or
+//! - **Springs** stepped explicitly (see [`crate::stiff`]: by default only soft spring groups
+//!   are; the implicit spring step is stable at any stiffness and never warned about). Every
+//!   method here advances positions with a symplectic kick–drift or
 //!   drift–kick–drift update, whose harmonic oscillator is stable iff `ω Δt < 2`, `ω = √(k/μ)`
 //!   with `μ` the reduced mass of the two ends (the body's mass for a world anchor). Damping is
 //!   ignored: it is a separate flow that only shrinks velocities, at any `cΔt`
@@ -51,7 +53,7 @@ pub const POSITION_RESOLUTION_LIMIT: Real = 1e-3;
 /// resolve.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum StabilityWarning {
-    /// A spring too stiff for the time step.
+    /// A spring too stiff for the time step, stepped explicitly ([`SpringSolver::Explicit`](crate::stiff::SpringSolver::Explicit)).
     StiffSpring {
         /// The spring entity.
         spring: Entity,
@@ -95,7 +97,8 @@ impl std::fmt::Display for StabilityWarning {
             StabilityWarning::StiffSpring { spring, omega_dt } => write!(
                 f,
                 "spring {spring}: √(k/μ)Δt = {omega_dt:.3} ≥ {SPRING_LIMIT}, outside the stable \
-                 region of every integrator here; lower the stiffness or the time step"
+                 region of the explicit spring step; use the implicit one (springs = `auto` or \
+                 `implicit`), or lower the stiffness or the time step"
             ),
             StabilityWarning::ExplicitGyroscopic {
                 body,
