@@ -217,8 +217,8 @@ pub struct ImplicitSpringSolver {
     /// Per body, `(1 − [hΩ̄/2]×)⁻¹`: the derivative of the Cayley rotation (see `evaluate`).
     cayley_derivative: Vec<DMat3>,
     krylov: Krylov,
-    /// The guess [`step`](Self::step) keeps for itself (one group stepped again and again).
-    own_guess: Vec<f64>,
+    /// The states at the start of the step, restored if it fails part-way.
+    saved: Vec<BodyState>,
 }
 
 impl Default for ImplicitSpringSolver {
@@ -240,10 +240,14 @@ impl Default for ImplicitSpringSolver {
             cayley: Vec::new(),
             cayley_derivative: Vec::new(),
             krylov: Krylov::default(),
-            own_guess: Vec::new(),
+            saved: Vec::new(),
         }
     }
 }
+
+/// Largest `h|ω|` (rad) of any body at the start of a piece of a step: faster spins start split
+/// (see [`ImplicitSpringSolver::step`]).
+const PIECE_TURN: f64 = 3.0;
 
 /// Largest change of `h|Ω̄|` (rad) of any body in one Newton iteration.
 const MAX_TURN: f64 = 0.5;
@@ -291,29 +295,34 @@ impl ImplicitSpringSolver {
         springs: &[GroupSpring],
         dt: Real,
     ) -> Result<SolveStats, ImplicitSpringError> {
-        let mut guess = std::mem::take(&mut self.own_guess);
-        guess.clear();
-        let result = self.step_from(bodies, springs, dt, &mut guess);
-        self.own_guess = guess;
-        result
-    }
-
-    /// [`step`](Self::step), with Newton's method also tried from `guess`: the mean velocities
-    /// `(v̄, Ω̄)` (six numbers per body) of an earlier step of the same group, which `step_from`
-    /// replaces with this step's. Along a fast, steady motion the mean velocities change little
-    /// from step to step, so the previous step's are a far better start than the current
-    /// velocities; the start with the smaller residual is taken, so a stale guess costs one
-    /// residual evaluation and nothing else. The result does not depend on the guess beyond
-    /// the solver's tolerance.
-    pub fn step_from(
-        &mut self,
-        bodies: &mut [GroupBody],
-        springs: &[GroupSpring],
-        dt: Real,
-        guess: &mut Vec<f64>,
-    ) -> Result<SolveStats, ImplicitSpringError> {
+        let h = dt.widen();
         let mut stats = SolveStats::default();
-        self.advance(bodies, springs, dt.widen(), 0, guess, &mut stats)?;
+        // Start split where the bodies already spin too fast for one Cayley rotation per step
+        // (saves the failed attempts at the coarser levels); deeper splits still follow where
+        // the spin grows within the step. A function of the state only, so the result is too.
+        let spin = bodies
+            .iter()
+            .map(|b| b.state.angular_velocity.widen().length())
+            .fold(0.0, f64::max)
+            * h;
+        let mut depth = 0;
+        while depth < MAX_SPLITS && spin > PIECE_TURN * f64::from(1u32 << depth) {
+            depth += 1;
+        }
+        let pieces = 1u32 << depth;
+        stats.splits += pieces as usize - 1;
+        self.saved.clear();
+        self.saved.extend(bodies.iter().map(|b| b.state));
+        for _ in 0..pieces {
+            if let Err(e) = self.advance(bodies, springs, h / f64::from(pieces), depth, &mut stats)
+            {
+                // Pieces already taken are undone: the bodies keep their states.
+                for (body, state) in bodies.iter_mut().zip(&self.saved) {
+                    body.state = *state;
+                }
+                return Err(e);
+            }
+        }
         Ok(stats)
     }
 
@@ -323,14 +332,13 @@ impl ImplicitSpringSolver {
         springs: &[GroupSpring],
         h: f64,
         depth: u32,
-        guess: &mut Vec<f64>,
         stats: &mut SolveStats,
     ) -> Result<(), ImplicitSpringError> {
-        match self.solve(bodies, springs, h, guess, stats) {
+        match self.solve(bodies, springs, h, stats) {
             Err(ImplicitSpringError::NotConverged { .. }) if depth < MAX_SPLITS => {
                 stats.splits += 1;
-                self.advance(bodies, springs, 0.5 * h, depth + 1, guess, stats)?;
-                self.advance(bodies, springs, 0.5 * h, depth + 1, guess, stats)
+                self.advance(bodies, springs, 0.5 * h, depth + 1, stats)?;
+                self.advance(bodies, springs, 0.5 * h, depth + 1, stats)
             }
             other => other,
         }
@@ -342,7 +350,6 @@ impl ImplicitSpringSolver {
         bodies: &mut [GroupBody],
         springs: &[GroupSpring],
         h: f64,
-        guess: &mut Vec<f64>,
         stats: &mut SolveStats,
     ) -> Result<(), ImplicitSpringError> {
         self.prepare(bodies, springs)?;
@@ -365,16 +372,6 @@ impl ImplicitSpringSolver {
         }
         let scale = self.energy_scale(h);
         let mut norm = self.evaluate(h);
-        if guess.len() == n && guess.iter().all(|g| g.is_finite()) {
-            std::mem::swap(&mut self.z, guess);
-            let from_guess = self.evaluate(h);
-            if from_guess < norm {
-                norm = from_guess;
-            } else {
-                std::mem::swap(&mut self.z, guess);
-                norm = self.evaluate(h);
-            }
-        }
         let mut update = f64::INFINITY;
         let mut iterations = 0;
         while iterations < self.max_newton {
@@ -460,10 +457,7 @@ impl ImplicitSpringSolver {
                 tolerance: self.tolerance,
             });
         }
-        self.finish(h, bodies)?;
-        guess.clear();
-        guess.extend_from_slice(&self.z);
-        Ok(())
+        self.finish(h, bodies)
     }
 
     /// Reads the bodies and springs into the `f64` principal-frame working data.
