@@ -210,18 +210,30 @@ pub fn markdown(results: &Results, plots: &[String]) -> String {
     }
     let _ = writeln!(
         out,
-        "## Stability matrix\n\nStable = finite, `||q| − 1| < 1e-5`, energy ratio in [0.01, 100]. \
-         **Bold** cells are unstable. \"warned\" = tumble's planning-time prediction.\n"
+        "## Stability matrix\n\nEvery scene conserves its total energy (kinetic + spring + gravity) \
+         physically. Verdict on it, checked after every step: **right** = finite, `||q| − 1| < \
+         1e-5`, `E/E₀` within 1 ± 5 %; **dissipative** = never above 1.05 but more than 5 % lost; \
+         **bounded** = more than 5 % gained at some step but within [0.01, 100]; **unstable** = \
+         anything else (bold). \"warned\" = tumble's planning-time prediction of a divergence; \
+         `springs` = the spring step (`auto` takes the implicit one for stiff groups). The same \
+         verdicts as a heatmap: [stability.svg](stability.svg).\n"
     );
-    out.push_str("| scene | setting | integrator | finite | max \\|\\|q\\|−1\\| | E/E₀ | warned |\n|---|---|---|---|---|---|---|\n");
+    out.push_str("| scene | setting | integrator | springs | finite | max \\|\\|q\\|−1\\| | E/E₀ | E/E₀ range | verdict | warned |\n|---|---|---|---|---|---|---|---|---|---|\n");
     for c in &results.stability {
         let mark = |s: String| if c.stable() { s } else { format!("**{s}**") };
+        let [low, high] = c.energy_range;
+        let range = if low.is_finite() && high.is_finite() {
+            format!("{low:.3} … {high:.3}")
+        } else {
+            "—".into()
+        };
         let _ = writeln!(
             out,
-            "| {} | {} | `{}` | {} | {} | {} | {} |",
+            "| {} | {} | `{}` | {} | {} | {} | {} | {range} | {} | {} |",
             c.scene,
             c.setting,
             c.integrator,
+            c.springs,
             mark(c.finite.to_string()),
             sci(c.max_quaternion_error),
             mark(if c.energy_ratio.is_finite() {
@@ -229,6 +241,7 @@ pub fn markdown(results: &Results, plots: &[String]) -> String {
             } else {
                 "—".into()
             }),
+            mark(c.verdict().to_owned()),
             c.warned
         );
     }
@@ -374,6 +387,84 @@ pub fn plot_energy(
         .background_style(WHITE.mix(0.8))
         .border_style(BLACK)
         .draw()?;
+    root.present()?;
+    Ok(file)
+}
+
+/// Draws the stability matrix as a heatmap: one row per scene and setting, one column per
+/// integrator and spring step, coloured by [`Cell::verdict`], with a `w` where tumble predicted a
+/// divergence; returns the file name.
+pub fn plot_stability(dir: &Path, cells: &[Cell]) -> Result<String, Box<dyn std::error::Error>> {
+    let file = "stability.svg".to_owned();
+    let mut rows: Vec<(String, String)> = Vec::new();
+    let mut columns: Vec<(String, String)> = Vec::new();
+    for c in cells {
+        let row = (c.scene.clone(), c.setting.clone());
+        if !rows.contains(&row) {
+            rows.push(row);
+        }
+        let column = (c.integrator.clone(), c.springs.clone());
+        if !columns.contains(&column) {
+            columns.push(column);
+        }
+    }
+    let (cell_w, cell_h, left, top) = (44_i32, 16_i32, 260_i32, 150_i32);
+    let width = left + cell_w * columns.len() as i32 + 20;
+    let height = top + cell_h * rows.len() as i32 + 40;
+    let path = dir.join(&file);
+    let root = SVGBackend::new(&path, (width as u32, height as u32)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let text = ("sans-serif", 11).into_font();
+    root.draw(&Text::new(
+        "verdict on total energy: green right · yellow dissipative · blue bounded · red unstable · w = predicted",
+        (8, 8),
+        text.clone(),
+    ))?;
+    for (j, (integrator, springs)) in columns.iter().enumerate() {
+        let x = left + cell_w * j as i32 + cell_w / 2;
+        let label = if springs == "—" {
+            integrator.clone()
+        } else {
+            format!("{integrator} / {springs}")
+        };
+        root.draw(&Text::new(
+            label,
+            (x, top - 6),
+            text.clone().transform(FontTransform::Rotate270),
+        ))?;
+    }
+    for (i, (scene, setting)) in rows.iter().enumerate() {
+        let y = top + cell_h * i as i32;
+        root.draw(&Text::new(
+            format!("{scene} · {setting}"),
+            (8, y + 3),
+            text.clone(),
+        ))?;
+        for (j, column) in columns.iter().enumerate() {
+            let Some(c) = cells.iter().find(|c| {
+                c.scene == *scene
+                    && c.setting == *setting
+                    && c.integrator == column.0
+                    && c.springs == column.1
+            }) else {
+                continue;
+            };
+            let colour = match c.verdict() {
+                "right" => RGBColor(76, 175, 80),
+                "dissipative" => RGBColor(255, 193, 7),
+                "bounded" => RGBColor(100, 160, 230),
+                _ => RGBColor(220, 50, 47),
+            };
+            let x = left + cell_w * j as i32;
+            root.draw(&Rectangle::new(
+                [(x + 1, y + 1), (x + cell_w - 1, y + cell_h - 1)],
+                colour.filled(),
+            ))?;
+            if c.warned {
+                root.draw(&Text::new("w", (x + cell_w / 2 - 3, y + 2), text.clone()))?;
+            }
+        }
+    }
     root.present()?;
     Ok(file)
 }

@@ -105,6 +105,10 @@ pub fn run_report(options: &ReportOptions) -> Result<(), Box<dyn std::error::Err
     for (spin, _) in spins() {
         plots.push(plot_energy(staging.path(), spin, &results.energy)?);
     }
+    plots.push(crate::output::plot_stability(
+        staging.path(),
+        &results.stability,
+    )?);
     for plot in &plots {
         let drawn = staging.path().join(plot);
         // A scene without finite points gets no plot file (see `plot_scene`).

@@ -17,14 +17,20 @@ pub struct Cell {
     pub scene: String,
     /// Integrator name.
     pub integrator: String,
+    /// Spring step (`PhysicsSettings::springs`: `auto`, `explicit`), `—` without springs.
+    pub springs: String,
     /// The swept setting, e.g. `"|ω|Δt = 5"`.
     pub setting: String,
     /// Every body stayed finite and was never quarantined.
     pub finite: bool,
     /// Largest `||q| − 1|` over the run.
     pub max_quaternion_error: f64,
-    /// Final / initial total energy, kinetic plus spring potential (NaN when not finite).
+    /// Final / initial total energy, kinetic plus spring potential plus gravity potential (NaN
+    /// when not finite).
     pub energy_ratio: f64,
+    /// Smallest and largest `E/E₀` over the run, checked after every step (NaN when not
+    /// finite).
+    pub energy_range: [f64; 2],
     /// tumble's planning-time stability prediction warned.
     pub warned: bool,
 }
@@ -39,7 +45,31 @@ impl Cell {
     pub fn stable(&self) -> bool {
         self.finite && self.max_quaternion_error < 1e-5 && (1e-2..1e2).contains(&self.energy_ratio)
     }
+
+    /// The verdict on the total energy, for scenes whose energy is conserved by the physics:
+    ///
+    /// - `right`: stable, and `E/E₀` within `1 ± 5 %` after every step;
+    /// - `dissipative`: stable, never above `1.05 E₀`, but more than 5 % lost (numerical
+    ///   damping);
+    /// - `bounded`: stable (a method near the edge of its stable region swings by up to ×100 and
+    ///   comes back), but more than 5 % gained at some step;
+    /// - `unstable`: not [`stable`](Self::stable).
+    pub fn verdict(&self) -> &'static str {
+        let [low, high] = self.energy_range;
+        if !self.stable() {
+            "unstable"
+        } else if high <= 1.0 + ENERGY_BAND && low >= 1.0 - ENERGY_BAND {
+            "right"
+        } else if high <= 1.0 + ENERGY_BAND {
+            "dissipative"
+        } else {
+            "bounded"
+        }
+    }
 }
+
+/// Largest relative change of the total energy a run may show and still be called `right`.
+pub const ENERGY_BAND: f64 = 0.05;
 
 fn sphere(m: Real) -> MassProps {
     MassProps(MassProperties::solid_sphere(Mass::new(m).expect("valid"), 0.1).expect("valid"))
@@ -53,10 +83,17 @@ fn run(
     setting: String,
 ) -> Cell {
     let warned = check_stability(world).iter().any(|w| w.is_instability());
-    let e0 = total_energy(world);
+    let springs = if world.query::<&Spring>().iter(world).next().is_some() {
+        world.resource::<PhysicsSettings>().springs.name()
+    } else {
+        "—"
+    };
+    let floor = gravity_floor(world);
+    let e0 = total_energy(world, floor);
     let mut schedule = PhysicsPlan::for_world(world).build_schedule();
     let mut max_q = 0.0_f64;
     let mut finite = true;
+    let mut range = [1.0_f64, 1.0];
     for _ in 0..steps {
         schedule.run(world);
         world.clear_trackers();
@@ -68,21 +105,56 @@ fn run(
         if !finite {
             break;
         }
+        let ratio = total_energy(world, floor) / e0;
+        range = [range[0].min(ratio), range[1].max(ratio)];
     }
-    let e1 = total_energy(world);
+    let e1 = total_energy(world, floor);
     Cell {
         scene: name.to_owned(),
         integrator: integrator.name().to_owned(),
+        springs: springs.to_owned(),
         setting,
         finite,
         max_quaternion_error: max_q,
         energy_ratio: if finite { e1 / e0 } else { f64::NAN },
+        energy_range: if finite { range } else { [f64::NAN; 2] },
         warned,
     }
 }
 
+/// Kinetic energy of every body plus the potential `½ k (|d| − L₀)²` of every spring and the
+/// gravity potential `m |g| (h − floor)`, `h` the height along `−g` (J).
+fn total_energy(world: &mut World, floor: f64) -> f64 {
+    let g = world.get_resource::<Gravity>().map_or(Vec3::ZERO, |g| g.0);
+    let gravity: f64 = world
+        .query_filtered::<(&Transform, &MassProps), With<RigidBody>>()
+        .iter(world)
+        .map(|(t, m)| {
+            let height = -to_f64(g.dot(t.center_of_mass(m)));
+            to_f64(m.mass()) * (height - floor * to_f64(g.length()))
+        })
+        .sum();
+    gravity + elastic_and_kinetic(world)
+}
+
+/// The floor of the gravity potential: 1 m below the lowest centre of mass at the start, so a
+/// falling scene starts with energy to lose and its `E/E₀` means something (the potential's zero
+/// is arbitrary; with it at the bodies' own height `E₀` could be 0).
+fn gravity_floor(world: &mut World) -> f64 {
+    let Some(g) = world.get_resource::<Gravity>().map(|g| g.0) else {
+        return 0.0;
+    };
+    let down = g.normalize_or_zero();
+    world
+        .query_filtered::<(&Transform, &MassProps), With<RigidBody>>()
+        .iter(world)
+        .map(|(t, m)| -to_f64(down.dot(t.center_of_mass(m))))
+        .fold(f64::INFINITY, f64::min)
+        - 1.0
+}
+
 /// Kinetic energy of every body plus the potential `½ k (|d| − L₀)²` of every spring (J).
-fn total_energy(world: &mut World) -> f64 {
+fn elastic_and_kinetic(world: &mut World) -> f64 {
     let mut q = world.query_filtered::<(&Transform, &Velocity, &MassProps), With<RigidBody>>();
     let kinetic: f64 = q
         .iter(world)
@@ -112,8 +184,16 @@ fn total_energy(world: &mut World) -> f64 {
 }
 
 fn world(dt: Real, integrator: Integrator) -> World {
+    springs_world(dt, integrator, SpringSolver::Auto)
+}
+
+fn springs_world(dt: Real, integrator: Integrator, springs: SpringSolver) -> World {
     let mut w = World::new();
-    w.insert_resource(PhysicsSettings::new(dt, integrator).expect("valid dt"));
+    w.insert_resource(
+        PhysicsSettings::new(dt, integrator)
+            .expect("valid dt")
+            .with_springs(springs),
+    );
     w
 }
 
@@ -139,9 +219,14 @@ fn thin_rod(integrator: Integrator, omega_dt: Real, steps: usize) -> Cell {
 }
 
 /// A mass on a stiff spring to a world anchor, √(k/m)Δt = `omega_dt`.
-fn stiff_spring(integrator: Integrator, omega_dt: Real, steps: usize) -> Cell {
+fn stiff_spring(
+    integrator: Integrator,
+    springs: SpringSolver,
+    omega_dt: Real,
+    steps: usize,
+) -> Cell {
     let (dt, m) = (1.0 / 60.0 as Real, 1.0 as Real);
-    let mut w = world(dt, integrator);
+    let mut w = springs_world(dt, integrator, springs);
     let body = w
         .spawn((RigidBody, sphere(m), Transform::from_translation(Vec3::X)))
         .id();
@@ -250,8 +335,10 @@ pub fn matrix(quick: bool, mut progress: impl FnMut()) -> Vec<Cell> {
         for omega_dt in [0.1, 1.0, 5.0, 10.0] {
             cells.push(thin_rod(integrator, omega_dt, steps));
         }
-        for omega_dt in [0.5, 1.0, 1.5, 2.0, 2.5] {
-            cells.push(stiff_spring(integrator, omega_dt, steps));
+        for springs in [SpringSolver::Explicit, SpringSolver::Auto] {
+            for omega_dt in [0.5, 1.0, 1.5, 2.0, 2.5, 10.0, 100.0] {
+                cells.push(stiff_spring(integrator, springs, omega_dt, steps));
+            }
         }
         for dt in [1.0 / 30.0, 1.0 / 60.0, 1.0 / 240.0] {
             cells.push(mass_ratio(integrator, dt, steps));
@@ -260,5 +347,126 @@ pub fn matrix(quick: bool, mut progress: impl FnMut()) -> Vec<Cell> {
         cells.push(long_run(integrator, long));
         progress();
     }
+    // Spring networks with the default integrator: the spring step is what differs.
+    let chain_steps = if quick { 300 } else { 3_000 };
+    for springs in [SpringSolver::Explicit, SpringSolver::Auto] {
+        for omega_dt in [0.5, 1.0, 2.0, 5.0, 10.0, 30.0, 100.0] {
+            cells.push(stiff_chain(springs, omega_dt, chain_steps));
+        }
+        cells.push(cloth(springs, 10.0, if quick { 60 } else { 600 }));
+    }
     cells
+}
+
+/// Ten asymmetric bodies (I = 0.02, 0.03, 0.04) in a chain of springs at off-centre anchors, the
+/// first tied to the world, each spring stretched 10 %; nominal `√(k/μ)Δt = omega_dt` (μ = ½).
+fn stiff_chain(springs: SpringSolver, omega_dt: Real, steps: usize) -> Cell {
+    let dt = 1.0 / 60.0;
+    let integrator = Integrator::default();
+    let mut w = springs_world(dt, integrator, springs);
+    let k = 0.5 * (omega_dt / dt).powi(2);
+    let mass = MassProperties::new(Mass::new(1.0).expect("valid"), Vec3::new(0.02, 0.03, 0.04))
+        .expect("valid");
+    let bodies: Vec<Entity> = (0..10)
+        .map(|i| {
+            let x = i as Real;
+            w.spawn((
+                RigidBody,
+                MassProps(mass),
+                Transform {
+                    translation: Vec3::new(x, 0.02 * x, 0.0),
+                    rotation: Quat::from_rotation_z(0.1 * x),
+                },
+                Velocity {
+                    linear: Vec3::new(0.0, 0.05, 0.0),
+                    angular: Vec3::new(0.2, -0.1, 0.3),
+                },
+            ))
+            .id()
+        })
+        .collect();
+    w.spawn(Spring {
+        a: bodies[0],
+        anchor_a: Vec3::new(-0.1, 0.05, 0.0),
+        b: SpringEnd::World(Vec3::new(-1.0, 0.0, 0.0)),
+        stiffness: k,
+        damping: 0.0,
+        rest_length: 0.8,
+    });
+    for pair in bodies.windows(2) {
+        w.spawn(Spring {
+            a: pair[0],
+            anchor_a: Vec3::new(0.1, 0.05, 0.0),
+            b: SpringEnd::Body {
+                body: pair[1],
+                anchor: Vec3::new(-0.1, -0.05, 0.02),
+            },
+            stiffness: k,
+            damping: 0.0,
+            rest_length: 0.72,
+        });
+    }
+    run(
+        &mut w,
+        steps,
+        "stiff-chain",
+        integrator,
+        format!("√(k/μ)Δt = {omega_dt}"),
+    )
+}
+
+/// A 16 × 16 cloth of 10 g bodies joined to their neighbours, two corners held, falling under
+/// gravity; `√(k/μ)Δt = omega_dt` for two neighbours.
+fn cloth(springs: SpringSolver, omega_dt: Real, steps: usize) -> Cell {
+    let (dt, n, spacing, m) = (1.0 / 60.0 as Real, 16, 0.1 as Real, 0.01 as Real);
+    let integrator = Integrator::default();
+    let mut w = springs_world(dt, integrator, springs);
+    w.insert_resource(Gravity::EARTH_Y_DOWN);
+    let k = 0.5 * m * (omega_dt / dt).powi(2);
+    let mass = MassProperties::solid_sphere(Mass::new(m).expect("valid"), 0.02).expect("valid");
+    let grid: Vec<Entity> = (0..n * n)
+        .map(|c| {
+            let (i, j) = ((c / n) as Real, (c % n) as Real);
+            w.spawn((
+                RigidBody,
+                MassProps(mass),
+                Transform::from_translation(Vec3::new(i * spacing, 0.0, j * spacing)),
+            ))
+            .id()
+        })
+        .collect();
+    let mut link = |a: Entity, b: SpringEnd, rest: Real| {
+        w.spawn(Spring {
+            a,
+            anchor_a: Vec3::ZERO,
+            b,
+            stiffness: k,
+            damping: 0.0,
+            rest_length: rest,
+        });
+    };
+    for i in 0..n {
+        for j in 0..n {
+            for (p, q) in [(i + 1, j), (i, j + 1)] {
+                if p < n && q < n {
+                    let end = SpringEnd::Body {
+                        body: grid[p * n + q],
+                        anchor: Vec3::ZERO,
+                    };
+                    link(grid[i * n + j], end, spacing);
+                }
+            }
+        }
+    }
+    for i in [0, n - 1] {
+        let corner = Vec3::new(i as Real * spacing, 0.0, 0.0);
+        link(grid[i * n], SpringEnd::World(corner), 0.0);
+    }
+    run(
+        &mut w,
+        steps,
+        "cloth-16x16",
+        integrator,
+        format!("√(k/μ)Δt = {omega_dt}"),
+    )
 }
