@@ -21,12 +21,16 @@
 //! F̄ = −k (ℓ̄ − L₀)/ℓ̄ · d̄,   d̄ = (d₀ + d₁)/2,   ℓ̄ = (ℓ₀ + ℓ₁)/2
 //! ```
 //!
-//! on end `a` (and `−F̄` on end `b`), with the torque `b × Q₀ᵀF̄` about the *mean* anchor `b`.
+//! on end `a` (and `−F̄` on end `b`). Its torque is taken in the mid-step frame `Q₀ S`
+//! (`S² = cay(hΩ̄)`, the half rotation): `T = b_m × (Q₀S)ᵀ F̄` with the arm
+//! `b_m = (S a + Sᵀ a)/2`. Since `b = S b_m` and `S` turns about `Ω̄`, `Ω̄·T = Ω̄·(b × Q₀ᵀF̄)`,
+//! so the torque does exactly the work below; and the mid-step frame is what makes the step
+//! symmetric (the same torque taken in the start frame `Q₀` would be first order).
 //!
 //! **Why it conserves energy at any step.** The translational kinetic energy changes by
 //! `m v̄·(v₁ − v₀) = h v̄·ΣF`; the rotational by `½(Π₀ + Π₁)·I⁻¹(Π₁ − Π₀) = Ω̄·(Π₁ − Π₀) = h Ω̄·T`
 //! (the gyroscopic term is orthogonal to `Ω̄`). So the work on an anchor is
-//! `F̄·(h v̄ + Q₀(h Ω̄ × b)) = F̄·Δp`, the anchor's exact displacement, and summed over both ends
+//! `h v̄·F̄ + h Ω̄·T = F̄·(h v̄ + Q₀(h Ω̄ × b)) = F̄·Δp`, the anchor's exact displacement, and summed over both ends
 //! `F̄·Δd = −k (ℓ̄ − L₀)/ℓ̄ · (ℓ₁² − ℓ₀²)/2 = −ΔV`. Kinetic plus elastic energy is therefore
 //! conserved exactly, for any stiffness and step, up to the solver's tolerance; a constant force
 //! through the centre of mass does exactly its work `h v̄·F`. Linear momentum is conserved too (the
@@ -186,8 +190,12 @@ struct Link {
 /// What the residual pass leaves for the Jacobian: per spring, the mean anchors and stiffness.
 #[derive(Debug, Clone, Copy, Default)]
 struct Linearized {
-    /// Mean anchors `b` (principal frame) of both ends.
+    /// Mean anchors `b = (a + cay(hΩ̄) a)/2` (principal frame at the start) of both ends: the
+    /// anchors' displacement is `h v̄ + Q₀ (hΩ̄ × b)`.
     b: [DVec3; 2],
+    /// The same displacement seen from the mid-step frame `Q₀ S` (`S² = cay(hΩ̄)`): arms
+    /// `(S a + Sᵀ a)/2`, the torques' lever arms (see `evaluate`).
+    arm: [DVec3; 2],
     /// `−2 ∂F̄/∂d₁ = k ((1 − L₀/ℓ̄) 1 + (L₀/ℓ̄²) d̄ n₁ᵀ)` (world frame).
     k: DMat3,
     /// The force on end `a`, `F̄`.
@@ -214,6 +222,14 @@ pub struct ImplicitSpringSolver {
     blocks: Vec<Block>,
     preconditioner: Vec<Block>,
     cayley: Vec<DQuat>,
+    /// Per body, the half rotation `S` (`S² = cay(hΩ̄)`).
+    half: Vec<DQuat>,
+    /// Per body, the mid-step frame `Q₀ S` as a matrix.
+    mid: Vec<DMat3>,
+    /// Per body, `Sᵀ` as a matrix.
+    half_back: Vec<DMat3>,
+    /// Per body, the total torque of the step in the mid-step frame (springs and load).
+    torque_mid: Vec<DVec3>,
     /// Per body, `(1 − [hΩ̄/2]×)⁻¹`: the derivative of the Cayley rotation (see `evaluate`).
     cayley_derivative: Vec<DMat3>,
     krylov: Krylov,
@@ -238,6 +254,10 @@ impl Default for ImplicitSpringSolver {
             blocks: Vec::new(),
             preconditioner: Vec::new(),
             cayley: Vec::new(),
+            half: Vec::new(),
+            mid: Vec::new(),
+            half_back: Vec::new(),
+            torque_mid: Vec::new(),
             cayley_derivative: Vec::new(),
             krylov: Krylov::default(),
             saved: Vec::new(),
@@ -579,12 +599,23 @@ impl ImplicitSpringSolver {
     /// Jacobian) and returns its norm, scaled per body by `1/√m`, `1/√I`.
     fn evaluate(&mut self, h: f64) -> f64 {
         self.cayley.clear();
+        self.half.clear();
+        self.mid.clear();
+        self.half_back.clear();
+        self.torque_mid.clear();
         self.cayley_derivative.clear();
         for (i, s) in self.starts.iter().enumerate() {
             let z = &self.z[6 * i..6 * i + 6];
             let vbar = v3(&z[..3]);
             let wbar = s.free * v3(&z[3..]);
-            self.cayley.push(cayley(h * wbar));
+            let c = cayley(h * wbar);
+            self.cayley.push(c);
+            // √c for a unit quaternion with w > −1 (always, for a Cayley rotation): normalize
+            // c + 1. Half the angle about the same axis, without trigonometry.
+            let half = DQuat::from_xyzw(c.x, c.y, c.z, c.w + 1.0).normalize();
+            self.half.push(half);
+            self.mid.push(DMat3::from_quat(s.q * half));
+            self.half_back.push(DMat3::from_quat(half.inverse()));
             // From (1 − [w/2]×) cay(w) a = (1 + [w/2]×) a: d(cay(w) a) = −(1 − [w/2]×)⁻¹ [b]× dw,
             // and (1 − [u]×)⁻¹ = 1 + ([u]× + [u]×²)/(1 + |u|²).
             let u = skew(0.5 * h * wbar);
@@ -593,9 +624,9 @@ impl ImplicitSpringSolver {
                 .push(DMat3::IDENTITY + (u + u * u) * (1.0 / (1.0 + uu)));
             let r = &mut self.residual[6 * i..6 * i + 6];
             put(&mut r[..3], s.mass * (vbar - s.v) - 0.5 * h * s.force);
-            // External torque in the principal frame at the mean of the two orientations.
-            let q1 = self.cayley[i];
-            let torque = 0.5 * (s.q.inverse() * s.torque + (s.q * q1).inverse() * s.torque);
+            // External torque in the principal frame at mid-step (symmetric in the two ends).
+            let torque = (s.q * half).inverse() * s.torque;
+            self.torque_mid.push(s.free * torque);
             let iw = s.inertia * wbar;
             let rot = iw - s.pi + 0.5 * h * wbar.cross(iw) - 0.5 * h * torque;
             // A locked axis has no equation of motion: its row pins Ω̄ to 0.
@@ -610,6 +641,8 @@ impl ImplicitSpringSolver {
                         let z = &self.z[6 * end.body..6 * end.body + 6];
                         let rotated = self.cayley[end.body] * end.local;
                         lin.b[e] = 0.5 * (end.local + rotated);
+                        let half = self.half[end.body];
+                        lin.arm[e] = 0.5 * (half * end.local + half.inverse() * end.local);
                         p1[e] = s.x + h * v3(&z[..3]) + s.q * rotated;
                     }
                     None => p1[e] = end.fixed,
@@ -634,7 +667,8 @@ impl ImplicitSpringSolver {
             for (e, end) in link.ends.iter().enumerate() {
                 if let Some(s) = self.starts.get(end.body) {
                     let f = if e == 0 { force } else { -force };
-                    let torque = s.free * lin.b[e].cross(s.r.transpose() * f);
+                    let torque = s.free * lin.arm[e].cross(self.mid[end.body].transpose() * f);
+                    self.torque_mid[end.body] += torque;
                     let r = &mut self.residual[6 * end.body..6 * end.body + 6];
                     add(&mut r[..3], -0.5 * h * f);
                     add(&mut r[3..], -0.5 * h * torque);
@@ -684,9 +718,12 @@ impl ImplicitSpringSolver {
     }
 
     /// `Gᵀ f`: the generalized force of a world force `f` at the end (force; principal torque).
-    fn end_transpose(&self, h: f64, body: usize, b: DVec3, f: DVec3) -> (DVec3, DVec3) {
+    fn end_transpose(&self, h: f64, body: usize, arm: DVec3, f: DVec3) -> (DVec3, DVec3) {
         let s = &self.starts[body];
-        (h * f, h * s.free * b.cross(s.r.transpose() * f))
+        (
+            h * f,
+            h * s.free * arm.cross(self.mid[body].transpose() * f),
+        )
     }
 
     /// `out = J u` with the approximate Jacobian of the module docs.
@@ -708,7 +745,7 @@ impl ImplicitSpringSolver {
             for (e, end) in link.ends.iter().enumerate() {
                 if end.body < self.starts.len() {
                     let (lin_part, rot_part) =
-                        self.end_transpose(h, end.body, lin.b[e], if e == 0 { f } else { -f });
+                        self.end_transpose(h, end.body, lin.arm[e], if e == 0 { f } else { -f });
                     let o = &mut out[6 * end.body..6 * end.body + 6];
                     add(&mut o[..3], lin_part);
                     add(&mut o[3..], rot_part);
@@ -724,8 +761,22 @@ impl ImplicitSpringSolver {
         let mut blocks = std::mem::take(&mut self.blocks);
         blocks.clear();
         blocks.extend((0..self.starts.len()).map(|i| self.body_block(h, i)));
-        // The torque arm `b` turns with Ω̄ too: ∂(−½h b × Q₀ᵀf)/∂Ω̄ = −¼h² [Q₀ᵀf]× M [b]×,
-        // with M the Cayley derivative (a body's own block; not symmetric).
+        // The torque turns with Ω̄ too. In the mid-step frame it is T = Sᵀ (b × Q₀ᵀf): the arm
+        // b moves, ∂(b × Q₀ᵀf)/∂Ω̄ = ½h [Q₀ᵀf]× M [b]× (M the Cayley derivative), and Sᵀ turns
+        // by about −½h δΩ̄, adding ½h [T]×; both enter the residual times −½h (a body's own
+        // block; not symmetric). The second is exact only for small turns: it slows Newton at
+        // worst, never moves the solution.
+        for (i, block) in blocks.iter_mut().enumerate() {
+            let s = &self.starts[i];
+            let term = -0.25 * h * h * skew(self.torque_mid[i]);
+            for a in 0..3 {
+                for c in 0..3 {
+                    if s.free[a] > 0.0 && s.free[c] > 0.0 {
+                        block[3 + a][3 + c] += term.col(c)[a];
+                    }
+                }
+            }
+        }
         for (link, lin) in self.links.iter().zip(&self.lin) {
             for (e, end) in link.ends.iter().enumerate() {
                 let Some(s) = self.starts.get(end.body) else {
@@ -735,7 +786,8 @@ impl ImplicitSpringSolver {
                 let term = -0.25
                     * h
                     * h
-                    * (skew(s.r.transpose() * f)
+                    * (skew(self.mid[end.body].transpose() * f)
+                        * self.half_back[end.body]
                         * self.cayley_derivative[end.body]
                         * skew(lin.b[e]));
                 let block = &mut blocks[end.body];
@@ -762,7 +814,7 @@ impl ImplicitSpringSolver {
                     let mut unit = [0.0; 6];
                     unit[c] = 1.0;
                     let g = self.end_jacobian(h, end.body, lin.b[e], &unit);
-                    let (lp, rp) = self.end_transpose(h, end.body, lin.b[e], 0.25 * (lin.k * g));
+                    let (lp, rp) = self.end_transpose(h, end.body, lin.arm[e], 0.25 * (lin.k * g));
                     for a in 0..3 {
                         block[a][c] += lp[a];
                         block[3 + a][c] += rp[a];
