@@ -377,7 +377,15 @@ pub fn solve_implicit_springs(
             });
         }
         match s.solver.step(&mut s.bodies, &s.springs, dt) {
-            Ok(_) => {
+            Ok(stats) => {
+                tracing::trace!(
+                    bodies = s.bodies.len(),
+                    springs = s.springs.len(),
+                    newton = stats.newton_iterations,
+                    linear = stats.linear_iterations,
+                    splits = stats.splits,
+                    "implicit spring group stepped"
+                );
                 for (k, &i) in s.members.iter().enumerate() {
                     if let Ok((_, mut t, mut v, m, _, damping)) = bodies.get_mut(s.entities[i]) {
                         write_body_state(&s.bodies[k].state, m, &mut t, &mut v);
