@@ -132,6 +132,17 @@ pub fn classification_is_stale(world: &World) -> bool {
     }
 }
 
+/// The indices (in `index`) of a spring's two ends, `None` for an end outside it (a world anchor
+/// or a body that is not indexed).
+fn ends_in(index: &EntityHashMap<usize>, spring: &Spring) -> (Option<usize>, Option<usize>) {
+    let a = index.get(&spring.a).copied();
+    let b = match spring.b {
+        SpringEnd::Body { body, .. } => index.get(&body).copied(),
+        SpringEnd::World(_) => None,
+    };
+    (a, b)
+}
+
 fn find(parent: &mut [usize], mut i: usize) -> usize {
     while parent[i] != i {
         parent[i] = parent[parent[i]];
@@ -163,11 +174,7 @@ pub fn classify_springs(world: &mut World) {
     let mut stiff_group = vec![false; masses.len()];
     let mut spring_root = Vec::with_capacity(springs.len());
     for (_, spring) in &springs {
-        let a = index.get(&spring.a).copied();
-        let b = match spring.b {
-            SpringEnd::Body { body, .. } => index.get(&body).copied(),
-            SpringEnd::World(_) => None,
-        };
+        let (a, b) = ends_in(&index, spring);
         let bound = |end: Option<usize>, anchor| {
             end.map_or(0.0, |i| inverse_effective_mass_bound(&masses[i], anchor))
         };
@@ -251,11 +258,23 @@ pub struct ImplicitScratch {
     entities: Vec<Entity>,
     parent: Vec<usize>,
     group_of: Vec<usize>,
-    bodies: Vec<GroupBody>,
-    springs: Vec<GroupSpring>,
-    /// Per body of the current group, its index among all implicit bodies.
+    /// Per root body, its group's number (groups numbered in order of their roots).
+    rank: Vec<usize>,
+    /// Body indices grouped: group `g`'s are `members[member_start[g]..member_start[g + 1]]`,
+    /// in index order.
     members: Vec<usize>,
+    member_start: Vec<usize>,
+    /// Springs grouped the same way, in query order within a group, their ends as indices
+    /// local to the group.
+    springs: Vec<GroupSpring>,
+    spring_start: Vec<usize>,
+    /// Each spring's group, before the springs are grouped.
+    pending: Vec<(usize, GroupSpring)>,
+    cursor: Vec<usize>,
+    /// Per body, its index within its group.
     local: Vec<usize>,
+    /// The current group's bodies, handed to the solver.
+    bodies: Vec<GroupBody>,
     /// Every implicit body of the world, in query order.
     all: Vec<GroupBody>,
 }
@@ -303,90 +322,113 @@ pub fn solve_implicit_springs(
             load: acc.take(),
         });
     }
-    let end_index = |index: &EntityHashMap<usize>, spring: &Spring| {
-        let a = index.get(&spring.a).copied();
-        let b = match spring.b {
-            SpringEnd::Body { body, .. } => index.get(&body).copied(),
-            SpringEnd::World(_) => None,
-        };
-        (a, b)
-    };
     for spring in &springs {
-        if let (Some(i), Some(j)) = end_index(&s.index, spring) {
+        if let (Some(i), Some(j)) = ends_in(&s.index, spring) {
             let (ri, rj) = (find(&mut s.parent, i), find(&mut s.parent, j));
             s.parent[ri] = rj;
         }
     }
+    let n = s.entities.len();
     s.group_of.clear();
-    for i in 0..s.entities.len() {
+    for i in 0..n {
         let r = find(&mut s.parent, i);
         s.group_of.push(r);
     }
+    // Groups in order of their roots, members in index order (query order: deterministic),
+    // by counting sort: one pass over the bodies and one over the springs, whatever the number
+    // of groups.
+    s.rank.clear();
+    s.rank.resize(n, usize::MAX);
+    let mut groups = 0;
+    for i in 0..n {
+        if s.group_of[i] == i {
+            s.rank[i] = groups;
+            groups += 1;
+        }
+    }
+    let (rank, group_of) = (&s.rank, &s.group_of);
+    counting_starts(
+        &mut s.member_start,
+        groups,
+        (0..n).map(|i| rank[group_of[i]]),
+    );
+    s.members.clear();
+    s.members.resize(n, 0);
     s.local.clear();
-    s.local.resize(s.entities.len(), usize::MAX);
-    // Groups in order of their first member (query order: deterministic).
-    for root in 0..s.entities.len() {
-        if s.group_of[root] != root {
-            continue;
-        }
-        s.members.clear();
-        s.bodies.clear();
-        for i in 0..s.entities.len() {
-            if s.group_of[i] == root {
-                s.local[i] = s.members.len();
-                s.members.push(i);
-                s.bodies.push(s.all[i]);
-            }
-        }
-        s.springs.clear();
-        for spring in &springs {
-            let (a, b) = end_index(&s.index, spring);
-            // Orient each spring so that its first end is a member of this group.
-            let (first, anchor_first, second) = match (a, b, spring.b) {
-                (Some(i), _, _) if s.group_of[i] == root => (i, spring.anchor_a, spring.b),
-                (_, Some(j), SpringEnd::Body { anchor, .. }) if s.group_of[j] == root => (
-                    j,
-                    anchor,
-                    SpringEnd::Body {
-                        body: spring.a,
-                        anchor: spring.anchor_a,
-                    },
-                ),
-                _ => continue,
-            };
-            let end = match second {
-                SpringEnd::World(p) => LinkEnd::Fixed(p),
-                SpringEnd::Body { body, anchor } => match s.index.get(&body) {
-                    Some(&k) => LinkEnd::Body {
-                        index: s.local[k],
-                        anchor,
-                    },
-                    None => match others.get(body) {
-                        // A static, kinematic or quarantined body holds its anchor still.
-                        Ok(t) => LinkEnd::Fixed(t.transform_point(anchor)),
-                        Err(_) => continue,
-                    },
+    s.local.resize(n, 0);
+    s.cursor.clear();
+    s.cursor.extend_from_slice(&s.member_start[..groups]);
+    for i in 0..n {
+        let g = s.rank[s.group_of[i]];
+        s.local[i] = s.cursor[g] - s.member_start[g];
+        s.members[s.cursor[g]] = i;
+        s.cursor[g] += 1;
+    }
+    s.pending.clear();
+    for spring in &springs {
+        // Orient each spring so that its first end is an implicit body.
+        let (first, anchor_first, second) = match (ends_in(&s.index, spring), spring.b) {
+            ((Some(i), _), _) => (i, spring.anchor_a, spring.b),
+            ((None, Some(j)), SpringEnd::Body { anchor, .. }) => (
+                j,
+                anchor,
+                SpringEnd::Body {
+                    body: spring.a,
+                    anchor: spring.anchor_a,
                 },
-            };
-            s.springs.push(GroupSpring {
-                a: s.local[first],
-                anchor_a: anchor_first,
-                b: end,
-                stiffness: spring.stiffness,
-                rest_length: spring.rest_length,
-            });
-        }
-        match s.solver.step(&mut s.bodies, &s.springs, dt) {
+            ),
+            _ => continue,
+        };
+        let end = match second {
+            SpringEnd::World(p) => LinkEnd::Fixed(p),
+            SpringEnd::Body { body, anchor } => match s.index.get(&body) {
+                Some(&k) => LinkEnd::Body {
+                    index: s.local[k],
+                    anchor,
+                },
+                None => match others.get(body) {
+                    // A static, kinematic or quarantined body holds its anchor still.
+                    Ok(t) => LinkEnd::Fixed(t.transform_point(anchor)),
+                    Err(_) => continue,
+                },
+            },
+        };
+        let link = GroupSpring {
+            a: s.local[first],
+            anchor_a: anchor_first,
+            b: end,
+            stiffness: spring.stiffness,
+            rest_length: spring.rest_length,
+        };
+        s.pending.push((s.rank[s.group_of[first]], link));
+    }
+    counting_starts(&mut s.spring_start, groups, s.pending.iter().map(|p| p.0));
+    // Sized by the pending springs, then each written to its group's slot.
+    s.springs.clear();
+    s.springs.extend(s.pending.iter().map(|p| p.1));
+    s.cursor.clear();
+    s.cursor.extend_from_slice(&s.spring_start[..groups]);
+    for &(g, link) in &s.pending {
+        s.springs[s.cursor[g]] = link;
+        s.cursor[g] += 1;
+    }
+    for g in 0..groups {
+        let members = s.member_start[g]..s.member_start[g + 1];
+        s.bodies.clear();
+        s.bodies
+            .extend(s.members[members.clone()].iter().map(|&i| s.all[i]));
+        let springs = &s.springs[s.spring_start[g]..s.spring_start[g + 1]];
+        match s.solver.step(&mut s.bodies, springs, dt) {
             Ok(stats) => {
                 tracing::trace!(
                     bodies = s.bodies.len(),
-                    springs = s.springs.len(),
+                    springs = springs.len(),
                     newton = stats.newton_iterations,
                     linear = stats.linear_iterations,
                     splits = stats.splits,
                     "implicit spring group stepped"
                 );
-                for (k, &i) in s.members.iter().enumerate() {
+                for (k, &i) in s.members[members].iter().enumerate() {
                     if let Ok((_, mut t, mut v, m, _, damping)) = bodies.get_mut(s.entities[i]) {
                         write_body_state(&s.bodies[k].state, m, &mut t, &mut v);
                         if let Some(d) = damping {
@@ -397,7 +439,7 @@ pub fn solve_implicit_springs(
                 }
             }
             Err(error) => {
-                for &i in &s.members {
+                for &i in &s.members[members] {
                     reject(
                         &mut commands,
                         BodyError {
@@ -408,5 +450,18 @@ pub fn solve_implicit_springs(
                 }
             }
         }
+    }
+}
+
+/// Fills `starts` (length `groups + 1`) with the prefix sums of how many of `keys` fall in each
+/// group: group `g`'s items go to `starts[g]..starts[g + 1]`.
+fn counting_starts(starts: &mut Vec<usize>, groups: usize, keys: impl Iterator<Item = usize>) {
+    starts.clear();
+    starts.resize(groups + 1, 0);
+    for g in keys {
+        starts[g + 1] += 1;
+    }
+    for g in 0..groups {
+        starts[g + 1] += starts[g];
     }
 }

@@ -167,6 +167,13 @@ struct Start {
     lock_scale: f64,
 }
 
+impl Start {
+    /// The body-frame angular velocity `I⁻¹ Π` of a body momentum, 0 on a locked axis.
+    fn angular_velocity(&self, pi: DVec3) -> DVec3 {
+        self.free * pi / self.inertia.max(DVec3::splat(f64::MIN_POSITIVE))
+    }
+}
+
 /// One spring end after the start geometry is known.
 #[derive(Debug, Clone, Copy, Default)]
 struct End {
@@ -288,6 +295,13 @@ fn cayley(w: DVec3) -> DQuat {
     DQuat::from_xyzw(half.x, half.y, half.z, 1.0).normalize()
 }
 
+/// `√c` for a unit quaternion with `w > −1` (always, for a Cayley rotation): `c + 1`
+/// normalized, half the angle about the same axis, without trigonometry.
+#[inline]
+fn half_rotation(c: DQuat) -> DQuat {
+    DQuat::from_xyzw(c.x, c.y, c.z, c.w + 1.0).normalize()
+}
+
 fn v3(z: &[f64]) -> DVec3 {
     DVec3::new(z[0], z[1], z[2])
 }
@@ -379,7 +393,7 @@ impl ImplicitSpringSolver {
         let n = bodies.len() * 6;
         self.z.clear();
         for s in &self.starts {
-            let omega = s.free * (s.pi / s.inertia.max(DVec3::splat(f64::MIN_POSITIVE)));
+            let omega = s.angular_velocity(s.pi);
             self.z
                 .extend_from_slice(&[s.v.x, s.v.y, s.v.z, omega.x, omega.y, omega.z]);
         }
@@ -592,7 +606,7 @@ impl ImplicitSpringSolver {
             .starts
             .iter()
             .map(|s| {
-                let omega = s.free * s.pi / s.inertia.max(DVec3::splat(f64::MIN_POSITIVE));
+                let omega = s.angular_velocity(s.pi);
                 0.5 * s.mass * s.v.length_squared() + 0.5 * s.pi.dot(omega)
             })
             .sum();
@@ -637,9 +651,7 @@ impl ImplicitSpringSolver {
             let wbar = s.free * v3(&z[3..]);
             let c = cayley(h * wbar);
             self.cayley.push(c);
-            // √c for a unit quaternion with w > −1 (always, for a Cayley rotation): normalize
-            // c + 1. Half the angle about the same axis, without trigonometry.
-            let half = DQuat::from_xyzw(c.x, c.y, c.z, c.w + 1.0).normalize();
+            let half = half_rotation(c);
             self.half.push(half);
             self.mid.push(DMat3::from_quat(s.q * half));
             // From (1 − [w/2]×) cay(w) a = (1 + [w/2]×) a: d(cay(w) a) = −(1 − [w/2]×)⁻¹ [b]× dw,
@@ -714,7 +726,7 @@ impl ImplicitSpringSolver {
     fn mid_torque(&self, h: f64, i: usize, w: DVec3) -> DVec3 {
         let s = &self.starts[i];
         let c = cayley(h * w);
-        let half = DQuat::from_xyzw(c.x, c.y, c.z, c.w + 1.0).normalize();
+        let half = half_rotation(c);
         let to_mid = (s.q * half).inverse();
         let mut torque = to_mid * s.torque;
         for &(link, e) in &self.ends_of[self.ends_start[i]..self.ends_start[i + 1]] {
@@ -876,7 +888,7 @@ impl ImplicitSpringSolver {
             let wbar = s.free * v3(&z[3..]);
             let q1 = (s.q * cayley(h * wbar)).normalize();
             let pi1 = s.free * (2.0 * s.inertia * wbar - s.pi);
-            let omega1 = s.free * pi1 / s.inertia.max(DVec3::splat(f64::MIN_POSITIVE));
+            let omega1 = s.angular_velocity(pi1);
             let rotation = (q1 * body.mass.principal_frame().widen().inverse()).normalize();
             let state = BodyState {
                 position: (s.x + h * vbar).narrow(),
