@@ -45,11 +45,16 @@
 //! # The solve
 //!
 //! The unknowns `(v̄, Ω̄)` of all bodies of the group solve a nonlinear system by Newton's method
-//! with an approximate Jacobian: the mass and gyroscopic blocks exactly, each spring's coupling
-//! as `¼ Gᵀ K G` with `K = k (m̂m̂ᵀ + max(1 − L₀/ℓ̄, 0)(1 − m̂m̂ᵀ))` (the spring's stiffness,
-//! its compressive geometric part dropped so the coupling stays positive) and `G` the anchor's
-//! Jacobian. The linear systems are solved by BiCGSTAB with a block-Jacobi preconditioner;
-//! a step that does not reduce the residual is halved. Iteration stops when the Newton update
+//! with its exact matrix: the mass and gyroscopic blocks, each spring's coupling `¼ Gᵀ K G` with
+//! `K = k ((1 − L₀/ℓ̄) 1 + (L₀/ℓ̄²) d̄ d₁ᵀ/ℓ₁)` (the discrete-gradient force's derivative, not
+//! symmetric and indefinite for a compressed spring) and `G` the anchor's Jacobian, and the
+//! turning of the torques' frame and arms with `Ω̄` (forward differences per body).
+//!
+//! Each Newton system is solved directly (module `springs::sparse`: block elimination in
+//! minimum-degree order, no fill on a chain or a tree), wrapped in BiCGSTAB so that a singular
+//! pivot falls back to block Jacobi instead of failing. A step that does not reduce the residual
+//! is shortened (backtracking), and a trust region limits each update's change of rotation.
+//! Iteration stops when the error left, estimated from the contraction of the last two updates,
 //! is below [`ImplicitSpringSolver::tolerance`] in the kinetic-energy norm, relative to the
 //! group's energy.
 
@@ -57,6 +62,7 @@ use glam::{DMat3, DQuat, DVec3};
 use thiserror::Error;
 
 use super::linear::{Block, Krylov, block_mul, invert};
+use super::sparse::BlockLu;
 use crate::mass::MassProperties;
 use crate::math::{Narrow, Real, Vec3, Widen};
 use crate::state::{BodyState, Wrench};
@@ -143,6 +149,17 @@ pub struct SolveStats {
     pub splits: usize,
 }
 
+/// The default [`ImplicitSpringSolver::tolerance`]: a step's energy error is about twice it,
+/// relative. Set below what storing the state costs anyway: rounding an `f32` state moves a
+/// group's energy by ~1e-7 of it each step, an `f64` state by ~1e-16.
+#[cfg(not(feature = "f64"))]
+pub const DEFAULT_TOLERANCE: f64 = 1e-8;
+/// The default [`ImplicitSpringSolver::tolerance`]: a step's energy error is about twice it,
+/// relative. Set below what storing the state costs anyway: rounding an `f32` state moves a
+/// group's energy by ~1e-7 of it each step, an `f64` state by ~1e-16.
+#[cfg(feature = "f64")]
+pub const DEFAULT_TOLERANCE: f64 = 1e-10;
+
 /// How many times a step may be halved, recursively, before the implicit step gives up
 /// (`2^MAX_SPLITS` pieces at most).
 pub const MAX_SPLITS: u32 = 8;
@@ -213,7 +230,8 @@ struct Linearized {
 /// the buffers have grown to the group's size).
 #[derive(Debug, Clone)]
 pub struct ImplicitSpringSolver {
-    /// Relative tolerance of the Newton update in the kinetic-energy norm (default `1e-10`).
+    /// Relative tolerance of the Newton update in the kinetic-energy norm (default
+    /// [`DEFAULT_TOLERANCE`]).
     pub tolerance: f64,
     /// Newton iterations of one solve before the step is split (default 20; see [`Self::step`]).
     pub max_newton: usize,
@@ -242,6 +260,12 @@ pub struct ImplicitSpringSolver {
     /// Per body, `(1 − [hΩ̄/2]×)⁻¹`: the derivative of the Cayley rotation (see `evaluate`).
     cayley_derivative: Vec<DMat3>,
     krylov: Krylov,
+    /// The direct factorization of the Newton matrix (the preconditioner when it exists).
+    lu: BlockLu,
+    /// Per spring, the Newton-matrix factors of its body ends (scratch of the factorization).
+    factors: Vec<[Option<EndFactors>; 2]>,
+    /// True when `lu` holds a factorization of the current Newton matrix.
+    factored: bool,
     /// The states at the start of the step, restored if it fails part-way.
     saved: Vec<BodyState>,
 }
@@ -249,7 +273,7 @@ pub struct ImplicitSpringSolver {
 impl Default for ImplicitSpringSolver {
     fn default() -> Self {
         Self {
-            tolerance: 1e-10,
+            tolerance: DEFAULT_TOLERANCE,
             max_newton: 20,
             starts: Vec::new(),
             links: Vec::new(),
@@ -270,6 +294,9 @@ impl Default for ImplicitSpringSolver {
             mid: Vec::new(),
             cayley_derivative: Vec::new(),
             krylov: Krylov::default(),
+            lu: BlockLu::default(),
+            factors: Vec::new(),
+            factored: false,
             saved: Vec::new(),
         }
     }
@@ -411,25 +438,37 @@ impl ImplicitSpringSolver {
         let mut norm = self.evaluate(h);
         let mut update = f64::INFINITY;
         let mut iterations = 0;
+        let (mut previous_full, mut previous_step) = (f64::INFINITY, 0.0);
         while iterations < self.max_newton {
             iterations += 1;
             stats.newton_iterations += 1;
-            self.build_preconditioner(h);
+            self.build_blocks(h);
+            self.factor(h);
             for (b, r) in self.rhs.iter_mut().zip(&self.residual) {
                 *b = -r;
             }
             let rhs = std::mem::take(&mut self.rhs);
             let mut delta = std::mem::take(&mut self.delta);
             let mut krylov = std::mem::take(&mut self.krylov);
-            stats.linear_iterations += krylov.solve(
+            let mut lu = std::mem::take(&mut self.lu);
+            let factored = self.factored;
+            let linear_iterations = krylov.solve(
                 &rhs,
                 &mut delta,
                 1e-9,
                 400,
                 |u, out| self.apply_jacobian(h, u, out),
-                |u, out| self.apply_preconditioner(u, out),
+                |u, out| {
+                    if factored {
+                        lu.solve(u, out);
+                    } else {
+                        self.apply_preconditioner(u, out);
+                    }
+                },
             );
             self.krylov = krylov;
+            self.lu = lu;
+            stats.linear_iterations += linear_iterations;
             self.rhs = rhs;
             // Backtrack on the residual norm: a full Newton step can overshoot far from the
             // solution (large rotations make the spring geometry strongly nonlinear).
@@ -477,6 +516,21 @@ impl ImplicitSpringSolver {
             if update <= self.tolerance {
                 break;
             }
+            // Near the solution Newton's method contracts at a falling rate: with the rate
+            // θ = |δₖ|/|δₖ₋₁| of two full steps, the error left after δₖ is at most
+            // θ/(1 − θ)·|δₖ| (the tail of a geometric series), so the step is done once that is
+            // within the tolerance; it saves the last iteration, whose only use would be to
+            // show the update is small.
+            let rate = full / previous_full;
+            if step == 1.0 && previous_step == 1.0 && rate < 0.5 {
+                let left = rate / (1.0 - rate) * update;
+                if left <= self.tolerance {
+                    update = left;
+                    break;
+                }
+            }
+            previous_full = full;
+            previous_step = step;
             if stagnating {
                 // Stuck on a tiny step in a valley of the residual that holds no solution
                 // nearby: typically the bodies must turn by about π or more within the step,
@@ -779,7 +833,8 @@ impl ImplicitSpringSolver {
         )
     }
 
-    /// `out = J u` with the approximate Jacobian of the module docs.
+    /// `out = J u`: the Newton matrix (the body blocks of [`Self::build_blocks`] and the
+    /// springs' `¼ GᵀKG`, applied spring by spring) times `u`.
     fn apply_jacobian(&self, h: f64, u: &[f64], out: &mut [f64]) {
         for (i, block) in self.blocks.iter().enumerate() {
             let y = block_mul(block, &u[6 * i..6 * i + 6]);
@@ -807,29 +862,29 @@ impl ImplicitSpringSolver {
         }
     }
 
-    /// The body blocks of the Jacobian at the current iterate, and the block-Jacobi
-    /// preconditioner: each body's block plus its springs' diagonal coupling `¼ GᵀKG`, inverted
-    /// (a diagonal scaled by the mass and inertia where singular).
-    fn build_preconditioner(&mut self, h: f64) {
+    /// The body blocks of the Newton matrix at the current iterate: mass, inertia and
+    /// gyroscopic terms, and the turning of the torques' frame and arms with `Ω̄`.
+    fn build_blocks(&mut self, h: f64) {
         let mut blocks = std::mem::take(&mut self.blocks);
         blocks.clear();
         blocks.extend((0..self.starts.len()).map(|i| self.body_block(h, i)));
         // The torques turn with Ω̄ too (forces held): the mid-step frame Q₀S and the arms
         // (S a + Sᵀa)/2 depend on Ω̄ through the half rotation S. Their derivative, a body's own
-        // 3×3 block (not symmetric), is taken by central differences of `mid_torque`: exact to
-        // ~1e-9 relative, and cheap (three perturbations of a body's own ends).
+        // 3×3 block (not symmetric), is taken by forward differences of `mid_torque` (three
+        // perturbations of a body's own ends): good to ~1e-8 relative, which leaves Newton's
+        // convergence quadratic down to far below the tolerance.
         for (i, block) in blocks.iter_mut().enumerate() {
             let s = &self.starts[i];
             let w = s.free * v3(&self.z[6 * i + 3..6 * i + 6]);
-            let eps = 1e-6 * (1.0 + w.length());
+            let eps = 1e-8 * (1.0 + w.length());
+            let base = self.mid_torque(h, i, w);
             for c in 0..3 {
                 if s.free[c] == 0.0 {
                     continue;
                 }
                 let mut dw = DVec3::ZERO;
                 dw[c] = eps;
-                let column = (self.mid_torque(h, i, w + dw) - self.mid_torque(h, i, w - dw))
-                    * (-0.5 * h / (2.0 * eps));
+                let column = (self.mid_torque(h, i, w + dw) - base) * (-0.5 * h / eps);
                 for a in 0..3 {
                     if s.free[a] > 0.0 {
                         block[3 + a][3 + c] += column[a];
@@ -837,29 +892,62 @@ impl ImplicitSpringSolver {
                 }
             }
         }
+        self.blocks = blocks;
+    }
+
+    /// Factors the Newton matrix at the current iterate: the body blocks of
+    /// [`Self::build_blocks`] plus the springs' part `¼ GᵀKG`, by [`BlockLu`]; where a pivot is
+    /// singular, block Jacobi instead (each body's diagonal block inverted, or its mass and
+    /// inertia where that block is singular too).
+    fn factor(&mut self, h: f64) {
         let mut preconditioner = std::mem::take(&mut self.preconditioner);
         preconditioner.clear();
-        preconditioner.extend_from_slice(&blocks);
+        preconditioner.extend_from_slice(&self.blocks);
+        // The springs' part ¼ GᵀKG of the Newton matrix, block by block: a body's own ends on
+        // its diagonal block, the coupling of the two ends of a spring between two bodies off it.
+        let len = self.starts.len();
+        let mut factors = std::mem::take(&mut self.factors);
+        factors.clear();
         for (link, lin) in self.links.iter().zip(&self.lin) {
+            let k = 0.25 * lin.k;
+            let ends: [Option<EndFactors>; 2] = [0, 1].map(|e| {
+                let body = link.ends[e].body;
+                (body < len).then(|| self.end_factors(h, body, lin.b[e], lin.arm[e]))
+            });
             for (e, end) in link.ends.iter().enumerate() {
-                if end.body >= self.starts.len() {
-                    continue;
-                }
-                let block = &mut preconditioner[end.body];
-                // Column c of ¼ Gᵀ K G, from the unit update e_c.
-                for c in 0..6 {
-                    let mut unit = [0.0; 6];
-                    unit[c] = 1.0;
-                    let g = self.end_jacobian(h, end.body, lin.b[e], &unit);
-                    let (lp, rp) = self.end_transpose(h, end.body, lin.arm[e], 0.25 * (lin.k * g));
-                    for a in 0..3 {
-                        block[a][c] += lp[a];
-                        block[3 + a][c] += rp[a];
-                    }
+                let Some(fe) = &ends[e] else { continue };
+                add_block(&mut preconditioner[end.body], &coupling(h, k, fe, fe, 1.0));
+                // A spring with both ends on one body couples them on its diagonal block.
+                if let Some(ff) = &ends[1 - e]
+                    && link.ends[1 - e].body == end.body
+                {
+                    add_block(&mut preconditioner[end.body], &coupling(h, k, fe, ff, -1.0));
                 }
             }
+            factors.push(ends);
         }
-        for (s, block) in self.starts.iter().zip(preconditioner.iter_mut()) {
+        let mut lu = std::mem::take(&mut self.lu);
+        lu.reset(&preconditioner);
+        for ((link, lin), ends) in self.links.iter().zip(&self.lin).zip(&factors) {
+            let k = 0.25 * lin.k;
+            let [a, b] = link.ends;
+            if let [Some(fa), Some(fb)] = ends
+                && a.body != b.body
+            {
+                lu.add(a.body, b.body, &coupling(h, k, fa, fb, -1.0));
+                lu.add(b.body, a.body, &coupling(h, k, fb, fa, -1.0));
+            }
+        }
+        self.factors = factors;
+        self.factored = lu.factor().is_ok();
+        self.lu = lu;
+        // Block Jacobi only where the direct factorization failed (a singular pivot).
+        for (s, block) in self
+            .starts
+            .iter()
+            .zip(preconditioner.iter_mut())
+            .filter(|_| !self.factored)
+        {
             *block = invert(block).unwrap_or_else(|| {
                 let mut d = [[0.0; 6]; 6];
                 for (a, row) in d.iter_mut().enumerate() {
@@ -868,8 +956,21 @@ impl ImplicitSpringSolver {
                 d
             });
         }
-        self.blocks = blocks;
         self.preconditioner = preconditioner;
+    }
+
+    /// The two 3×3 factors of a spring end's blocks of the Newton matrix (see [`coupling`]) on
+    /// body `i`, with mean anchor `b` and lever arm `arm` (see [`Linearized`]):
+    /// `G_turn = −h R C [b]× F`, how the body's turn moves the anchor (see `end_jacobian`), and
+    /// `E_turn = h F [arm]× Mᵀ`, the torque of a world force at the anchor (see
+    /// `end_transpose`); `F` masks locked axes, `M` is the mid-step frame.
+    fn end_factors(&self, h: f64, i: usize, b: DVec3, arm: DVec3) -> EndFactors {
+        let s = &self.starts[i];
+        let free = DMat3::from_diagonal(s.free);
+        EndFactors {
+            move_by_turn: -h * (s.r * self.cayley_derivative[i] * skew(b)) * free,
+            torque_of_force: h * free * skew(arm) * self.mid[i].transpose(),
+        }
     }
 
     fn apply_preconditioner(&self, u: &[f64], out: &mut [f64]) {
@@ -905,6 +1006,43 @@ impl ImplicitSpringSolver {
             body.state = state;
         }
         Ok(())
+    }
+}
+
+/// A spring end's factors of the Newton matrix, see `ImplicitSpringSolver::end_factors`.
+#[derive(Debug, Clone, Copy)]
+struct EndFactors {
+    move_by_turn: DMat3,
+    torque_of_force: DMat3,
+}
+
+/// The block `sign · Eₑᵀ K G_f` of the Newton matrix that spring end `e` receives from end `f`
+/// (`K` = ¼ of the spring's stiffness matrix): `G_f = [h 1, G_turn]` maps the update of end `f`'s
+/// body to its anchor's motion, `Eₑᵀ = [h 1; E_turn]` maps a world force at end `e` to its body's
+/// generalized force.
+fn coupling(h: f64, k: DMat3, e: &EndFactors, f: &EndFactors, sign: f64) -> Block {
+    let k = sign * k;
+    let k_turn = k * f.move_by_turn;
+    let torque_k = e.torque_of_force * k;
+    let parts = [
+        [(h * h) * k, h * k_turn],
+        [h * torque_k, torque_k * f.move_by_turn],
+    ];
+    let mut block = [[0.0; 6]; 6];
+    for (r, row) in block.iter_mut().enumerate() {
+        for (c, x) in row.iter_mut().enumerate() {
+            *x = parts[r / 3][c / 3].col(c % 3)[r % 3];
+        }
+    }
+    block
+}
+
+/// `a += b` for 6×6 blocks.
+fn add_block(a: &mut Block, b: &Block) {
+    for (x, y) in a.iter_mut().zip(b) {
+        for (u, v) in x.iter_mut().zip(y) {
+            *u += v;
+        }
     }
 }
 
@@ -983,7 +1121,8 @@ mod jacobian_tests {
         ];
         solver.residual = vec![0.0; n];
         solver.evaluate(h);
-        solver.build_preconditioner(h);
+        solver.build_blocks(h);
+        solver.factor(h);
         let base = solver.z.clone();
         for j in 0..n {
             let mut unit = vec![0.0; n];
@@ -1003,7 +1142,8 @@ mod jacobian_tests {
             let r_minus = solver.residual.clone();
             solver.z = base.clone();
             solver.evaluate(h);
-            solver.build_preconditioner(h);
+            solver.build_blocks(h);
+            solver.factor(h);
             for i in 0..n {
                 let numeric = (r_plus[i] - r_minus[i]) / (2.0 * eps);
                 let scale = numeric.abs().max(analytic[i].abs()).max(1e-3);
@@ -1012,6 +1152,103 @@ mod jacobian_tests {
                     "J[{i}][{j}]: numeric {numeric:e}, analytic {:e}",
                     analytic[i]
                 );
+            }
+        }
+    }
+
+    /// The direct factorization inverts the Newton matrix that `apply_jacobian` applies, on a
+    /// group with a self-spring, two springs between one pair, a world spring and a loop of
+    /// three bodies (fill-in).
+    #[test]
+    fn the_factorization_inverts_the_newton_matrix() {
+        let mass = |i: Vec3| MassProperties::new(Mass::new(1.3).unwrap(), i).unwrap();
+        let body = |x: Vec3, q: Quat, w: Vec3| GroupBody {
+            state: BodyState {
+                position: x,
+                rotation: q,
+                linear_velocity: Vec3::new(0.1, 0.2, -0.1),
+                angular_velocity: w,
+            },
+            mass: mass(Vec3::new(0.02, 0.03, 0.04)),
+            load: Wrench::default(),
+        };
+        let bodies = [
+            body(
+                Vec3::ZERO,
+                Quat::from_rotation_z(0.3),
+                Vec3::new(1.0, 2.0, -1.0),
+            ),
+            body(
+                Vec3::new(0.9, 0.1, 0.0),
+                Quat::from_rotation_x(0.5),
+                Vec3::new(-2.0, 0.5, 3.0),
+            ),
+            body(
+                Vec3::new(0.4, 0.8, 0.1),
+                Quat::from_rotation_y(-0.4),
+                Vec3::new(0.3, 0.0, 1.0),
+            ),
+        ];
+        let spring = |a: usize, anchor_a: Vec3, b: LinkEnd, stiffness: Real| GroupSpring {
+            a,
+            anchor_a,
+            b,
+            stiffness,
+            rest_length: 0.5,
+        };
+        let to = |index: usize, anchor: Vec3| LinkEnd::Body { index, anchor };
+        let springs = [
+            spring(
+                0,
+                Vec3::new(0.1, 0.05, 0.0),
+                to(1, Vec3::new(-0.1, 0.0, 0.05)),
+                5e5,
+            ),
+            spring(
+                0,
+                Vec3::new(0.0, -0.1, 0.0),
+                to(1, Vec3::new(0.0, 0.1, 0.0)),
+                2e5,
+            ),
+            spring(
+                1,
+                Vec3::new(0.1, 0.0, 0.0),
+                to(2, Vec3::new(0.0, -0.1, 0.0)),
+                3e5,
+            ),
+            spring(
+                2,
+                Vec3::new(-0.1, 0.0, 0.0),
+                to(0, Vec3::new(0.0, 0.1, 0.0)),
+                4e5,
+            ),
+            spring(
+                1,
+                Vec3::new(0.0, 0.0, 0.1),
+                to(1, Vec3::new(0.0, 0.0, -0.1)),
+                1e5,
+            ),
+            spring(2, Vec3::ZERO, LinkEnd::Fixed(Vec3::new(0.0, 2.0, 0.0)), 1e5),
+        ];
+        let h = 1.0 / 60.0;
+        let mut solver = ImplicitSpringSolver::default();
+        solver.prepare(&bodies, &springs).unwrap();
+        let n = 18;
+        solver.z = (0..n).map(|k| (k as f64 * 0.7).sin() * 3.0).collect();
+        solver.residual = vec![0.0; n];
+        solver.evaluate(h);
+        solver.build_blocks(h);
+        solver.factor(h);
+        assert!(solver.factored, "the test matrix is regular");
+        for j in 0..n {
+            let mut unit = vec![0.0; n];
+            unit[j] = 1.0;
+            let mut x = vec![0.0; n];
+            solver.lu.solve(&unit, &mut x);
+            let mut back = vec![0.0; n];
+            solver.apply_jacobian(h, &x, &mut back);
+            for (i, (b, u)) in back.iter().zip(&unit).enumerate() {
+                assert!((b - u).abs() < 1e-9, "(J LU⁻¹)[{i}][{j}] = {b:e}");
             }
         }
     }

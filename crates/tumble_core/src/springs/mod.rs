@@ -8,6 +8,7 @@
 
 pub mod implicit;
 mod linear;
+mod sparse;
 
 pub use implicit::{GroupBody, GroupSpring, ImplicitSpringError, ImplicitSpringSolver, LinkEnd};
 
