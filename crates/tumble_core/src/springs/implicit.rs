@@ -266,6 +266,8 @@ pub struct ImplicitSpringSolver {
     factors: Vec<[Option<EndFactors>; 2]>,
     /// True when `lu` holds a factorization of the current Newton matrix.
     factored: bool,
+    /// True when `lu` holds the elimination order of the current group.
+    analyzed: bool,
     /// The states at the start of the step, restored if it fails part-way.
     saved: Vec<BodyState>,
 }
@@ -297,6 +299,7 @@ impl Default for ImplicitSpringSolver {
             lu: BlockLu::default(),
             factors: Vec::new(),
             factored: false,
+            analyzed: false,
             saved: Vec::new(),
         }
     }
@@ -557,6 +560,7 @@ impl ImplicitSpringSolver {
         bodies: &[GroupBody],
         springs: &[GroupSpring],
     ) -> Result<(), ImplicitSpringError> {
+        self.analyzed = false;
         self.starts.clear();
         for body in bodies {
             let m = &body.mass;
@@ -939,6 +943,11 @@ impl ImplicitSpringSolver {
             }
         }
         self.factors = factors;
+        if !self.analyzed {
+            // The pattern is the group's graph, the same for every Newton iteration of a solve.
+            lu.analyze();
+            self.analyzed = true;
+        }
         self.factored = lu.factor().is_ok();
         self.lu = lu;
         // Block Jacobi only where the direct factorization failed (a singular pivot).

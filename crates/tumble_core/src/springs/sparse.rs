@@ -16,30 +16,36 @@
 //! sparse matrices (faer, nalgebra-sparse) would add large dependencies to the engine core for a
 //! few hundred lines that need nothing but 6×6 products.
 
+use std::cmp::Reverse;
+use std::collections::BinaryHeap;
+
 use super::linear::{Block, block_mul, invert};
+
+/// `c −= a b` for 6×6 blocks, in place.
+#[inline]
+fn subtract_product(c: &mut Block, a: &Block, b: &Block) {
+    for (ci, ai) in c.iter_mut().zip(a) {
+        for (k, &aik) in ai.iter().enumerate() {
+            if aik != 0.0 {
+                for (cij, bkj) in ci.iter_mut().zip(&b[k]) {
+                    *cij -= aik * bkj;
+                }
+            }
+        }
+    }
+}
 
 /// `a b` for 6×6 blocks.
 fn product(a: &Block, b: &Block) -> Block {
     let mut c = [[0.0; 6]; 6];
     for (ci, ai) in c.iter_mut().zip(a) {
         for (k, &aik) in ai.iter().enumerate() {
-            if aik != 0.0 {
-                for (cij, bkj) in ci.iter_mut().zip(&b[k]) {
-                    *cij += aik * bkj;
-                }
+            for (cij, bkj) in ci.iter_mut().zip(&b[k]) {
+                *cij += aik * bkj;
             }
         }
     }
     c
-}
-
-/// `a -= b`.
-fn subtract(a: &mut Block, b: &Block) {
-    for (ai, bi) in a.iter_mut().zip(b) {
-        for (x, y) in ai.iter_mut().zip(bi) {
-            *x -= y;
-        }
-    }
 }
 
 /// One eliminated body: its pivot inverse, the multipliers `A_ip P` of the bodies below it and
@@ -59,10 +65,18 @@ pub(crate) struct BlockLu {
     /// Off-diagonal blocks by row: `rows[i]` holds `(j, A_ij)`; the pattern is symmetric.
     rows: Vec<Vec<(usize, Block)>>,
     diagonal: Vec<Block>,
+    /// Scratch of `analyze`: the bodies already ordered.
     eliminated: Vec<bool>,
     pivots: Vec<Pivot>,
     pivot_count: usize,
     scratch: Vec<f64>,
+    /// The elimination order, from [`BlockLu::analyze`].
+    order: Vec<usize>,
+    /// Per body, where column `j` sits in the row being updated (`usize::MAX`: absent).
+    slot: Vec<usize>,
+    /// The symbolic graph of `analyze`.
+    graph: Vec<Vec<usize>>,
+    queue: BinaryHeap<Reverse<(usize, usize)>>,
 }
 
 /// A block pivot could not be inverted.
@@ -79,8 +93,8 @@ impl BlockLu {
         for row in &mut self.rows {
             row.clear();
         }
-        self.eliminated.clear();
-        self.eliminated.resize(n, false);
+        self.slot.clear();
+        self.slot.resize(n, usize::MAX);
         self.pivot_count = 0;
     }
 
@@ -102,18 +116,58 @@ impl BlockLu {
         }
     }
 
-    /// Factors the matrix in place. Each step eliminates a remaining body with the fewest
-    /// remaining neighbours (the lowest index among equals, so the order, and the bits, depend
-    /// on the matrix alone).
-    pub(crate) fn factor(&mut self) -> Result<(), SingularPivot> {
+    /// Chooses the elimination order from the present pattern (call after the `add`s; the
+    /// order holds for every matrix of the same pattern). Each step eliminates a remaining body
+    /// with the fewest remaining neighbours, counting the fill of earlier steps (the lowest index
+    /// among equals, so the order, and the bits, depend on the pattern alone).
+    pub(crate) fn analyze(&mut self) {
         let n = self.diagonal.len();
-        for _ in 0..n {
-            let p = (0..n)
-                .filter(|&i| !self.eliminated[i])
-                .min_by_key(|&i| self.rows[i].len())
-                .expect("a body remains while pivots are missing");
-            let inverse = invert(&self.diagonal[p]).ok_or(SingularPivot)?;
+        self.graph.resize_with(n.max(self.graph.len()), Vec::new);
+        for (adjacent, row) in self.graph.iter_mut().zip(&self.rows) {
+            adjacent.clear();
+            adjacent.extend(row.iter().map(|(j, _)| *j));
+        }
+        self.slot.clear();
+        self.slot.resize(n, usize::MAX);
+        self.queue.clear();
+        self.queue
+            .extend((0..n).map(|i| Reverse((self.graph[i].len(), i))));
+        self.order.clear();
+        self.eliminated.clear();
+        self.eliminated.resize(n, false);
+        while let Some(Reverse((degree, p))) = self.queue.pop() {
+            if self.eliminated[p] || degree != self.graph[p].len() {
+                continue; // a stale entry: p went already, or its degree changed since
+            }
             self.eliminated[p] = true;
+            self.order.push(p);
+            let neighbours = std::mem::take(&mut self.graph[p]);
+            for &i in &neighbours {
+                // i loses p and gains every other neighbour of p it lacked (the fill).
+                let adjacent = &mut self.graph[i];
+                adjacent.retain(|&j| j != p);
+                for &j in adjacent.iter() {
+                    self.slot[j] = i;
+                }
+                for &j in &neighbours {
+                    if j != i && self.slot[j] != i {
+                        adjacent.push(j);
+                    }
+                }
+                self.queue.push(Reverse((adjacent.len(), i)));
+            }
+            self.graph[p] = neighbours;
+            self.graph[p].clear();
+        }
+        self.slot.fill(usize::MAX);
+    }
+
+    /// Factors the matrix in place, in the order of the last [`BlockLu::analyze`].
+    pub(crate) fn factor(&mut self) -> Result<(), SingularPivot> {
+        debug_assert_eq!(self.order.len(), self.diagonal.len(), "analyze first");
+        for step in 0..self.order.len() {
+            let p = self.order[step];
+            let inverse = invert(&self.diagonal[p]).ok_or(SingularPivot)?;
             if self.pivots.len() <= self.pivot_count {
                 self.pivots.push(Pivot::default());
             }
@@ -122,9 +176,8 @@ impl BlockLu {
             pivot.inverse = inverse;
             pivot.lower.clear();
             pivot.upper.clear();
-            let row = std::mem::take(&mut self.rows[p]);
-            for &(j, a_pj) in &row {
-                pivot.upper.push((j, a_pj));
+            let mut row = std::mem::take(&mut self.rows[p]);
+            for (j, a_pj) in row.drain(..) {
                 // Take A_jp out of row j: p is gone from the remaining matrix.
                 let at = self.rows[j]
                     .iter()
@@ -132,26 +185,28 @@ impl BlockLu {
                     .expect("the pattern is symmetric");
                 let (_, a_jp) = self.rows[j].swap_remove(at);
                 pivot.lower.push((j, product(&a_jp, &inverse)));
+                pivot.upper.push((j, a_pj));
             }
             self.rows[p] = row;
-            self.rows[p].clear();
             // Schur complement: A_ij −= (A_ip P) A_pj over all remaining neighbours i, j of p.
             for (i, l_ip) in &pivot.lower {
+                let row = &mut self.rows[*i];
+                for (at, (j, _)) in row.iter().enumerate() {
+                    self.slot[*j] = at;
+                }
                 for (j, a_pj) in &pivot.upper {
-                    let update = product(l_ip, a_pj);
                     if i == j {
-                        subtract(&mut self.diagonal[*i], &update);
+                        subtract_product(&mut self.diagonal[*i], l_ip, a_pj);
+                    } else if self.slot[*j] != usize::MAX {
+                        subtract_product(&mut row[self.slot[*j]].1, l_ip, a_pj);
                     } else {
-                        let row = &mut self.rows[*i];
-                        match row.iter_mut().find(|(c, _)| c == j) {
-                            Some((_, b)) => subtract(b, &update),
-                            None => {
-                                let mut b = [[0.0; 6]; 6];
-                                subtract(&mut b, &update);
-                                row.push((*j, b));
-                            }
-                        }
+                        self.slot[*j] = row.len();
+                        row.push((*j, [[0.0; 6]; 6]));
+                        subtract_product(&mut row.last_mut().expect("pushed").1, l_ip, a_pj);
                     }
+                }
+                for (j, _) in row.iter() {
+                    self.slot[*j] = usize::MAX;
                 }
             }
             self.pivots[self.pivot_count] = pivot;
@@ -244,6 +299,7 @@ mod tests {
                 off.push((i, j, a));
                 off.push((j, i, b));
             }
+            lu.analyze();
             lu.factor().expect("diagonally dominant");
             let u: Vec<f64> = (0..6 * n).map(|k| (k as f64 * 0.37).sin()).collect();
             let mut x = vec![0.0; 6 * n];
@@ -272,6 +328,7 @@ mod tests {
     fn a_singular_pivot_is_reported() {
         let mut lu = BlockLu::default();
         lu.reset(&[[[0.0; 6]; 6]]);
+        lu.analyze();
         assert_eq!(lu.factor(), Err(SingularPivot));
     }
 }
