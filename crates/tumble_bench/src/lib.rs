@@ -14,6 +14,7 @@ pub mod engines;
 pub mod measure;
 pub mod output;
 pub mod population;
+pub mod springs;
 
 use std::path::PathBuf;
 use tumble_core::math::Vec3;
@@ -113,7 +114,9 @@ pub struct BenchResults {
     pub fixed_cost_ns: Vec<(String, f64)>,
     /// The cost of an unused feature.
     pub unused_feature: UnusedFeature,
-    /// The targets of issue #7.
+    /// Spring chains: the cost of stiffness and spring throughput.
+    pub springs: springs::SpringResults,
+    /// The targets of issue #7 and of the stiff-springs issue.
     pub targets: Vec<Target>,
 }
 
@@ -207,6 +210,7 @@ pub fn run_bench(options: &BenchOptions, mut progress: impl FnMut(&str)) -> Benc
         .collect();
     progress("unused feature: no gravity vs zero gravity");
     let unused_feature = unused_gravity(sizes.last().copied().unwrap_or(1).min(10_000), &effort);
+    let springs = springs::run(options.quick, &mut progress);
     let mut results = BenchResults {
         schema: 1,
         pool_threads: pool_threads(),
@@ -215,6 +219,7 @@ pub fn run_bench(options: &BenchOptions, mut progress: impl FnMut(&str)) -> Benc
         rows,
         fixed_cost_ns,
         unused_feature,
+        springs,
         targets: Vec::new(),
     };
     results.targets = output::targets(&results);

@@ -13,6 +13,7 @@ mod build;
 mod error;
 mod format;
 pub mod output;
+pub mod presets;
 pub mod text;
 mod trajectory;
 mod validate;

@@ -332,6 +332,28 @@ fn half_rotation(c: DQuat) -> DQuat {
     DQuat::from_xyzw(c.x, c.y, c.z, c.w + 1.0).normalize()
 }
 
+/// `∂δθ/∂w` of the half rotation `S` of `cay(hw)` (see `half_rotation`), perturbed in its own
+/// frame (`dS = S [δθ]×`): `S` turns by `φ = atan(h|w|/2)` about `n = w/|w|`, so with
+/// `ψ = φ n`, `∂ψ/∂w = φ'(|w|) nnᵀ + (φ/|w|)(1 − nnᵀ)` and
+/// `δθ = J_r(ψ) δψ`, `J_r(ψ) = 1 − (1 − cos φ)/φ² [ψ]× + (φ − sin φ)/φ³ [ψ]×²`.
+fn half_turn_jacobian(h: f64, w: DVec3) -> DMat3 {
+    let r = w.length();
+    let u = 0.5 * h * r;
+    if u < 1e-6 {
+        // φ ≈ u: ψ ≈ hw/2 and J_r ≈ 1 − [ψ]×/2, to O(u²).
+        return 0.5 * h * (DMat3::IDENTITY - 0.25 * h * skew(w));
+    }
+    let phi = u.atan();
+    let n = w / r;
+    let nn = outer(n, n);
+    let dpsi = (0.5 * h / (1.0 + u * u)) * nn + (phi / r) * (DMat3::IDENTITY - nn);
+    let psi = skew(phi * n);
+    let (sin, cos) = phi.sin_cos();
+    let right = DMat3::IDENTITY - ((1.0 - cos) / (phi * phi)) * psi
+        + ((phi - sin) / (phi * phi * phi)) * (psi * psi);
+    right * dpsi
+}
+
 fn v3(z: &[f64]) -> DVec3 {
     DVec3::new(z[0], z[1], z[2])
 }
@@ -779,21 +801,29 @@ impl ImplicitSpringSolver {
             .sum::<f64>()
     }
 
-    /// The total torque on body `i` in its mid-step frame (its springs' forces and its load held
-    /// at the current iterate's values) if its mean angular velocity were `w`.
-    fn mid_torque(&self, h: f64, i: usize, w: DVec3) -> DVec3 {
+    /// `∂τ/∂Ω̄` of the total torque on body `i` in its mid-step frame `M = Q₀S` (its springs'
+    /// forces and its load held at the current iterate's values): with the half rotation perturbed in its
+    /// own frame, `dS = S [δθ]×`, the pieces move as `d(Mᵀx) = [Mᵀx]× δθ`,
+    /// `d(S a) = −[S a]× S δθ`, `d(Sᵀa) = [Sᵀa]× δθ`, so
+    /// `∂τ/∂θ = [MᵀT]× + Σ ([arm]×[Mᵀf]× − ½[Mᵀf]× ([Sᵀa]× − [S a]× S))`, and
+    /// `δθ = J_r(ψ) ∂ψ/∂Ω̄ δΩ̄` for the rotation vector `ψ = atan(h|Ω̄|/2) Ω̄/|Ω̄|` of `S`
+    /// (`J_r` the right Jacobian of SO(3)).
+    fn turning_torque_jacobian(&self, h: f64, i: usize, w: DVec3) -> DMat3 {
         let s = &self.starts[i];
-        let c = cayley(h * w);
-        let half = half_rotation(c);
+        let half = half_rotation(cayley(h * w));
         let to_mid = (s.q * half).inverse();
-        let mut torque = to_mid * s.torque;
+        let turn = DMat3::from_quat(half);
+        let mut by_theta = skew(to_mid * s.torque);
         for &(link, e) in &self.ends_of[self.ends_start[i]..self.ends_start[i + 1]] {
             let (end, lin) = (&self.links[link].ends[e], &self.lin[link]);
             let f = if e == 0 { lin.force } else { -lin.force };
-            let arm = 0.5 * (half * end.local + half.inverse() * end.local);
-            torque += arm.cross(to_mid * f);
+            let y = skew(to_mid * f);
+            let (turned, back) = (half * end.local, half.inverse() * end.local);
+            let arm = 0.5 * (turned + back);
+            by_theta += skew(arm) * y - 0.5 * y * (skew(back) - skew(turned) * turn);
         }
-        s.free * torque
+        let free = DMat3::from_diagonal(s.free);
+        free * by_theta * half_turn_jacobian(h, w)
     }
 
     /// The mass and gyroscopic 6×6 block of body `i` at the current iterate.
@@ -872,26 +902,17 @@ impl ImplicitSpringSolver {
         let mut blocks = std::mem::take(&mut self.blocks);
         blocks.clear();
         blocks.extend((0..self.starts.len()).map(|i| self.body_block(h, i)));
-        // The torques turn with Ω̄ too (forces held): the mid-step frame Q₀S and the arms
-        // (S a + Sᵀa)/2 depend on Ω̄ through the half rotation S. Their derivative, a body's own
-        // 3×3 block (not symmetric), is taken by forward differences of `mid_torque` (three
-        // perturbations of a body's own ends): good to ~1e-8 relative, which leaves Newton's
-        // convergence quadratic down to far below the tolerance.
+        // The torques turn with Ω̄ too (forces held): the mid-step frame M = Q₀S and the arms
+        // (S a + Sᵀa)/2 depend on Ω̄ through the half rotation S, a body's own 3×3 block (not
+        // symmetric); see `turning_torque_jacobian`.
         for (i, block) in blocks.iter_mut().enumerate() {
             let s = &self.starts[i];
             let w = s.free * v3(&self.z[6 * i + 3..6 * i + 6]);
-            let eps = 1e-8 * (1.0 + w.length());
-            let base = self.mid_torque(h, i, w);
-            for c in 0..3 {
-                if s.free[c] == 0.0 {
-                    continue;
-                }
-                let mut dw = DVec3::ZERO;
-                dw[c] = eps;
-                let column = (self.mid_torque(h, i, w + dw) - base) * (-0.5 * h / eps);
-                for a in 0..3 {
-                    if s.free[a] > 0.0 {
-                        block[3 + a][3 + c] += column[a];
+            let turning = self.turning_torque_jacobian(h, i, w);
+            for a in 0..3 {
+                for c in 0..3 {
+                    if s.free[a] > 0.0 && s.free[c] > 0.0 {
+                        block[3 + a][3 + c] -= 0.5 * h * turning.col(c)[a];
                     }
                 }
             }
