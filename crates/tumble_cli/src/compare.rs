@@ -213,7 +213,7 @@ pub fn run(scene: &Scene, settings: Settings) -> Result<(), Failure> {
     }
     print_energy(&result);
     println!(
-        "time per step: tumble {:.0} ns, rapier {:.0} ns (rapier/tumble = {:.1})",
+        "time per step: tumble {:.0} ns, rapier {:.0} ns (rapier/tumble = {:.2})",
         result.tumble_ns_per_step,
         result.rapier_ns_per_step,
         result.speed_ratio()
