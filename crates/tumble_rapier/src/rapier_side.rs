@@ -60,7 +60,13 @@ impl RapierScene {
     /// As joints, each spring is a `SpringJointBuilder::new(L₀, k, c)` with
     /// `local_anchor1/2` = the scene's anchors (both conventions are relative to the body
     /// origin) and rapier's default spring model (`MotorModel::ForceBased`: `k` and `c` are the
-    /// physical constants); a world end is a fixed body at the world point, anchor 0.
+    /// physical constants); a world end is a fixed body at the world point, anchor 0. As
+    /// forces, every step resets each body's forces and adds its loads and, at the current
+    /// anchors, `F_a = −(k (ℓ − L₀) + c (u·n)) n` to `a` and `−F_a` to `b`
+    /// (`add_force_at_point`), held over rapier's substeps.
+    ///
+    /// # Panics
+    /// If a spring names a body index outside `scene.bodies`.
     pub fn with_springs(
         scene: &ComparisonScene,
         gyroscopic: bool,

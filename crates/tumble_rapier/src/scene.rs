@@ -122,6 +122,9 @@ impl ComparisonScene {
 
     /// The world position of a body-local anchor (relative to the body origin) of body `i` in
     /// state `state`: `x + R (a − c)`, in `f64`.
+    ///
+    /// # Panics
+    /// If `i` is not an index of `bodies`.
     pub fn anchor_point(&self, i: usize, state: &BodyState, anchor: Vec3) -> glam::DVec3 {
         let c = self.bodies[i].mass.local_center_of_mass().widen();
         state.position.widen() + state.rotation.widen() * (anchor.widen() - c)
@@ -135,6 +138,9 @@ impl ComparisonScene {
     /// with `w` the angular velocity in the body's principal frame, `s` the gravity scale and the
     /// gravity potential's zero at the origin. Damping and constant loads are not counted (their
     /// work is not a potential).
+    ///
+    /// # Panics
+    /// If `states` is shorter than `bodies` or a spring names a body index outside `bodies`.
     pub fn total_energy(&self, states: &[BodyState]) -> f64 {
         let g = self.gravity.unwrap_or(Vec3::ZERO).widen();
         let bodies: f64 = self
