@@ -40,9 +40,5 @@ pub fn scene(n: usize) -> ComparisonScene {
             ComparisonBody::new(format!("b{i}"), properties, state)
         })
         .collect();
-    ComparisonScene {
-        dt: DT,
-        gravity: Some(GRAVITY),
-        bodies,
-    }
+    ComparisonScene::new(DT, Some(GRAVITY), bodies)
 }

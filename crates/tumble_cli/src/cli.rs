@@ -66,6 +66,15 @@ pub enum Command {
         /// rapier's gyroscopic term.
         #[arg(long, default_value = "on", value_parser = ["on", "off"])]
         gyroscopic: String,
+        /// How tumble steps springs: `auto` (implicit for stiff spring groups), `explicit` or
+        /// `implicit` (default: the scene's `[world] springs`, else `auto`).
+        #[arg(long)]
+        springs: Option<OsString>,
+        /// How springs are built in rapier: `joint` (its `SpringJoint`, force-based model: what a
+        /// rapier user picks; implicit, loses energy) or `force` (the spring force added with
+        /// `add_force_at_point` every step: explicit, gains energy, diverges when stiff).
+        #[arg(long, default_value = "joint")]
+        rapier_springs: OsString,
         /// Compare even when tumble predicts the step unstable for this scene.
         #[arg(long)]
         allow_unstable: bool,

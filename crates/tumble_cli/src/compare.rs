@@ -4,18 +4,42 @@ use glam::DQuat;
 use tumble_core::exact::TorqueFreeTop;
 use tumble_core::math::{Narrow, Quat, Real, Vec3, Widen, to_f64};
 use tumble_core::{BodyState, Integrator};
-use tumble_rapier::{ComparisonBody, ComparisonOptions, ComparisonScene, Load, compare};
+use tumble_ecs::prelude::SpringSolver;
+use tumble_rapier::{
+    Comparison, ComparisonBody, ComparisonOptions, ComparisonScene, ComparisonSpring,
+    ComparisonSpringEnd, Load, RapierSprings, compare,
+};
 use tumble_scene::text::terminal_safe;
 use tumble_scene::{ForceDef, Scene};
 
 use crate::exit::{self, Failure};
 
+/// How `tumble compare` runs the two engines.
+#[derive(Debug, Clone, Copy)]
+pub struct Settings {
+    /// tumble's integrator.
+    pub integrator: Integrator,
+    /// rapier's gyroscopic term.
+    pub gyroscopic: bool,
+    /// tumble's spring step.
+    pub springs: SpringSolver,
+    /// rapier's springs: its `SpringJoint` or a force added by hand.
+    pub rapier_springs: RapierSprings,
+}
+
 /// Builds the comparison and prints, per body, the largest difference to rapier and to the
-/// exact solution where one exists, and the speed ratio.
+/// exact solution where one exists, each engine's total energy, and the speed ratio.
 ///
-/// A body that tumble quarantined, or whose state went non-finite in either engine, is named on
-/// stderr and the command fails with [`exit::REJECTED`]: its differences are not a comparison.
-pub fn run(scene: &Scene, integrator: Integrator, gyroscopic: bool) -> Result<(), Failure> {
+/// A body that either engine quarantined, or whose state went non-finite in either engine, is
+/// named on stderr and the command fails with [`exit::REJECTED`]: its differences are not a
+/// comparison.
+pub fn run(scene: &Scene, settings: Settings) -> Result<(), Failure> {
+    let Settings {
+        integrator,
+        gyroscopic,
+        springs,
+        rapier_springs,
+    } = settings;
     let states = scene.body_states();
     let mut bodies: Vec<ComparisonBody> = states
         .iter()
@@ -27,38 +51,62 @@ pub fn run(scene: &Scene, integrator: Integrator, gyroscopic: bool) -> Result<()
             b
         })
         .collect();
-    let index = |name: &str| states.iter().position(|s| s.name == name);
+    let index = |name: &str| {
+        states
+            .iter()
+            .position(|s| s.name == name)
+            .ok_or_else(|| Failure::from("unknown body"))
+    };
+    let vec = |v: &[f64; 3]| glam::DVec3::from_array(*v).narrow();
+    let mut spring_defs = Vec::new();
     for force in &scene.file().forces {
         match force {
             ForceDef::Constant { body, force, point } => {
-                let i = index(body).ok_or_else(|| Failure::from("unknown body"))?;
-                let f = glam::DVec3::from_array(*force).narrow();
-                let p = point.map(|p| glam::DVec3::from_array(p).narrow());
-                bodies[i].loads.push(Load::Force {
-                    force: f,
-                    local_point: p,
+                bodies[index(body)?].loads.push(Load::Force {
+                    force: vec(force),
+                    local_point: point.as_ref().map(vec),
                 });
             }
             ForceDef::Torque { body, torque } => {
-                let i = index(body).ok_or_else(|| Failure::from("unknown body"))?;
-                bodies[i]
-                    .loads
-                    .push(Load::Torque(glam::DVec3::from_array(*torque).narrow()));
+                bodies[index(body)?].loads.push(Load::Torque(vec(torque)));
             }
-            ForceDef::Spring { .. } => {
-                return Err(Failure::from(format!(
-                    "scene `{}` has springs, which the rapier comparison does not model (rapier \
-                     has no spring force generator); supported: free bodies, gravity, gravity \
-                     scale, constant forces (at points) and torques, damping",
-                    terminal_safe(scene.name())
-                )));
+            ForceDef::Spring {
+                a,
+                anchor_a,
+                b,
+                anchor_b,
+                stiffness,
+                damping,
+                rest_length,
+            } => {
+                let b = match b {
+                    Some(b) => ComparisonSpringEnd::Body {
+                        body: index(b)?,
+                        anchor: vec(anchor_b),
+                    },
+                    None => ComparisonSpringEnd::World(vec(anchor_b)),
+                };
+                spring_defs.push(ComparisonSpring {
+                    a: index(a)?,
+                    anchor_a: vec(anchor_a),
+                    b,
+                    stiffness: stiffness.narrow(),
+                    damping: damping.narrow(),
+                    rest_length: rest_length.narrow(),
+                });
             }
         }
     }
+    let mut sprung = vec![false; bodies.len()];
+    for spring in &spring_defs {
+        sprung[spring.a] = true;
+        if let ComparisonSpringEnd::Body { body, .. } = spring.b {
+            sprung[body] = true;
+        }
+    }
     let comparison = ComparisonScene {
-        dt: scene.dt(),
-        gravity: scene.gravity(),
-        bodies,
+        springs: spring_defs,
+        ..ComparisonScene::new(scene.dt(), scene.gravity(), bodies)
     };
     // Exact solutions for bodies without loads or damping: the position is the parabola
     // x₀ + v₀t + ½ g s t²; the orientation is a steady rotation for a spherical body, or the
@@ -67,8 +115,12 @@ pub fn run(scene: &Scene, integrator: Integrator, gyroscopic: bool) -> Result<()
     let exact_for: Vec<Option<(Option<TorqueFreeTop>, bool)>> = comparison
         .bodies
         .iter()
-        .map(|b| {
-            let free = b.loads.is_empty() && b.linear_damping == 0.0 && b.angular_damping == 0.0;
+        .zip(&sprung)
+        .map(|(b, &sprung)| {
+            let free = !sprung
+                && b.loads.is_empty()
+                && b.linear_damping == 0.0
+                && b.angular_damping == 0.0;
             if !free {
                 return None;
             }
@@ -113,10 +165,23 @@ pub fn run(scene: &Scene, integrator: Integrator, gyroscopic: bool) -> Result<()
         gyroscopic,
         rapier_solver_iterations: 4,
         steps: scene.steps().min(1_000_000) as usize,
+        springs,
+        rapier_springs,
     };
     let result = compare(&comparison, &options, Some(&exact));
+    let (tumble_springs, rapier_springs) = if comparison.springs.is_empty() {
+        (String::new(), String::new())
+    } else {
+        (
+            format!(", springs `{springs}`"),
+            format!(
+                ", springs `{rapier_springs}` = {}",
+                rapier_springs.description()
+            ),
+        )
+    };
     println!(
-        "scene {} · tumble `{integrator}` vs rapier 0.36 (gyroscopic {}, 4 substeps) · {} steps of {} s",
+        "scene {} · tumble `{integrator}`{tumble_springs} vs rapier 0.36 (gyroscopic {}, 4 substeps{rapier_springs}) · {} steps of {} s",
         terminal_safe(scene.name()),
         if gyroscopic { "on" } else { "off" },
         options.steps,
@@ -146,8 +211,9 @@ pub fn run(scene: &Scene, integrator: Integrator, gyroscopic: bool) -> Result<()
             pair(d.exact_angle)
         );
     }
+    print_energy(&result);
     println!(
-        "time per step: tumble {:.0} ns, rapier {:.0} ns (rapier/tumble = {:.1})",
+        "time per step: tumble {:.0} ns, rapier {:.0} ns (rapier/tumble = {:.2})",
         result.tumble_ns_per_step,
         result.rapier_ns_per_step,
         result.speed_ratio()
@@ -157,6 +223,9 @@ pub fn run(scene: &Scene, integrator: Integrator, gyroscopic: bool) -> Result<()
         let name = terminal_safe(&d.name);
         if let Some(step) = d.tumble_rejected_at {
             tracing::error!(target: "tumble", "body `{name}`: tumble quarantined it at step {step}; its differences after that step compare a frozen state");
+        }
+        if let Some(step) = d.rapier_quarantined_at {
+            tracing::error!(target: "tumble", "body `{name}`: rapier quarantined it at step {step} (its state went non-finite; rapier froze it); its differences after that step compare a frozen state");
         }
         if let Some(step) = d.non_finite_at {
             tracing::error!(target: "tumble", "body `{name}`: a state went non-finite at step {step} (NaN in the table)");
@@ -173,4 +242,34 @@ pub fn run(scene: &Scene, integrator: Integrator, gyroscopic: bool) -> Result<()
         ));
     }
     Ok(())
+}
+
+/// Prints each engine's total energy (kinetic + spring + gravity, [`ComparisonScene::total_energy`])
+/// before and after, with the largest relative change over the run, or the step after which it
+/// stopped meaning anything (a quarantined or non-finite body).
+fn print_energy(result: &Comparison) {
+    let describe = |series: &[f64]| {
+        let e0 = series[0];
+        let end = series.last().copied().unwrap_or(e0);
+        match series.iter().position(|e| !e.is_finite()) {
+            Some(step) => {
+                format!("{e0:.6e} J → not valid from step {step} (quarantined or non-finite)")
+            }
+            None => {
+                let worst = series
+                    .iter()
+                    .map(|e| ((e - e0) / e0).abs())
+                    .fold(0.0, f64::max);
+                format!(
+                    "{e0:.6e} → {end:.6e} J (E/E₀ = {:.6}, max |E − E₀|/E₀ = {worst:.2e})",
+                    end / e0
+                )
+            }
+        }
+    };
+    println!(
+        "total energy (kinetic + spring + gravity): tumble {}; rapier {}",
+        describe(&result.tumble_energy),
+        describe(&result.rapier_energy)
+    );
 }

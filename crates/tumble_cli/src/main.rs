@@ -199,9 +199,16 @@ fn dispatch(cli: Cli) -> Result<(), Failure> {
             scene,
             integrator,
             gyroscopic,
+            springs,
+            rapier_springs,
             allow_unstable,
         } => {
             let integrator = integrator.map(|v| utf8("--integrator", v)).transpose()?;
+            let springs = springs.map(|v| utf8("--springs", v)).transpose()?;
+            let rapier_springs: tumble_rapier::RapierSprings =
+                utf8("--rapier-springs", rapier_springs)?.parse().map_err(
+                    |e: tumble_rapier::UnknownRapierSprings| format!("--rapier-springs: {e}"),
+                )?;
             let loaded = load(&scene)?;
             let scene = Scene::parse(&loaded.file, &loaded.text)?;
             let integrator = match integrator {
@@ -213,15 +220,30 @@ fn dispatch(cli: Cli) -> Result<(), Failure> {
                 }
                 None => scene.integrator(),
             };
+            let springs = match springs {
+                Some(name) => name
+                    .parse()
+                    .map_err(|e: String| format!("--springs: {}", terminal_safe(&e)))?,
+                None => scene.settings().springs,
+            };
             // The same planning-time predictions as `run`, for tumble's side of the comparison.
             let mut built = scene.build();
-            built
-                .world
-                .resource_mut::<tumble_ecs::prelude::PhysicsSettings>()
-                .integrator = integrator;
+            {
+                let mut settings = built
+                    .world
+                    .resource_mut::<tumble_ecs::prelude::PhysicsSettings>();
+                settings.integrator = integrator;
+                settings.springs = springs;
+            }
             let names = summary::Names::new(&mut built.world, &built.bodies);
             run::stability_gate(&mut built, &names, allow_unstable)?;
-            compare::run(&scene, integrator, gyroscopic == "on")
+            let settings = compare::Settings {
+                integrator,
+                gyroscopic: gyroscopic == "on",
+                springs,
+                rapier_springs,
+            };
+            compare::run(&scene, settings)
         }
         Command::Report(options) => {
             tumble_report::run::run_report(&options).map_err(|e| Failure::from(e.to_string()))

@@ -181,10 +181,55 @@ fn compare_reports_rapier_and_exact_differences() {
     );
     assert!(ours * 10.0 < theirs, "{row}");
     assert!(text.contains("rapier/tumble"), "{text}");
-    // Springs are outside what rapier models here: a clear one-line error.
-    let out = tumble().args(["compare", "spring_chain"]).output().unwrap();
-    assert!(!out.status.success());
-    assert!(String::from_utf8_lossy(&out.stderr).contains("springs"));
+}
+
+/// Springs are compared too: rapier's `SpringJoint` by default, the hand-written force on
+/// request; the header names both engines' spring modes, and each engine's energy is printed.
+#[test]
+fn compare_accepts_springs_and_names_the_rapier_spring_mode() {
+    for (flags, tumble_mode, rapier_mode) in [
+        (&[][..], "springs `auto`", "springs `joint` = SpringJoint"),
+        (
+            &["--springs", "implicit", "--rapier-springs", "force"][..],
+            "springs `implicit`",
+            "springs `force` = add_force_at_point",
+        ),
+    ] {
+        let out = tumble()
+            .args(["compare", "spring_chain"])
+            .args(flags)
+            .output()
+            .unwrap();
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert!(
+            out.status.success(),
+            "{flags:?}: {}{text}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let header = text.lines().next().unwrap_or_default();
+        assert!(header.contains(tumble_mode), "{header}");
+        assert!(header.contains(rapier_mode), "{header}");
+        assert!(
+            text.lines().any(|l| l.starts_with("total energy")
+                && l.contains("tumble")
+                && l.contains("rapier")),
+            "{text}"
+        );
+        for body in ["m1", "m2", "m3"] {
+            assert!(text.lines().any(|l| l.starts_with(body)), "{text}");
+        }
+    }
+    let out = tumble()
+        .args(["compare", "spring_chain", "--rapier-springs", "spring"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        String::from_utf8_lossy(&out.stderr)
+            .contains("--rapier-springs: unknown rapier spring mode"),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
 }
 
 #[test]

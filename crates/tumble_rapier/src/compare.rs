@@ -5,8 +5,10 @@ use tumble_core::math::{Real, to_f64};
 
 use tumble_core::rotation::angle_between;
 use tumble_core::{BodyState, Integrator};
+use tumble_ecs::prelude::SpringSolver;
 
 use crate::rapier_side::RapierScene;
+use crate::rapier_springs::RapierSprings;
 use crate::scene::ComparisonScene;
 use crate::tumble_side::TumbleScene;
 
@@ -21,6 +23,10 @@ pub struct ComparisonOptions {
     pub rapier_solver_iterations: usize,
     /// Number of steps.
     pub steps: usize,
+    /// How tumble steps the springs (`PhysicsSettings::springs`; default `auto`).
+    pub springs: SpringSolver,
+    /// How the springs are built in rapier (default: its `SpringJoint`).
+    pub rapier_springs: RapierSprings,
 }
 
 impl Default for ComparisonOptions {
@@ -30,6 +36,8 @@ impl Default for ComparisonOptions {
             gyroscopic: true,
             rapier_solver_iterations: 4,
             steps: 600,
+            springs: SpringSolver::Auto,
+            rapier_springs: RapierSprings::Joint,
         }
     }
 }
@@ -54,15 +62,21 @@ pub struct BodyDifference {
     /// The first step after which tumble had quarantined the body (its state is then frozen,
     /// so the differences above stop meaning anything from that step on).
     pub tumble_rejected_at: Option<usize>,
+    /// The first step after which rapier had quarantined the body (its state went non-finite;
+    /// rapier froze it at its last valid pose, see [`RapierScene::is_quarantined`]).
+    pub rapier_quarantined_at: Option<usize>,
     /// The first step after which either engine's state of the body was not finite (the
     /// differences are then NaN, never silently dropped by `max`).
     pub non_finite_at: Option<usize>,
 }
 
 impl BodyDifference {
-    /// True when the run of this body is trustworthy: never quarantined, always finite.
+    /// True when the run of this body is trustworthy: never quarantined by either engine,
+    /// always finite.
     pub fn is_clean(&self) -> bool {
-        self.tumble_rejected_at.is_none() && self.non_finite_at.is_none()
+        self.tumble_rejected_at.is_none()
+            && self.rapier_quarantined_at.is_none()
+            && self.non_finite_at.is_none()
     }
 }
 
@@ -87,6 +101,13 @@ pub struct Comparison {
     pub tumble_ns_per_step: f64,
     /// Mean wall time per step of rapier's pipeline (ns).
     pub rapier_ns_per_step: f64,
+    /// tumble's total energy ([`ComparisonScene::total_energy`], J) before the first step
+    /// (index 0) and after every step; NaN from the step on which tumble quarantined any body
+    /// (its frozen state no longer belongs to the run) or a state went non-finite.
+    pub tumble_energy: Vec<f64>,
+    /// rapier's total energy, computed the same way from its states; NaN from the step on
+    /// which rapier quarantined any body or a state went non-finite.
+    pub rapier_energy: Vec<f64>,
 }
 
 impl Comparison {
@@ -106,8 +127,22 @@ pub fn compare(
     options: &ComparisonOptions,
     exact: Option<ExactSolution<'_>>,
 ) -> Comparison {
-    let mut tumble = TumbleScene::new(scene, options.integrator);
-    let mut rapier = RapierScene::new(scene, options.gyroscopic, options.rapier_solver_iterations);
+    let mut tumble = TumbleScene::with_springs(scene, options.integrator, options.springs);
+    let mut rapier = RapierScene::with_springs(
+        scene,
+        options.gyroscopic,
+        options.rapier_solver_iterations,
+        options.rapier_springs,
+    );
+    let n = scene.bodies.len();
+    let initial: Vec<BodyState> = scene.bodies.iter().map(|b| b.state).collect();
+    let e0 = scene.total_energy(&initial);
+    let mut tumble_energy = Vec::with_capacity(options.steps + 1);
+    let mut rapier_energy = Vec::with_capacity(options.steps + 1);
+    tumble_energy.push(e0);
+    rapier_energy.push(e0);
+    let (mut tumble_states, mut rapier_states) = (initial.clone(), initial);
+    let (mut tumble_valid, mut rapier_valid) = (true, true);
     let mut bodies: Vec<BodyDifference> = scene
         .bodies
         .iter()
@@ -125,10 +160,29 @@ pub fn compare(
         rapier.step();
         rapier_ns += start.elapsed().as_nanos();
         let t = to_f64(scene.dt) * step as f64;
+        for i in 0..n {
+            tumble_states[i] = tumble.state(i);
+            rapier_states[i] = rapier.state(i);
+            tumble_valid &= !tumble.is_rejected(i);
+            rapier_valid &= !rapier.is_quarantined(i);
+        }
+        tumble_energy.push(if tumble_valid {
+            scene.total_energy(&tumble_states)
+        } else {
+            f64::NAN
+        });
+        rapier_energy.push(if rapier_valid {
+            scene.total_energy(&rapier_states)
+        } else {
+            f64::NAN
+        });
         for (i, diff) in bodies.iter_mut().enumerate() {
-            let (a, b) = (tumble.state(i), rapier.state(i));
+            let (a, b) = (tumble_states[i], rapier_states[i]);
             if diff.tumble_rejected_at.is_none() && tumble.is_rejected(i) {
                 diff.tumble_rejected_at = Some(step);
+            }
+            if diff.rapier_quarantined_at.is_none() && rapier.is_quarantined(i) {
+                diff.rapier_quarantined_at = Some(step);
             }
             if diff.non_finite_at.is_none() && !(a.is_finite() && b.is_finite()) {
                 diff.non_finite_at = Some(step);
@@ -160,5 +214,7 @@ pub fn compare(
         bodies,
         tumble_ns_per_step: tumble_ns as f64 / steps,
         rapier_ns_per_step: rapier_ns as f64 / steps,
+        tumble_energy,
+        rapier_energy,
     }
 }

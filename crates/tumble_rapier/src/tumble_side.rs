@@ -7,7 +7,7 @@ use tumble_core::{BodyState, Integrator};
 use tumble_ecs::components::{body_state, write_body_state};
 use tumble_ecs::prelude::*;
 
-use crate::scene::{ComparisonScene, Load};
+use crate::scene::{ComparisonScene, ComparisonSpringEnd, Load};
 
 /// A tumble world holding the bodies of a [`ComparisonScene`] and its planned schedule.
 pub struct TumbleScene {
@@ -17,15 +17,32 @@ pub struct TumbleScene {
 }
 
 impl TumbleScene {
-    /// Builds the scene with the given integrator.
+    /// Builds the scene with the given integrator; springs, if any, stepped as
+    /// [`SpringSolver::Auto`] chooses.
     ///
     /// # Panics
     /// If `scene.dt` is not a valid time step (a `ComparisonScene` is built by code, not read
     /// from a user file; the scene loader validates user input).
     pub fn new(scene: &ComparisonScene, integrator: Integrator) -> Self {
+        Self::with_springs(scene, integrator, SpringSolver::Auto)
+    }
+
+    /// [`new`](Self::new) with the springs stepped as `springs` says
+    /// (`PhysicsSettings::springs`). Each [`ComparisonSpring`](crate::ComparisonSpring) becomes a
+    /// `Spring` component with the same anchors (both relative to the body origin).
+    ///
+    /// # Panics
+    /// As [`new`](Self::new), and if a spring names a body index outside `scene.bodies`.
+    pub fn with_springs(
+        scene: &ComparisonScene,
+        integrator: Integrator,
+        springs: SpringSolver,
+    ) -> Self {
         let mut world = World::new();
         world.insert_resource(
-            PhysicsSettings::new(scene.dt, integrator).expect("comparison scenes have a valid dt"),
+            PhysicsSettings::new(scene.dt, integrator)
+                .expect("comparison scenes have a valid dt")
+                .with_springs(springs),
         );
         if let Some(g) = scene.gravity {
             world.insert_resource(Gravity(g));
@@ -61,6 +78,23 @@ impl TumbleScene {
                 }
             }
             entities.push(id);
+        }
+        for spring in &scene.springs {
+            let b = match spring.b {
+                ComparisonSpringEnd::World(p) => SpringEnd::World(p),
+                ComparisonSpringEnd::Body { body, anchor } => SpringEnd::Body {
+                    body: entities[body],
+                    anchor,
+                },
+            };
+            world.spawn(Spring {
+                a: entities[spring.a],
+                anchor_a: spring.anchor_a,
+                b,
+                stiffness: spring.stiffness,
+                damping: spring.damping,
+                rest_length: spring.rest_length,
+            });
         }
         let schedule = PhysicsPlan::for_world(&mut world).build_schedule();
         Self {

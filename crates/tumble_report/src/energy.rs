@@ -59,11 +59,11 @@ pub fn traces(seconds: usize) -> Vec<EnergyTrace> {
                     }
                 }
                 Method::Rapier => {
-                    let scene = ComparisonScene {
+                    let scene = ComparisonScene::new(
                         dt,
-                        gravity: None,
-                        bodies: vec![ComparisonBody::new(spin, mass, initial)],
-                    };
+                        None,
+                        vec![ComparisonBody::new(spin, mass, initial)],
+                    );
                     let mut world = RapierScene::new(&scene, true, 4);
                     for _ in 0..seconds {
                         for _ in 0..60 {

@@ -9,14 +9,20 @@
 //! - **stability matrix** ([`stability`]): extreme scenes × integrator × setting: finite?
 //!   `max ||q| − 1|`? final/initial energy? and whether tumble's stability prediction warned;
 //! - **energy over time** ([`energy`]) for long spins, each method and rapier;
+//! - **springs against rapier** ([`springs`], [`spring_output`]): the stiff chain
+//!   ([`chain`]) at several `ωΔt`, tumble's explicit and implicit spring steps against rapier's
+//!   `SpringJoint` and a hand-written spring force: energy over time and time per step;
 //! - **outputs** ([`output`]): `report.md`, `results.json` and SVG plots.
 
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
+pub mod chain;
 pub mod energy;
 pub mod output;
 pub mod reference;
 pub mod run;
+pub mod spring_output;
+pub mod springs;
 pub mod stability;
 pub mod workprec;

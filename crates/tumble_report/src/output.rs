@@ -8,6 +8,7 @@ use plotters::prelude::*;
 use serde::Serialize;
 
 use crate::energy::EnergyTrace;
+use crate::springs::SpringRun;
 use crate::stability::Cell;
 use crate::workprec::Point;
 
@@ -63,6 +64,8 @@ pub struct Results {
     pub stability: Vec<Cell>,
     /// Energy over time of the long spins.
     pub energy: Vec<EnergyTrace>,
+    /// The stiff chain in tumble and rapier, each spring step (see [`crate::springs`]).
+    pub springs: Vec<SpringRun>,
 }
 
 impl Results {
@@ -72,6 +75,7 @@ impl Results {
         work_precision: Vec<Point>,
         stability: Vec<Cell>,
         energy: Vec<EnergyTrace>,
+        springs: Vec<SpringRun>,
     ) -> Self {
         let units = BTreeMap::from([
             ("dt_s", "s"),
@@ -86,6 +90,12 @@ impl Results {
                 "relative_energy",
                 "1 (E(t)/E(0) − 1, one sample per second)",
             ),
+            ("omega_dt", "1 (nominal √(k/μ)Δt)"),
+            (
+                "energy_ratio (springs)",
+                "1 (E/E₀ after every step, null once quarantined or non-finite)",
+            ),
+            ("us_per_step", "µs"),
         ]);
         Self {
             schema: 1,
@@ -94,6 +104,7 @@ impl Results {
             work_precision,
             stability,
             energy,
+            springs,
         }
     }
 }
@@ -245,6 +256,8 @@ pub fn markdown(results: &Results, plots: &[String]) -> String {
             c.warned
         );
     }
+    out.push('\n');
+    out.push_str(&crate::spring_output::spring_section(&results.springs));
     out
 }
 

@@ -76,7 +76,8 @@ pub struct Case {
     pub horizon: f64,
     /// Exact solution.
     pub exact: Exact,
-    /// True when rapier can run the scene (no springs).
+    /// True when the work–precision study runs rapier on the scene (not on the spring scene:
+    /// rapier's springs, joint and force, are measured on the chain in [`crate::springs`]).
     pub rapier: bool,
 }
 

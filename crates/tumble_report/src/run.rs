@@ -9,6 +9,8 @@ use tumble_scene::text::path_for_terminal;
 use crate::energy::{spins, traces};
 use crate::output::{Machine, Results, headline_table, markdown, plot_energy, plot_scene};
 use crate::reference::cases;
+use crate::spring_output::plot_spring_energy;
+use crate::springs::spring_runs;
 use crate::stability::matrix;
 use crate::workprec::{Effort, Method, measure};
 
@@ -28,7 +30,8 @@ pub struct ReportOptions {
     pub readme: Option<PathBuf>,
 }
 
-/// Runs the work–precision study, the stability matrix and the energy traces; writes
+/// Runs the work–precision study, the stability matrix, the energy traces and the springs
+/// against rapier; writes
 /// `report.md`, `results.json` and the SVG plots; prints the headline table.
 ///
 /// The output directory is checked first (an existing non-directory is an error naming it,
@@ -60,7 +63,9 @@ pub fn run_report(options: &ReportOptions) -> Result<(), Box<dyn std::error::Err
     };
     let cases = cases();
     let methods = Method::all();
-    let total = cases.len() * methods.len() * dts.len() + tumble_core::Integrator::ALL.len();
+    let total = cases.len() * methods.len() * dts.len()
+        + tumble_core::Integrator::ALL.len()
+        + 2 * crate::springs::OMEGA_DTS.len();
     let bar = ProgressBar::new(total as u64);
     bar.set_style(ProgressStyle::with_template(
         "{bar:40} {pos}/{len} {msg} [{elapsed}]",
@@ -83,9 +88,17 @@ pub fn run_report(options: &ReportOptions) -> Result<(), Box<dyn std::error::Err
     let cells = matrix(options.quick, || bar.inc(1));
     bar.set_message("energy over time");
     let energy = traces(if options.quick { 30 } else { 120 });
+    bar.set_message("springs against rapier");
+    let springs = spring_runs(if options.quick { 120 } else { 600 }, || bar.inc(1));
     bar.finish_and_clear();
 
-    let results = Results::new(Machine::detect(options.quick), points, cells, energy);
+    let results = Results::new(
+        Machine::detect(options.quick),
+        points,
+        cells,
+        energy,
+        springs,
+    );
     let out: &Path = &options.out;
     create_directory(out)?;
     // The plots are drawn into a private directory (plotters opens its path as it is), then
@@ -109,6 +122,7 @@ pub fn run_report(options: &ReportOptions) -> Result<(), Box<dyn std::error::Err
         staging.path(),
         &results.stability,
     )?);
+    plots.push(plot_spring_energy(staging.path(), &results.springs)?);
     for plot in &plots {
         let drawn = staging.path().join(plot);
         // A scene without finite points gets no plot file (see `plot_scene`).

@@ -9,6 +9,7 @@ use tumble_core::invariants::kinetic_energy;
 use tumble_core::{Integrator, Mass, MassProperties};
 use tumble_ecs::components::body_state;
 use tumble_ecs::prelude::*;
+use tumble_rapier::TumbleScene;
 
 /// One cell of the matrix.
 #[derive(Debug, Clone, Serialize)]
@@ -358,56 +359,14 @@ pub fn matrix(quick: bool, mut progress: impl FnMut()) -> Vec<Cell> {
     cells
 }
 
-/// Ten asymmetric bodies (I = 0.02, 0.03, 0.04) in a chain of springs at off-centre anchors, the
-/// first tied to the world, each spring stretched 10 %; nominal `√(k/μ)Δt = omega_dt` (μ = ½).
+/// The report's stiff chain ([`crate::chain::stiff_chain`]) with the default integrator and the
+/// given spring step.
 fn stiff_chain(springs: SpringSolver, omega_dt: Real, steps: usize) -> Cell {
-    let dt = 1.0 / 60.0;
     let integrator = Integrator::default();
-    let mut w = springs_world(dt, integrator, springs);
-    let k = 0.5 * (omega_dt / dt).powi(2);
-    let mass = MassProperties::new(Mass::new(1.0).expect("valid"), Vec3::new(0.02, 0.03, 0.04))
-        .expect("valid");
-    let bodies: Vec<Entity> = (0..10)
-        .map(|i| {
-            let x = i as Real;
-            w.spawn((
-                RigidBody,
-                MassProps(mass),
-                Transform {
-                    translation: Vec3::new(x, 0.02 * x, 0.0),
-                    rotation: Quat::from_rotation_z(0.1 * x),
-                },
-                Velocity {
-                    linear: Vec3::new(0.0, 0.05, 0.0),
-                    angular: Vec3::new(0.2, -0.1, 0.3),
-                },
-            ))
-            .id()
-        })
-        .collect();
-    w.spawn(Spring {
-        a: bodies[0],
-        anchor_a: Vec3::new(-0.1, 0.05, 0.0),
-        b: SpringEnd::World(Vec3::new(-1.0, 0.0, 0.0)),
-        stiffness: k,
-        damping: 0.0,
-        rest_length: 0.8,
-    });
-    for pair in bodies.windows(2) {
-        w.spawn(Spring {
-            a: pair[0],
-            anchor_a: Vec3::new(0.1, 0.05, 0.0),
-            b: SpringEnd::Body {
-                body: pair[1],
-                anchor: Vec3::new(-0.1, -0.05, 0.02),
-            },
-            stiffness: k,
-            damping: 0.0,
-            rest_length: 0.72,
-        });
-    }
+    let chain = crate::chain::stiff_chain(omega_dt);
+    let mut scene = TumbleScene::with_springs(&chain, integrator, springs);
     run(
-        &mut w,
+        scene.world_mut(),
         steps,
         "stiff-chain",
         integrator,

@@ -119,11 +119,7 @@ fn rapier_run(case: &Case, dt: Real, steps: usize, batch: usize) -> (BodyState, 
         }
         Load::Free | Load::Spring(_) => None,
     };
-    let scene = ComparisonScene {
-        dt,
-        gravity,
-        bodies: vec![body; batch],
-    };
+    let scene = ComparisonScene::new(dt, gravity, vec![body; batch]);
     let mut world = RapierScene::new(&scene, true, 4);
     let start = Instant::now();
     for _ in 0..steps {

@@ -74,7 +74,8 @@ fn results_json_has_the_documented_shape() {
     )];
     let cells = matrix(true, || {}).into_iter().take(3).collect();
     let energy = tumble_report::energy::traces(2);
-    let results = Results::new(Machine::detect(true), points, cells, energy);
+    let springs = tumble_report::springs::spring_runs(3, || {});
+    let results = Results::new(Machine::detect(true), points, cells, energy, springs);
     let json: serde_json::Value = serde_json::to_value(&results).unwrap();
     assert_eq!(json["schema"], 1);
     for key in ["cpu", "cores", "os", "tumble_version", "quick"] {
@@ -118,6 +119,25 @@ fn results_json_has_the_documented_shape() {
         "t = 0, 1, 2 s"
     );
     assert!(e.get("spin").is_some() && e.get("method").is_some());
+    let runs = json["springs"].as_array().unwrap();
+    assert_eq!(runs.len(), 12, "4 variants × 3 ωΔt");
+    for key in [
+        "variant",
+        "omega_dt",
+        "energy_ratio",
+        "failed_at",
+        "us_per_step",
+    ] {
+        assert!(runs[0].get(key).is_some(), "springs[].{key}");
+    }
+    assert_eq!(runs[0]["energy_ratio"].as_array().unwrap().len(), 4);
+    // The explicit chain at ωΔt = 10 is quarantined at step 2: null from there, not a number.
+    let explicit = runs
+        .iter()
+        .find(|r| r["variant"] == "tumble explicit" && r["omega_dt"] == 10.0)
+        .unwrap();
+    assert_eq!(explicit["failed_at"], 2);
+    assert!(explicit["energy_ratio"][3].is_null(), "{explicit}");
 }
 
 #[test]
