@@ -2,27 +2,15 @@
 //! ωΔt from 0.5 to 100) and how many springs a step gets through (chains of chains, with gravity,
 //! a force at a body point and damping on every body).
 
-use bevy_ecs::prelude::*;
-use bevy_ecs::schedule::Schedule;
 use serde::Serialize;
 use tumble_core::math::{Real, Vec3};
 use tumble_core::{BodyState, Integrator};
-use tumble_ecs::components::body_state;
-use tumble_ecs::prelude::*;
-use tumble_scene::presets::{ChainStart, SpringChain};
+use tumble_ecs::prelude::SpringSolver;
+use tumble_rapier::presets::{ChainStart, spring_chain};
+use tumble_rapier::{Load, TumbleScene};
 
 use crate::engines::Engine;
 use crate::measure::{Effort, compare};
-
-/// The step every spring world runs at (s).
-const DT: Real = 1.0 / 60.0;
-
-/// A world of spring chains through tumble's ECS schedule.
-pub struct SpringWorld {
-    world: World,
-    schedule: Schedule,
-    bodies: Vec<Entity>,
-}
 
 /// How a spring world is loaded.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -33,9 +21,15 @@ pub enum Loads {
     GravityForcesDamping,
 }
 
+/// `chains` spring chains ([`spring_chain`]) through tumble's ECS schedule, the springs
+/// stepped as `springs` says.
+pub struct SpringWorld {
+    tumble: TumbleScene,
+    bodies: usize,
+}
+
 impl SpringWorld {
-    /// `chains` chains of [`SpringChain`] side by side (2 m apart along z), stepped with
-    /// `springs`.
+    /// The world; see [`Loads`] for what acts besides the springs.
     pub fn new(
         chains: usize,
         omega_dt: Real,
@@ -43,63 +37,37 @@ impl SpringWorld {
         springs: SpringSolver,
         loads: Loads,
     ) -> Self {
-        let mut world = World::new();
-        world.insert_resource(
-            PhysicsSettings::new(DT, Integrator::default())
-                .expect("a valid step")
-                .with_springs(springs),
-        );
+        let mut scene = spring_chain(omega_dt, start, chains);
         if loads == Loads::GravityForcesDamping {
-            world.insert_resource(Gravity::EARTH_Y_DOWN);
-        }
-        let mut bodies = Vec::new();
-        for c in 0..chains {
-            let mut chain = SpringChain::new(omega_dt, DT, start);
-            chain.origin = Vec3::new(0.0, 0.0, 2.0 * c as Real);
-            let spawned = chain.spawn(&mut world);
-            if loads == Loads::GravityForcesDamping {
-                for &body in &spawned {
-                    world.spawn(ConstantForce {
-                        body,
-                        force: Vec3::new(0.5, 0.0, 0.0),
-                        local_point: Some(Vec3::new(0.0, 0.05, 0.02)),
-                    });
-                    world.entity_mut(body).insert(Damping {
-                        linear: 0.05,
-                        angular: 0.05,
-                    });
-                }
+            scene.gravity = Some(Vec3::new(0.0, -9.81, 0.0));
+            for body in &mut scene.bodies {
+                body.loads.push(Load::Force {
+                    force: Vec3::new(0.5, 0.0, 0.0),
+                    local_point: Some(Vec3::new(0.0, 0.05, 0.02)),
+                });
+                body.linear_damping = 0.05;
+                body.angular_damping = 0.05;
             }
-            bodies.extend(spawned);
         }
-        let schedule = PhysicsPlan::for_world(&mut world).build_schedule();
         Self {
-            world,
-            schedule,
-            bodies,
+            tumble: TumbleScene::with_springs(&scene, Integrator::default(), springs),
+            bodies: scene.bodies.len(),
         }
+    }
+
+    /// True when every body is finite and none was quarantined.
+    pub fn is_clean(&self) -> bool {
+        (0..self.bodies).all(|i| self.tumble.state(i).is_finite() && !self.tumble.is_rejected(i))
     }
 }
 
 impl Engine for SpringWorld {
     fn step(&mut self) {
-        self.schedule.run(&mut self.world);
-        self.world.clear_trackers();
+        self.tumble.step();
     }
 
     fn state(&self, i: usize) -> BodyState {
-        let e = self.bodies[i];
-        match (
-            self.world.get::<Transform>(e),
-            self.world.get::<Velocity>(e),
-            self.world.get::<MassProps>(e),
-        ) {
-            (Some(t), Some(v), Some(m)) => body_state(t, v, m),
-            _ => BodyState {
-                position: Vec3::NAN,
-                ..BodyState::default()
-            },
-        }
+        self.tumble.state(i)
     }
 }
 
@@ -184,13 +152,7 @@ pub fn run(quick: bool, mut progress: impl FnMut(&str)) -> SpringResults {
             ));
             let mut world = SpringWorld::new(1, omega_dt, start, springs, Loads::None);
             let ns = compare(&mut [&mut world], 1, &chain_effort)[0];
-            let clean = (0..world.bodies.len()).all(|i| world.state(i).is_finite())
-                && world
-                    .world
-                    .query::<&Rejected>()
-                    .iter(&world.world)
-                    .next()
-                    .is_none();
+            let clean = world.is_clean();
             stiffness.push(StiffnessRow {
                 start: start_name.to_owned(),
                 springs: mode_name(springs).to_owned(),

@@ -64,6 +64,7 @@
 #![warn(missing_docs)]
 
 mod compare;
+pub mod presets;
 mod rapier_side;
 mod rapier_springs;
 mod scene;

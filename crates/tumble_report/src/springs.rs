@@ -1,4 +1,4 @@
-//! Springs against rapier: the stiff chain ([`crate::chain::stiff_chain`]) at several `ωΔt` in
+//! Springs against rapier: the stiff chain ([`tumble_rapier::presets::spring_chain`], stretched) at several `ωΔt` in
 //! tumble (explicit and implicit spring step) and in rapier 0.36 (its `SpringJoint`, and a spring
 //! force added by hand each step), with the total energy of each after every step.
 
@@ -7,7 +7,7 @@ use tumble_core::math::{Real, to_f64};
 use tumble_ecs::prelude::SpringSolver;
 use tumble_rapier::{Comparison, ComparisonOptions, RapierSprings, compare};
 
-use crate::chain::stiff_chain;
+use tumble_rapier::presets::{ChainStart, spring_chain};
 
 /// The nominal `√(k/μ)Δt` of the chain runs: inside the explicit step's stable region, at its
 /// edge, and far beyond it (the bundled `stiff_chain` scene).
@@ -95,7 +95,7 @@ fn extract(result: &Comparison, variant: Variant, omega_dt: Real) -> SpringRun {
 pub fn spring_runs(steps: usize, mut progress: impl FnMut()) -> Vec<SpringRun> {
     let mut runs = Vec::new();
     for omega_dt in OMEGA_DTS {
-        let chain = stiff_chain(omega_dt);
+        let chain = spring_chain(omega_dt, ChainStart::Stretched, 1);
         for (tumble, rapier) in [
             (SpringSolver::Explicit, RapierSprings::Joint),
             (SpringSolver::Implicit, RapierSprings::Force),

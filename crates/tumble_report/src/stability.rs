@@ -359,11 +359,15 @@ pub fn matrix(quick: bool, mut progress: impl FnMut()) -> Vec<Cell> {
     cells
 }
 
-/// The report's stiff chain ([`crate::chain::stiff_chain`]) with the default integrator and the
+/// The report's stiff chain ([`tumble_rapier::presets::spring_chain`], stretched) with the default integrator and the
 /// given spring step.
 fn stiff_chain(springs: SpringSolver, omega_dt: Real, steps: usize) -> Cell {
     let integrator = Integrator::default();
-    let chain = crate::chain::stiff_chain(omega_dt);
+    let chain = tumble_rapier::presets::spring_chain(
+        omega_dt,
+        tumble_rapier::presets::ChainStart::Stretched,
+        1,
+    );
     let mut scene = TumbleScene::with_springs(&chain, integrator, springs);
     run(
         scene.world_mut(),

@@ -4,8 +4,8 @@
 
 use tumble_core::math::DOUBLE_PRECISION;
 use tumble_ecs::prelude::SpringSolver;
+use tumble_rapier::presets::{ChainStart, spring_chain};
 use tumble_rapier::{ComparisonOptions, RapierSprings, compare};
-use tumble_report::chain::stiff_chain;
 use tumble_report::spring_output::spring_section;
 use tumble_report::springs::{SpringRun, spring_runs};
 
@@ -95,7 +95,11 @@ fn implicit_chain_keeps_its_energy_at_omega_dt_10_and_the_joint_dissipates_when_
             rapier_springs: RapierSprings::Joint,
             ..ComparisonOptions::default()
         };
-        let result = compare(&stiff_chain(omega_dt), &options, None);
+        let result = compare(
+            &spring_chain(omega_dt, ChainStart::Stretched, 1),
+            &options,
+            None,
+        );
         let e0 = result.tumble_energy[0];
         let drift = result
             .tumble_energy

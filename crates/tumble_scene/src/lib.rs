@@ -13,7 +13,6 @@ mod build;
 mod error;
 mod format;
 pub mod output;
-pub mod presets;
 pub mod text;
 mod trajectory;
 mod validate;
