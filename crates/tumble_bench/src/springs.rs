@@ -3,7 +3,7 @@
 //! a force at a body point and damping on every body).
 
 use serde::Serialize;
-use tumble_core::math::{Real, Vec3};
+use tumble_core::math::{Real, Vec3, to_f64};
 use tumble_core::{BodyState, Integrator};
 use tumble_ecs::prelude::SpringSolver;
 use tumble_rapier::presets::{ChainStart, spring_chain};
@@ -156,7 +156,7 @@ pub fn run(quick: bool, mut progress: impl FnMut(&str)) -> SpringResults {
             stiffness.push(StiffnessRow {
                 start: start_name.to_owned(),
                 springs: mode_name(springs).to_owned(),
-                omega_dt: f64::from(omega_dt),
+                omega_dt: to_f64(omega_dt),
                 us_per_step: ns / 1000.0,
                 clean,
             });
@@ -192,7 +192,7 @@ pub fn run(quick: bool, mut progress: impl FnMut(&str)) -> SpringResults {
             throughput.push(ThroughputRow {
                 springs,
                 mode: mode_name(mode).to_owned(),
-                omega_dt: f64::from(omega_dt),
+                omega_dt: to_f64(omega_dt),
                 ns_per_spring_step: ns,
             });
         }

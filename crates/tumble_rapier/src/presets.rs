@@ -93,6 +93,7 @@ pub fn spring_chain(omega_dt: Real, start: ChainStart, chains: usize) -> Compari
 #[cfg(test)]
 mod tests {
     use super::*;
+    use tumble_core::math::to_f64;
 
     fn elastic_energy(scene: &ComparisonScene) -> f64 {
         let states: Vec<BodyState> = scene
@@ -111,11 +112,11 @@ mod tests {
     fn a_relaxed_chain_starts_at_rest_length_and_a_stretched_one_does_not() {
         let relaxed = spring_chain(10.0, ChainStart::Relaxed, 3);
         let stretched = spring_chain(10.0, ChainStart::Stretched, 1);
-        let k = f64::from(stretched.springs[0].stiffness);
+        let k = to_f64(stretched.springs[0].stiffness);
         assert_eq!((relaxed.bodies.len(), relaxed.springs.len()), (30, 30));
         assert_eq!((stretched.bodies.len(), stretched.springs.len()), (10, 10));
         // A rest length rounded to `Real` leaves a stretch of an ulp or so of a metre per spring.
-        let ulp = f64::from(Real::EPSILON);
+        let ulp = to_f64(Real::EPSILON);
         assert!(elastic_energy(&relaxed) <= 30.0 * 0.5 * k * (4.0 * ulp).powi(2));
         // Every spring stretched by 0.05 m or more.
         assert!(elastic_energy(&stretched) >= 10.0 * 0.5 * k * 0.05 * 0.05);
