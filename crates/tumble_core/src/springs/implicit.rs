@@ -333,25 +333,19 @@ fn half_rotation(c: DQuat) -> DQuat {
 }
 
 /// `∂δθ/∂w` of the half rotation `S` of `cay(hw)` (see `half_rotation`), perturbed in its own
-/// frame (`dS = S [δθ]×`): `S` turns by `φ = atan(h|w|/2)` about `n = w/|w|`, so with
-/// `ψ = φ n`, `∂ψ/∂w = φ'(|w|) nnᵀ + (φ/|w|)(1 − nnᵀ)` and
-/// `δθ = J_r(ψ) δψ`, `J_r(ψ) = 1 − (1 − cos φ)/φ² [ψ]× + (φ − sin φ)/φ³ [ψ]×²`.
+/// frame (`dS = S [δθ]×`), without trigonometry: with `u = hw/2` and `σ = √(1 + |u|²)`, `S` is
+/// itself a Cayley rotation, `S = cay(g)` with `g = 2u/(1 + σ)` (its quaternion is
+/// `(u, 1 + σ)` normalized), and the Cayley map's right-trivialized derivative is
+/// `δθ = (1 − [g/2]×) dg / (1 + |g|²/4)`, with
+/// `dg = (2/(1 + σ)) du − 2/((1 + σ)² σ) u (u·du)`.
 fn half_turn_jacobian(h: f64, w: DVec3) -> DMat3 {
-    let r = w.length();
-    let u = 0.5 * h * r;
-    if u < 1e-6 {
-        // φ ≈ u: ψ ≈ hw/2 and J_r ≈ 1 − [ψ]×/2, to O(u²).
-        return 0.5 * h * (DMat3::IDENTITY - 0.25 * h * skew(w));
-    }
-    let phi = u.atan();
-    let n = w / r;
-    let nn = outer(n, n);
-    let dpsi = (0.5 * h / (1.0 + u * u)) * nn + (phi / r) * (DMat3::IDENTITY - nn);
-    let psi = skew(phi * n);
-    let (sin, cos) = phi.sin_cos();
-    let right = DMat3::IDENTITY - ((1.0 - cos) / (phi * phi)) * psi
-        + ((phi - sin) / (phi * phi * phi)) * (psi * psi);
-    right * dpsi
+    let u = 0.5 * h * w;
+    let sigma = (1.0 + u.length_squared()).sqrt();
+    let f = 2.0 / (1.0 + sigma);
+    let g = f * u;
+    let dg = f * DMat3::IDENTITY - (2.0 / ((1.0 + sigma) * (1.0 + sigma) * sigma)) * outer(u, u);
+    let right = (DMat3::IDENTITY - skew(0.5 * g)) * (1.0 / (1.0 + 0.25 * g.length_squared()));
+    (0.5 * h) * (right * dg)
 }
 
 fn v3(z: &[f64]) -> DVec3 {
@@ -806,8 +800,7 @@ impl ImplicitSpringSolver {
     /// own frame, `dS = S [δθ]×`, the pieces move as `d(Mᵀx) = [Mᵀx]× δθ`,
     /// `d(S a) = −[S a]× S δθ`, `d(Sᵀa) = [Sᵀa]× δθ`, so
     /// `∂τ/∂θ = [MᵀT]× + Σ ([arm]×[Mᵀf]× − ½[Mᵀf]× ([Sᵀa]× − [S a]× S))`, and
-    /// `δθ = J_r(ψ) ∂ψ/∂Ω̄ δΩ̄` for the rotation vector `ψ = atan(h|Ω̄|/2) Ω̄/|Ω̄|` of `S`
-    /// (`J_r` the right Jacobian of SO(3)).
+    /// `δθ` from `half_turn_jacobian`.
     fn turning_torque_jacobian(&self, h: f64, i: usize, w: DVec3) -> DMat3 {
         let s = &self.starts[i];
         let half = half_rotation(cayley(h * w));
@@ -1146,42 +1139,50 @@ mod jacobian_tests {
         let mut solver = ImplicitSpringSolver::default();
         solver.prepare(&bodies, &springs).unwrap();
         let n = 12;
-        solver.z = vec![
-            0.2, -0.1, 0.3, 4.0, -3.0, 5.0, -0.3, 0.2, 0.1, -6.0, 2.0, 7.0,
-        ];
-        solver.residual = vec![0.0; n];
-        solver.evaluate(h);
-        solver.build_blocks(h);
-        solver.factor(h);
-        let base = solver.z.clone();
-        for j in 0..n {
-            let mut unit = vec![0.0; n];
-            unit[j] = 1.0;
-            let mut analytic = vec![0.0; n];
-            solver.apply_jacobian(h, &unit, &mut analytic);
-            let eps = 1e-6;
-            let mut plus = base.clone();
-            plus[j] += eps;
-            solver.z = plus;
-            solver.evaluate(h);
-            let r_plus = solver.residual.clone();
-            let mut minus = base.clone();
-            minus[j] -= eps;
-            solver.z = minus;
-            solver.evaluate(h);
-            let r_minus = solver.residual.clone();
-            solver.z = base.clone();
+        // A slow turn (h|Ω̄| ≈ 0.13) and a fast one (≈ 3.3: the half rotation far from linear).
+        for spin in [1.0, 25.0] {
+            solver.z = vec![
+                0.2, -0.1, 0.3, 4.0, -3.0, 5.0, -0.3, 0.2, 0.1, -6.0, 2.0, 7.0,
+            ];
+            for body in solver.z.chunks_exact_mut(6) {
+                for w in &mut body[3..] {
+                    *w *= spin;
+                }
+            }
+            solver.residual = vec![0.0; n];
             solver.evaluate(h);
             solver.build_blocks(h);
             solver.factor(h);
-            for i in 0..n {
-                let numeric = (r_plus[i] - r_minus[i]) / (2.0 * eps);
-                let scale = numeric.abs().max(analytic[i].abs()).max(1e-3);
-                assert!(
-                    (numeric - analytic[i]).abs() <= 1e-5 * scale + 1e-8,
-                    "J[{i}][{j}]: numeric {numeric:e}, analytic {:e}",
-                    analytic[i]
-                );
+            let base = solver.z.clone();
+            for j in 0..n {
+                let mut unit = vec![0.0; n];
+                unit[j] = 1.0;
+                let mut analytic = vec![0.0; n];
+                solver.apply_jacobian(h, &unit, &mut analytic);
+                let eps = 1e-6;
+                let mut plus = base.clone();
+                plus[j] += eps;
+                solver.z = plus;
+                solver.evaluate(h);
+                let r_plus = solver.residual.clone();
+                let mut minus = base.clone();
+                minus[j] -= eps;
+                solver.z = minus;
+                solver.evaluate(h);
+                let r_minus = solver.residual.clone();
+                solver.z = base.clone();
+                solver.evaluate(h);
+                solver.build_blocks(h);
+                solver.factor(h);
+                for i in 0..n {
+                    let numeric = (r_plus[i] - r_minus[i]) / (2.0 * eps);
+                    let scale = numeric.abs().max(analytic[i].abs()).max(1e-3);
+                    assert!(
+                        (numeric - analytic[i]).abs() <= 1e-5 * scale + 1e-8,
+                        "spin ×{spin}: J[{i}][{j}]: numeric {numeric:e}, analytic {:e}",
+                        analytic[i]
+                    );
+                }
             }
         }
     }
