@@ -51,8 +51,8 @@
 //! turning of the torques' frame and arms with `Ω̄` (forward differences per body).
 //!
 //! Each Newton system is solved directly (module `springs::sparse`: block elimination in
-//! minimum-degree order, no fill on a chain or a tree), wrapped in BiCGSTAB so that a singular
-//! pivot falls back to block Jacobi instead of failing. A step that does not reduce the residual
+//! minimum-degree order, no fill on a chain or a tree); where a pivot is singular, by BiCGSTAB
+//! with a block-Jacobi preconditioner instead of failing. A step that does not reduce the residual
 //! is shortened (backtracking), and a trust region limits each update's change of rotation.
 //! Iteration stops when the error left, estimated from the contraction of the last two updates,
 //! is below [`ImplicitSpringSolver::tolerance`] in the kinetic-energy norm, relative to the
@@ -143,7 +143,8 @@ pub enum ImplicitSpringError {
 pub struct SolveStats {
     /// Newton iterations.
     pub newton_iterations: usize,
-    /// BiCGSTAB iterations, summed over the Newton iterations.
+    /// Linear solves, summed over the Newton iterations: one direct solve per Newton iteration,
+    /// or the BiCGSTAB iterations of one where the direct factorization met a singular pivot.
     pub linear_iterations: usize,
     /// Times a step was split in two because Newton's method did not converge.
     pub splits: usize,
@@ -309,6 +310,10 @@ impl Default for ImplicitSpringSolver {
 /// (see [`ImplicitSpringSolver::step`]).
 const PIECE_TURN: f64 = 3.0;
 
+/// Relative size (kinetic-energy norm) of the previous Newton update above which an iteration
+/// refactors the Newton matrix; below it, the last factorization preconditions BiCGSTAB.
+const REFACTOR_ABOVE: f64 = 1e-3;
+
 /// Largest change of `h|Ω̄|` (rad) of any body in one Newton iteration.
 const MAX_TURN: f64 = 0.5;
 
@@ -461,33 +466,45 @@ impl ImplicitSpringSolver {
         while iterations < self.max_newton {
             iterations += 1;
             stats.newton_iterations += 1;
+            // The body blocks follow the iterate (Krylov applies the exact Newton matrix). The
+            // factorization is rebuilt while the updates are large; near the solution the matrix
+            // barely changes between iterations, and the last factorization, as BiCGSTAB's
+            // preconditioner, solves the new one in a couple of iterations for far less work.
             self.build_blocks(h);
-            self.factor(h);
+            let fresh = previous_full > REFACTOR_ABOVE;
+            if fresh {
+                self.factor(h);
+            }
             for (b, r) in self.rhs.iter_mut().zip(&self.residual) {
                 *b = -r;
             }
             let rhs = std::mem::take(&mut self.rhs);
             let mut delta = std::mem::take(&mut self.delta);
-            let mut krylov = std::mem::take(&mut self.krylov);
-            let mut lu = std::mem::take(&mut self.lu);
-            let factored = self.factored;
-            let linear_iterations = krylov.solve(
-                &rhs,
-                &mut delta,
-                1e-9,
-                400,
-                |u, out| self.apply_jacobian(h, u, out),
-                |u, out| {
-                    if factored {
-                        lu.solve(u, out);
-                    } else {
-                        self.apply_preconditioner(u, out);
-                    }
-                },
-            );
-            self.krylov = krylov;
-            self.lu = lu;
-            stats.linear_iterations += linear_iterations;
+            if fresh && self.factored {
+                // The factorization is of the exact Newton matrix: one direct solve.
+                self.lu.solve(&rhs, &mut delta);
+                stats.linear_iterations += 1;
+            } else {
+                let mut krylov = std::mem::take(&mut self.krylov);
+                let mut lu = std::mem::take(&mut self.lu);
+                let factored = self.factored;
+                stats.linear_iterations += krylov.solve(
+                    &rhs,
+                    &mut delta,
+                    1e-9,
+                    400,
+                    |u, out| self.apply_jacobian(h, u, out),
+                    |u, out| {
+                        if factored {
+                            lu.solve(u, out);
+                        } else {
+                            self.apply_preconditioner(u, out);
+                        }
+                    },
+                );
+                self.krylov = krylov;
+                self.lu = lu;
+            }
             self.rhs = rhs;
             // Backtrack on the residual norm: a full Newton step can overshoot far from the
             // solution (large rotations make the spring geometry strongly nonlinear).

@@ -9,35 +9,45 @@
 pub(crate) type Block = [[f64; 6]; 6];
 
 /// Inverts `m` by Gauss–Jordan elimination with partial pivoting; `None` if singular.
+///
+/// Works on the augmented rows `[m | 1]` of twelve entries, so that every row operation is one
+/// fixed-length loop the compiler unrolls and vectorizes (the Newton solve of a spring group
+/// inverts one such block per body and iteration).
 pub(crate) fn invert(m: &Block) -> Option<Block> {
-    let mut a = *m;
-    let mut inv = [[0.0; 6]; 6];
-    for (i, row) in inv.iter_mut().enumerate() {
-        row[i] = 1.0;
+    let mut rows = [[0.0; 12]; 6];
+    for (i, (row, source)) in rows.iter_mut().zip(m).enumerate() {
+        row[..6].copy_from_slice(source);
+        row[6 + i] = 1.0;
     }
     for col in 0..6 {
-        let pivot = (col..6).max_by(|&p, &q| a[p][col].abs().total_cmp(&a[q][col].abs()))?;
-        if a[pivot][col] == 0.0 || !a[pivot][col].is_finite() {
-            return None;
-        }
-        a.swap(col, pivot);
-        inv.swap(col, pivot);
-        let scale = 1.0 / a[col][col];
-        for k in 0..6 {
-            a[col][k] *= scale;
-            inv[col][k] *= scale;
-        }
-        for row in 0..6 {
-            if row != col {
-                let f = a[row][col];
-                if f != 0.0 {
-                    for k in 0..6 {
-                        a[row][k] -= f * a[col][k];
-                        inv[row][k] -= f * inv[col][k];
-                    }
-                }
+        let mut pivot = col;
+        let mut best = rows[col][col].abs();
+        for (r, row) in rows.iter().enumerate().skip(col + 1) {
+            if row[col].abs() > best {
+                best = row[col].abs();
+                pivot = r;
             }
         }
+        if !(best > 0.0 && best.is_finite()) {
+            return None;
+        }
+        rows.swap(col, pivot);
+        let scale = 1.0 / rows[col][col];
+        let mut pivot_row = rows[col];
+        for x in &mut pivot_row {
+            *x *= scale;
+        }
+        for (r, row) in rows.iter_mut().enumerate() {
+            let f = if r == col { 0.0 } else { row[col] };
+            for (x, p) in row.iter_mut().zip(&pivot_row) {
+                *x -= f * p;
+            }
+        }
+        rows[col] = pivot_row;
+    }
+    let mut inv = [[0.0; 6]; 6];
+    for (out, row) in inv.iter_mut().zip(&rows) {
+        out.copy_from_slice(&row[6..]);
     }
     Some(inv)
 }

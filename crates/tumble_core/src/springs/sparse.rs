@@ -165,52 +165,61 @@ impl BlockLu {
     /// Factors the matrix in place, in the order of the last [`BlockLu::analyze`].
     pub(crate) fn factor(&mut self) -> Result<(), SingularPivot> {
         debug_assert_eq!(self.order.len(), self.diagonal.len(), "analyze first");
-        for step in 0..self.order.len() {
-            let p = self.order[step];
-            let inverse = invert(&self.diagonal[p]).ok_or(SingularPivot)?;
-            if self.pivots.len() <= self.pivot_count {
-                self.pivots.push(Pivot::default());
+        let Self {
+            rows,
+            diagonal,
+            pivots,
+            pivot_count,
+            order,
+            slot,
+            ..
+        } = self;
+        *pivot_count = 0;
+        for &p in order.iter() {
+            if pivots.len() <= *pivot_count {
+                pivots.push(Pivot::default());
             }
-            let mut pivot = std::mem::take(&mut self.pivots[self.pivot_count]);
+            let pivot = &mut pivots[*pivot_count];
+            *pivot_count += 1;
             pivot.body = p;
-            pivot.inverse = inverse;
-            pivot.lower.clear();
+            pivot.inverse = invert(&diagonal[p]).ok_or(SingularPivot)?;
+            // Row p becomes the pivot's upper blocks A_pj (the vectors trade places, no block
+            // is copied); each A_jp leaves row j (p is gone from the remaining matrix) as the
+            // multiplier A_jp P.
             pivot.upper.clear();
-            let mut row = std::mem::take(&mut self.rows[p]);
-            for (j, a_pj) in row.drain(..) {
-                // Take A_jp out of row j: p is gone from the remaining matrix.
-                let at = self.rows[j]
+            std::mem::swap(&mut pivot.upper, &mut rows[p]);
+            pivot.lower.clear();
+            for &(j, _) in &pivot.upper {
+                let at = rows[j]
                     .iter()
                     .position(|(c, _)| *c == p)
                     .expect("the pattern is symmetric");
-                let (_, a_jp) = self.rows[j].swap_remove(at);
-                pivot.lower.push((j, product(&a_jp, &inverse)));
-                pivot.upper.push((j, a_pj));
+                pivot
+                    .lower
+                    .push((j, product(&rows[j][at].1, &pivot.inverse)));
+                rows[j].swap_remove(at);
             }
-            self.rows[p] = row;
             // Schur complement: A_ij −= (A_ip P) A_pj over all remaining neighbours i, j of p.
             for (i, l_ip) in &pivot.lower {
-                let row = &mut self.rows[*i];
+                let row = &mut rows[*i];
                 for (at, (j, _)) in row.iter().enumerate() {
-                    self.slot[*j] = at;
+                    slot[*j] = at;
                 }
                 for (j, a_pj) in &pivot.upper {
                     if i == j {
-                        subtract_product(&mut self.diagonal[*i], l_ip, a_pj);
-                    } else if self.slot[*j] != usize::MAX {
-                        subtract_product(&mut row[self.slot[*j]].1, l_ip, a_pj);
+                        subtract_product(&mut diagonal[*i], l_ip, a_pj);
+                    } else if slot[*j] != usize::MAX {
+                        subtract_product(&mut row[slot[*j]].1, l_ip, a_pj);
                     } else {
-                        self.slot[*j] = row.len();
+                        slot[*j] = row.len();
                         row.push((*j, [[0.0; 6]; 6]));
                         subtract_product(&mut row.last_mut().expect("pushed").1, l_ip, a_pj);
                     }
                 }
                 for (j, _) in row.iter() {
-                    self.slot[*j] = usize::MAX;
+                    slot[*j] = usize::MAX;
                 }
             }
-            self.pivots[self.pivot_count] = pivot;
-            self.pivot_count += 1;
         }
         Ok(())
     }
