@@ -40,74 +40,14 @@ pub fn run(scene: &Scene, settings: Settings) -> Result<(), Failure> {
         springs,
         rapier_springs,
     } = settings;
-    let states = scene.body_states();
-    let mut bodies: Vec<ComparisonBody> = states
-        .iter()
-        .map(|s| {
-            let mut b = ComparisonBody::new(s.name.clone(), s.mass, s.state);
-            b.gravity_scale = s.gravity_scale;
-            b.linear_damping = s.linear_damping;
-            b.angular_damping = s.angular_damping;
-            b
-        })
-        .collect();
-    let index = |name: &str| {
-        states
-            .iter()
-            .position(|s| s.name == name)
-            .ok_or_else(|| Failure::from("unknown body"))
-    };
-    let vec = |v: &[f64; 3]| glam::DVec3::from_array(*v).narrow();
-    let mut spring_defs = Vec::new();
-    for force in &scene.file().forces {
-        match force {
-            ForceDef::Constant { body, force, point } => {
-                bodies[index(body)?].loads.push(Load::Force {
-                    force: vec(force),
-                    local_point: point.as_ref().map(vec),
-                });
-            }
-            ForceDef::Torque { body, torque } => {
-                bodies[index(body)?].loads.push(Load::Torque(vec(torque)));
-            }
-            ForceDef::Spring {
-                a,
-                anchor_a,
-                b,
-                anchor_b,
-                stiffness,
-                damping,
-                rest_length,
-            } => {
-                let b = match b {
-                    Some(b) => ComparisonSpringEnd::Body {
-                        body: index(b)?,
-                        anchor: vec(anchor_b),
-                    },
-                    None => ComparisonSpringEnd::World(vec(anchor_b)),
-                };
-                spring_defs.push(ComparisonSpring {
-                    a: index(a)?,
-                    anchor_a: vec(anchor_a),
-                    b,
-                    stiffness: stiffness.narrow(),
-                    damping: damping.narrow(),
-                    rest_length: rest_length.narrow(),
-                });
-            }
-        }
-    }
-    let mut sprung = vec![false; bodies.len()];
-    for spring in &spring_defs {
+    let comparison = comparison_scene(scene)?;
+    let mut sprung = vec![false; comparison.bodies.len()];
+    for spring in &comparison.springs {
         sprung[spring.a] = true;
         if let ComparisonSpringEnd::Body { body, .. } = spring.b {
             sprung[body] = true;
         }
     }
-    let comparison = ComparisonScene {
-        springs: spring_defs,
-        ..ComparisonScene::new(scene.dt(), scene.gravity(), bodies)
-    };
     // Exact solutions for bodies without loads or damping: the position is the parabola
     // x₀ + v₀t + ½ g s t²; the orientation is a steady rotation for a spherical body, or the
     // elliptic torque-free top for distinct moments (identity principal frame).
@@ -244,6 +184,71 @@ pub fn run(scene: &Scene, settings: Settings) -> Result<(), Failure> {
     Ok(())
 }
 
+/// The scene as both engines run it: bodies with their loads and damping, and the springs.
+fn comparison_scene(scene: &Scene) -> Result<ComparisonScene, Failure> {
+    let states = scene.body_states();
+    let mut bodies: Vec<ComparisonBody> = states
+        .iter()
+        .map(|s| {
+            let mut b = ComparisonBody::new(s.name.clone(), s.mass, s.state);
+            b.gravity_scale = s.gravity_scale;
+            b.linear_damping = s.linear_damping;
+            b.angular_damping = s.angular_damping;
+            b
+        })
+        .collect();
+    let index = |name: &str| {
+        states
+            .iter()
+            .position(|s| s.name == name)
+            .ok_or_else(|| Failure::from("unknown body"))
+    };
+    let vec = |v: &[f64; 3]| glam::DVec3::from_array(*v).narrow();
+    let mut spring_defs = Vec::new();
+    for force in &scene.file().forces {
+        match force {
+            ForceDef::Constant { body, force, point } => {
+                bodies[index(body)?].loads.push(Load::Force {
+                    force: vec(force),
+                    local_point: point.as_ref().map(vec),
+                });
+            }
+            ForceDef::Torque { body, torque } => {
+                bodies[index(body)?].loads.push(Load::Torque(vec(torque)));
+            }
+            ForceDef::Spring {
+                a,
+                anchor_a,
+                b,
+                anchor_b,
+                stiffness,
+                damping,
+                rest_length,
+            } => {
+                let b = match b {
+                    Some(b) => ComparisonSpringEnd::Body {
+                        body: index(b)?,
+                        anchor: vec(anchor_b),
+                    },
+                    None => ComparisonSpringEnd::World(vec(anchor_b)),
+                };
+                spring_defs.push(ComparisonSpring {
+                    a: index(a)?,
+                    anchor_a: vec(anchor_a),
+                    b,
+                    stiffness: stiffness.narrow(),
+                    damping: damping.narrow(),
+                    rest_length: rest_length.narrow(),
+                });
+            }
+        }
+    }
+    Ok(ComparisonScene {
+        springs: spring_defs,
+        ..ComparisonScene::new(scene.dt(), scene.gravity(), bodies)
+    })
+}
+
 /// Prints each engine's total energy (kinetic + spring + gravity, [`ComparisonScene::total_energy`])
 /// before and after, with the largest relative change over the run, or the step after which it
 /// stopped meaning anything (a quarantined or non-finite body).
@@ -272,4 +277,42 @@ fn print_energy(result: &Comparison) {
         describe(&result.tumble_energy),
         describe(&result.rapier_energy)
     );
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use tumble_rapier::presets::{ChainStart, spring_chain};
+
+    /// `scenes/stiff_chain.toml` is the report's and the bench's chain at ωΔt = 10 (the file
+    /// holds its numbers to 9 digits).
+    #[test]
+    fn the_bundled_stiff_chain_is_the_preset() {
+        let text = include_str!("../../../scenes/stiff_chain.toml");
+        let scene = Scene::parse("stiff_chain.toml", text).expect("a valid scene");
+        let file = comparison_scene(&scene).expect("a comparable scene");
+        let preset = spring_chain(10.0, ChainStart::Stretched, 1);
+        let close = |a: Real, b: Real| (a - b).abs() <= 1e-6 * (1.0 + b.abs());
+        let close3 = |a: Vec3, b: Vec3| (0..3).all(|k| close(a[k], b[k]));
+        assert_eq!(file.bodies.len(), preset.bodies.len());
+        assert_eq!(file.springs.len(), preset.springs.len());
+        assert!(close(file.dt, preset.dt));
+        for (f, p) in file.bodies.iter().zip(&preset.bodies) {
+            assert_eq!(f.mass, p.mass, "{}", f.name);
+            assert!(close3(f.state.position, p.state.position), "{}", f.name);
+            assert!(
+                f.state.rotation.angle_between(p.state.rotation) <= 1e-6,
+                "{}",
+                f.name
+            );
+            assert!(close3(f.state.linear_velocity, p.state.linear_velocity));
+            assert!(close3(f.state.angular_velocity, p.state.angular_velocity));
+        }
+        for (f, p) in file.springs.iter().zip(&preset.springs) {
+            assert_eq!((f.a, f.b), (p.a, p.b));
+            assert!(close3(f.anchor_a, p.anchor_a));
+            assert!(close(f.stiffness, p.stiffness) && close(f.rest_length, p.rest_length));
+            assert_eq!(f.damping, p.damping);
+        }
+    }
 }
