@@ -1104,23 +1104,29 @@ mod jacobian_tests {
     use crate::mass::Mass;
     use crate::math::Quat;
 
-    /// The Newton matrix against central differences of the residual, column by column.
-    #[test]
-    fn jacobian_matches_finite_differences() {
-        let mass = |i: Vec3| MassProperties::new(Mass::new(1.0).unwrap(), i).unwrap();
-        let body = |x: Vec3, q: Quat, w: Vec3| GroupBody {
+    /// An asymmetric body (I = (0.02, 0.03, 0.04)) of mass `m` at `x`, turned by `q`, moving at
+    /// (0.1, 0.2, −0.1) and turning at `w`, under `load`.
+    fn test_body(m: Real, load: Wrench, x: Vec3, q: Quat, w: Vec3) -> GroupBody {
+        GroupBody {
             state: BodyState {
                 position: x,
                 rotation: q,
                 linear_velocity: Vec3::new(0.1, 0.2, -0.1),
                 angular_velocity: w,
             },
-            mass: mass(Vec3::new(0.02, 0.03, 0.04)),
-            load: Wrench {
-                force: Vec3::new(0.0, -9.8, 0.0),
-                torque: Vec3::new(0.01, 0.0, 0.02),
-            },
+            mass: MassProperties::new(Mass::new(m).unwrap(), Vec3::new(0.02, 0.03, 0.04)).unwrap(),
+            load,
+        }
+    }
+
+    /// The Newton matrix against central differences of the residual, column by column.
+    #[test]
+    fn jacobian_matches_finite_differences() {
+        let load = Wrench {
+            force: Vec3::new(0.0, -9.8, 0.0),
+            torque: Vec3::new(0.01, 0.0, 0.02),
         };
+        let body = |x: Vec3, q: Quat, w: Vec3| test_body(1.0, load, x, q, w);
         let bodies = [
             body(
                 Vec3::ZERO,
@@ -1209,17 +1215,7 @@ mod jacobian_tests {
     /// three bodies (fill-in).
     #[test]
     fn the_factorization_inverts_the_newton_matrix() {
-        let mass = |i: Vec3| MassProperties::new(Mass::new(1.3).unwrap(), i).unwrap();
-        let body = |x: Vec3, q: Quat, w: Vec3| GroupBody {
-            state: BodyState {
-                position: x,
-                rotation: q,
-                linear_velocity: Vec3::new(0.1, 0.2, -0.1),
-                angular_velocity: w,
-            },
-            mass: mass(Vec3::new(0.02, 0.03, 0.04)),
-            load: Wrench::default(),
-        };
+        let body = |x: Vec3, q: Quat, w: Vec3| test_body(1.3, Wrench::default(), x, q, w);
         let bodies = [
             body(
                 Vec3::ZERO,
