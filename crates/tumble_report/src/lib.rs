@@ -10,7 +10,7 @@
 //!   `max ||q| − 1|`? final/initial energy? and whether tumble's stability prediction warned;
 //! - **energy over time** ([`energy`]) for long spins, each method and rapier;
 //! - **springs against rapier** ([`springs`], [`spring_output`]): the stiff chain
-//!   ([`chain`]) at several `ωΔt`, tumble's explicit and implicit spring steps against rapier's
+//!   ([`tumble_rapier::presets::spring_chain`]) at several `ωΔt`, tumble's explicit and implicit spring steps against rapier's
 //!   `SpringJoint` and a hand-written spring force: energy over time and time per step;
 //! - **outputs** ([`output`]): `report.md`, `results.json` and SVG plots.
 
