@@ -2,12 +2,16 @@
 //!
 //! The explicit (drift–kick–drift) spring step is cheap but keeps a spring's energy only to about
 //! `(ωΔt)²/4` of it and diverges at `ωΔt ≥ 2`. A group of bodies joined by springs (a connected
-//! component of the spring graph over dynamic bodies) whose stiffest spring can reach
+//! component of the spring graph over dynamic bodies) that can vibrate at
 //! `ωΔt ≥` [`IMPLICIT_OMEGA_DT`] is stepped instead by the energy-conserving implicit step of
 //! [`tumble_core::springs::implicit`], as a whole: stable at any stiffness, with kinetic plus
-//! elastic energy conserved exactly and no numerical damping. `ω` is bounded above with the
-//! anchors' lever arms (`ω² = k Σ (1/m + |r|² max I⁻¹)`), so a group is never stiffer than the
-//! classification assumed. Soft groups pay nothing: their bodies stay on the explicit path.
+//! elastic energy conserved exactly and no numerical damping. `ω` is bounded above per body, over
+//! all of its springs and with the anchors' lever arms:
+//! `ω² ≤ max_bodies Σ_(its springs) k (ι_a + ι_b)`, `ι = 1/m + |r|² max I⁻¹` per end (a
+//! Gershgorin-style bound on the group's stiffness matrix, exact for the top mode of a uniform
+//! chain; one spring's own `k (ι_a + ι_b)` misses that a body pulled by several springs vibrates
+//! faster, by up to √degree). So a group is never stiffer than the classification assumed. Soft
+//! groups pay nothing: their bodies stay on the explicit path.
 //!
 //! [`PhysicsSettings::springs`](crate::components::PhysicsSettings::springs) overrides the choice
 //! for a world ([`SpringSolver`]). The classification is made when the schedule is planned and
@@ -173,20 +177,37 @@ pub fn classify_springs(world: &mut World) {
     let mut parent: Vec<usize> = (0..masses.len()).collect();
     let mut stiff_group = vec![false; masses.len()];
     let mut spring_root = Vec::with_capacity(springs.len());
-    for (_, spring) in &springs {
+    // Per spring, its ends' inverse effective mass bounds `ι`; per body, `Σ k (ι_a + ι_b)` over
+    // its springs (see the module docs).
+    let inverse_masses: Vec<[Real; 2]> = springs
+        .iter()
+        .map(|(_, spring)| {
+            let (a, b) = ends_in(&index, spring);
+            let bound = |end: Option<usize>, anchor| {
+                end.map_or(0.0, |i| inverse_effective_mass_bound(&masses[i], anchor))
+            };
+            let anchor_b = match spring.b {
+                SpringEnd::Body { anchor, .. } => anchor,
+                SpringEnd::World(_) => tumble_core::math::Vec3::ZERO,
+            };
+            [bound(a, spring.anchor_a), bound(b, anchor_b)]
+        })
+        .collect();
+    let mut pull: Vec<Real> = vec![0.0; masses.len()];
+    for ((_, spring), iota) in springs.iter().zip(&inverse_masses) {
         let (a, b) = ends_in(&index, spring);
-        let bound = |end: Option<usize>, anchor| {
-            end.map_or(0.0, |i| inverse_effective_mass_bound(&masses[i], anchor))
-        };
-        let anchor_b = match spring.b {
-            SpringEnd::Body { anchor, .. } => anchor,
-            SpringEnd::World(_) => tumble_core::math::Vec3::ZERO,
-        };
-        let omega_dt = omega_dt_bound(
-            spring.stiffness,
-            [bound(a, spring.anchor_a), bound(b, anchor_b)],
-            dt,
-        );
+        for i in [a, b].into_iter().flatten() {
+            pull[i] += spring.stiffness * (iota[0] + iota[1]);
+        }
+    }
+    for ((_, spring), iota) in springs.iter().zip(&inverse_masses) {
+        let (a, b) = ends_in(&index, spring);
+        let own = omega_dt_bound(spring.stiffness, *iota, dt);
+        let omega_dt = [a, b]
+            .into_iter()
+            .flatten()
+            .map(|i| pull[i].sqrt() * dt)
+            .fold(own, Real::max);
         let stiff = match settings.springs {
             SpringSolver::Auto => omega_dt >= IMPLICIT_OMEGA_DT,
             SpringSolver::Implicit => true,

@@ -213,6 +213,44 @@ fn the_planner_picks_the_spring_method_and_can_be_overridden() {
     assert_eq!(plan(5.0, SpringSolver::Explicit), (false, true, true));
 }
 
+/// A body pulled by many springs vibrates faster than any one of them: a point mass held by
+/// `n` springs to world points, each soft on its own (`√(k/m)Δt = 0.2`, below the 0.3 threshold),
+/// moves at `√n` times that along their common axis. The planner counts a body's springs
+/// together: one spring stays explicit, eight make the group implicit.
+#[test]
+fn the_planner_counts_every_spring_on_a_body() {
+    let implicit_with = |n: usize| {
+        let mut world = World::new();
+        world.insert_resource(PhysicsSettings::default());
+        let hub = body(
+            &mut world,
+            Vec3::ZERO,
+            Quat::IDENTITY,
+            Vec3::splat(0.4),
+            Vec3::ZERO,
+            Vec3::ZERO,
+        );
+        let k = (0.2 / DT).powi(2);
+        for i in 0..n {
+            let angle = i as Real * 0.7;
+            world.spawn(Spring {
+                a: hub,
+                anchor_a: Vec3::ZERO,
+                b: SpringEnd::World(Vec3::new(angle.cos(), angle.sin(), 0.0)),
+                stiffness: k,
+                damping: 0.0,
+                rest_length: 0.5,
+            });
+        }
+        PhysicsPlan::for_world(&mut world).contains(Stage::SolveImplicitSprings)
+    };
+    assert!(!implicit_with(1), "one soft spring stays explicit");
+    assert!(
+        implicit_with(8),
+        "eight of them on one body are stiff together"
+    );
+}
+
 /// A small cloth (a grid joined by springs to its neighbours, two corners held) falling under
 /// gravity at `ωΔt = 10`: finite, and its total energy (kinetic + elastic + gravity potential)
 /// does not grow: the implicit step conserves it, so only round-off may add to it.
