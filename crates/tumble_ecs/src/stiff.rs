@@ -177,9 +177,9 @@ pub fn classify_springs(world: &mut World) {
     let mut parent: Vec<usize> = (0..masses.len()).collect();
     let mut stiff_group = vec![false; masses.len()];
     let mut spring_root = Vec::with_capacity(springs.len());
-    // Per spring, its ends' inverse effective mass bounds `ι`; per body, `Σ k (ι_a + ι_b)` over
-    // its springs (see the module docs).
-    let inverse_masses: Vec<[Real; 2]> = springs
+    // Per spring, its ends (indices in `masses`) and their inverse effective mass bounds `ι`;
+    // per body, `Σ k (ι_a + ι_b)` over its springs (see the module docs).
+    let ends: Vec<(Option<usize>, Option<usize>, [Real; 2])> = springs
         .iter()
         .map(|(_, spring)| {
             let (a, b) = ends_in(&index, spring);
@@ -190,19 +190,19 @@ pub fn classify_springs(world: &mut World) {
                 SpringEnd::Body { anchor, .. } => anchor,
                 SpringEnd::World(_) => tumble_core::math::Vec3::ZERO,
             };
-            [bound(a, spring.anchor_a), bound(b, anchor_b)]
+            (a, b, [bound(a, spring.anchor_a), bound(b, anchor_b)])
         })
         .collect();
     let mut pull: Vec<Real> = vec![0.0; masses.len()];
-    for ((_, spring), iota) in springs.iter().zip(&inverse_masses) {
-        let (a, b) = ends_in(&index, spring);
+    for ((_, spring), &(a, b, iota)) in springs.iter().zip(&ends) {
         for i in [a, b].into_iter().flatten() {
             pull[i] += spring.stiffness * (iota[0] + iota[1]);
         }
     }
-    for ((_, spring), iota) in springs.iter().zip(&inverse_masses) {
-        let (a, b) = ends_in(&index, spring);
-        let own = omega_dt_bound(spring.stiffness, *iota, dt);
+    for ((_, spring), &(a, b, iota)) in springs.iter().zip(&ends) {
+        // A body's pull includes this spring's own `k (ι_a + ι_b)`; a spring without a dynamic
+        // end joins no group, and its own bound is all there is.
+        let own = omega_dt_bound(spring.stiffness, iota, dt);
         let omega_dt = [a, b]
             .into_iter()
             .flatten()

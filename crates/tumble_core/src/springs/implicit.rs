@@ -48,7 +48,7 @@
 //! with its exact matrix: the mass and gyroscopic blocks, each spring's coupling `¼ Gᵀ K G` with
 //! `K = k ((1 − L₀/ℓ̄) 1 + (L₀/ℓ̄²) d̄ d₁ᵀ/ℓ₁)` (the discrete-gradient force's derivative, not
 //! symmetric and indefinite for a compressed spring) and `G` the anchor's Jacobian, and the
-//! turning of the torques' frame and arms with `Ω̄` (forward differences per body).
+//! turning of the torques' frame and arms with `Ω̄` (in closed form, `turning_torque_jacobian`).
 //!
 //! Each Newton system is solved directly (module `springs::sparse`: block elimination in
 //! minimum-degree order, no fill on a chain or a tree); where a pivot is singular, by BiCGSTAB
@@ -1064,19 +1064,16 @@ impl ImplicitSpringSolver {
             .iter()
             .zip(poses)
             .map(|(s, p)| {
-                let w = s.free * (p.q.inverse() * p.w);
+                let w = p.body_rate(s);
                 0.5 * s.mass * p.v.length_squared() + 0.5 * (s.inertia * w * w).element_sum()
             })
             .sum();
-        let anchor = |end: &End| match poses.get(end.body) {
-            Some(p) => p.x + p.q * end.local,
-            None => end.fixed,
-        };
         let elastic: f64 = self
             .links
             .iter()
             .map(|l| {
-                let stretch = (anchor(&l.ends[0]) - anchor(&l.ends[1])).length() - l.rest;
+                let stretch =
+                    (anchor_at(poses, &l.ends[0]) - anchor_at(poses, &l.ends[1])).length() - l.rest;
                 0.5 * l.k * stretch * stretch
             })
             .sum();
@@ -1089,9 +1086,12 @@ impl ImplicitSpringSolver {
     /// the origin and its lever arm) plus `Σ_bodies ε (m|v|² + |ω| |Iω|)` for the velocities.
     fn rounding_bound(&self, exact: &[Pose]) -> f64 {
         let eps = Real::EPSILON.widen();
-        let anchor = |end: &End| match exact.get(end.body) {
-            Some(p) => (p.x + p.q * end.local, p.x.length() + end.local.length()),
-            None => (end.fixed, end.fixed.length()),
+        let anchor = |end: &End| {
+            let reach = match exact.get(end.body) {
+                Some(p) => p.x.length() + end.local.length(),
+                None => end.fixed.length(),
+            };
+            (anchor_at(exact, end), reach)
         };
         let springs: f64 = self
             .links
@@ -1106,7 +1106,7 @@ impl ImplicitSpringSolver {
             .iter()
             .zip(exact)
             .map(|(s, p)| {
-                let w = s.free * (p.q.inverse() * p.w);
+                let w = p.body_rate(s);
                 eps * (s.mass * p.v.length_squared() + w.length() * (s.inertia * w).length())
             })
             .sum();
@@ -1151,7 +1151,7 @@ impl ImplicitSpringSolver {
             .iter()
             .zip(&rounded)
             .map(|(s, p)| {
-                let w = s.free * (p.q.inverse() * p.w);
+                let w = p.body_rate(s);
                 0.5 * s.mass * (p.v - centre).length_squared()
                     + 0.5 * (s.inertia * w * w).element_sum()
             })
@@ -1185,6 +1185,21 @@ struct Pose {
     v: DVec3,
     /// World-frame angular velocity.
     w: DVec3,
+}
+
+impl Pose {
+    /// The angular velocity in the principal frame, 0 on a locked axis of `s`'s body.
+    fn body_rate(&self, s: &Start) -> DVec3 {
+        s.free * (self.q.inverse() * self.w)
+    }
+}
+
+/// The world point of a spring end with the bodies at `poses`.
+fn anchor_at(poses: &[Pose], end: &End) -> DVec3 {
+    match poses.get(end.body) {
+        Some(p) => p.x + p.q * end.local,
+        None => end.fixed,
+    }
 }
 
 /// A spring end's factors of the Newton matrix, see `ImplicitSpringSolver::end_factors`.
