@@ -71,9 +71,10 @@ fn audit_cost(c: &mut Criterion) {
     ] {
         group.bench_with_input(BenchmarkId::from_parameter(name), &audit, |b, &audit| {
             let mut world = chain(n, audit);
-            let mut schedule = PhysicsPlan::for_world(&mut world).build_schedule();
+            let plan = PhysicsPlan::for_world(&mut world);
+            let mut schedule = plan.build_schedule();
             b.iter(|| {
-                schedule.run(&mut world);
+                plan.run_step(&mut schedule, &mut world);
                 world.clear_trackers();
             });
         });

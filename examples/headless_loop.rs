@@ -16,9 +16,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             angular: Vec3::new(0.1, 4.0, 0.1),
         })
         .id();
-    let mut schedule = PhysicsPlan::for_world(&mut world).build_schedule();
+    let plan = PhysicsPlan::for_world(&mut world);
+    let mut schedule = plan.build_schedule();
     for step in 1..=120 {
-        schedule.run(&mut world);
+        plan.run_step(&mut schedule, &mut world);
         world.clear_trackers();
         if step % 30 == 0 {
             let t = world.get::<Transform>(body).ok_or("body vanished")?;

@@ -59,9 +59,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .id();
         bodies.push((name, entity));
     }
-    let mut schedule = PhysicsPlan::for_world(&mut world).build_schedule();
+    let plan = PhysicsPlan::for_world(&mut world);
+    let mut schedule = plan.build_schedule();
     for _ in 0..120 {
-        schedule.run(&mut world);
+        plan.run_step(&mut schedule, &mut world);
         world.clear_trackers();
     }
     for (name, entity) in bodies {

@@ -2,8 +2,10 @@
 //!
 //! Rigid-body dynamics for headless game loops, on `bevy_ecs`, `glam` and `parry3d`.
 //!
-//! Spawn bodies with components, build a [`PhysicsPlan`](prelude::PhysicsPlan) schedule, run it
-//! once per fixed step, read the poses back:
+//! Spawn bodies with components, build a [`PhysicsPlan`](prelude::PhysicsPlan) schedule, run one
+//! step of it per fixed step (`plan.run_step`: the schedule once per stage of the step, once
+//! unless there are substeps or a composition; or let `PhysicsRunner` plan and step), read the
+//! poses back:
 //!
 //! ```
 //! use tumble::prelude::*;
@@ -16,9 +18,10 @@
 //! let ball = world
 //!     .spawn((RigidBody, MassProps(mass), ForceAccumulator::default()))
 //!     .id();
-//! let mut schedule = PhysicsPlan::for_world(&mut world).build_schedule();
+//! let plan = PhysicsPlan::for_world(&mut world);
+//! let mut schedule = plan.build_schedule();
 //! for _ in 0..60 {
-//!     schedule.run(&mut world);
+//!     plan.run_step(&mut schedule, &mut world);
 //!     world.clear_trackers();
 //! }
 //! let y = world.get::<Transform>(ball).unwrap().translation.y;

@@ -9,4 +9,5 @@ mod integrators {
     pub mod gyroscopic;
     pub mod harness;
     pub mod stability;
+    pub mod stages;
 }

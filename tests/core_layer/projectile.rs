@@ -99,11 +99,11 @@ fn drift_kick_drift_is_exact_for_constant_gravity() {
             ))
             .id();
         let plan = PhysicsPlan::for_world(&mut world);
-        assert!(plan.contains(Stage::BeginStep), "{integrator}: {plan}");
+        assert!(plan.contains(Stage::BeginStage), "{integrator}: {plan}");
         let mut schedule = plan.build_schedule();
         let n = 600;
         for _ in 0..n {
-            schedule.run(&mut world);
+            plan.run_step(&mut schedule, &mut world);
         }
         let t = to_f64(dt) * to_f64(n);
         let exact = x0.widen() + v0.widen() * t + 0.5 * g.widen() * t * t;

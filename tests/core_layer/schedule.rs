@@ -110,7 +110,7 @@ fn static_and_kinematic_bodies_are_never_integrated() {
     let plan = PhysicsPlan::for_world(&mut world);
     assert_eq!(
         plan.to_string(),
-        "audit_energy_start → begin_step → apply_gravity → apply_springs → \
+        "audit_energy_start → begin_stage → apply_gravity → apply_springs → \
          audit_external_loads → integrate_with_forces → discard_fixed_body_forces → audit_energy"
     );
     let mut schedule = plan.build_schedule();
@@ -169,7 +169,7 @@ fn the_runner_replans_when_the_world_changes() {
     // Switching to a drift–kick–drift integrator adds the first half-drift.
     world.resource_mut::<PhysicsSettings>().integrator = Integrator::Splitting;
     physics.step(&mut world);
-    assert!(physics.plan().contains(Stage::BeginStep));
+    assert!(physics.plan().contains(Stage::BeginStage));
     assert_eq!(physics.replans(), 3);
     assert_eq!(format!("{physics}"), physics.plan().to_string());
 }
@@ -219,6 +219,8 @@ fn user_force_system_in_forces_set_runs_before_integration() {
 #[test]
 fn a_world_needing_everything_plans_every_stage_in_order() {
     let mut world = world_with(0.01, Integrator::Splitting);
+    // Substeps: the stage cursor's two systems.
+    world.resource_mut::<PhysicsSettings>().substeps = std::num::NonZeroU32::new(2).unwrap();
     world.insert_resource(Gravity::EARTH_Y_DOWN);
     let wall = world
         .spawn((RigidBody, Static, ForceAccumulator::default()))
@@ -286,7 +288,7 @@ fn damper_stages_only_with_a_damped_spring() {
     physics.step(&mut world);
     assert_eq!(
         physics.plan().to_string(),
-        "audit_energy_start → damp_springs_start → begin_step → apply_springs → \
+        "audit_energy_start → damp_springs_start → begin_stage → apply_springs → \
          audit_external_loads → integrate_with_forces → damp_springs_end → audit_energy"
     );
     assert_eq!(physics.replans(), 1);

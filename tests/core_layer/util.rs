@@ -12,14 +12,15 @@ pub fn world_with(dt: Real, integrator: Integrator) -> World {
     world
 }
 
-/// Plans the schedule of `world` and runs it `steps` times.
+/// Plans the schedule of `world` and runs `steps` steps of it.
 pub fn run(world: &mut World, steps: usize) -> Schedule {
-    let mut schedule = PhysicsPlan::for_world(world).build_schedule();
-    run_schedule(world, &mut schedule, steps);
+    let plan = PhysicsPlan::for_world(world);
+    let mut schedule = plan.build_schedule();
+    run_schedule(world, &mut schedule, steps * plan.runs_per_step());
     schedule
 }
 
-/// Runs an already built schedule `steps` times.
+/// Runs an already built schedule `steps` times (stages: steps of a plan of one stage).
 pub fn run_schedule(world: &mut World, schedule: &mut Schedule, steps: usize) {
     for _ in 0..steps {
         schedule.run(world);

@@ -34,9 +34,10 @@ fn spring_world(omega_dt: Real, integrator: Integrator, springs: SpringSolver) -
 }
 
 fn diverges(world: &mut World, body: Entity, steps: usize) -> bool {
-    let mut schedule = PhysicsPlan::for_world(world).build_schedule();
+    let plan = PhysicsPlan::for_world(world);
+    let mut schedule = plan.build_schedule();
     for _ in 0..steps {
-        schedule.run(world);
+        plan.run_step(&mut schedule, world);
         let x = world.get::<Transform>(body).unwrap().translation.length();
         if world.get::<Rejected>(body).is_some() || x > 1e3 {
             return true;

@@ -108,6 +108,9 @@ pub struct RunArgs {
     /// or `implicit`.
     #[arg(long)]
     pub springs: Option<OsString>,
+    /// Override the substeps per step (1 to 1000): the forces are sampled in each.
+    #[arg(long, allow_hyphen_values = true)]
+    pub substeps: Option<i64>,
     /// Write the trajectory to this CSV file, `-` for stdout (the summary then goes to stderr).
     #[arg(long)]
     pub out: Option<PathBuf>,

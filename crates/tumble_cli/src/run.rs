@@ -12,7 +12,9 @@ use tumble_core::math::{Real, to_f64};
 use tumble_ecs::prelude::*;
 use tumble_scene::output::{OutputError, OutputFile};
 use tumble_scene::text::{path_for_terminal, terminal_safe};
-use tumble_scene::{BuiltScene, MAX_STEPS, Scene, SceneError, TrajectoryError, csv_text_cell};
+use tumble_scene::{
+    BuiltScene, MAX_STEPS, MAX_SUBSTEPS, Scene, SceneError, TrajectoryError, csv_text_cell,
+};
 
 use crate::cli::RunArgs;
 use crate::exit::{self, Failure};
@@ -39,15 +41,40 @@ fn override_error(
     steps: Option<u64>,
     integrator: bool,
     springs: bool,
+    substeps: bool,
 ) -> Failure {
     let flag = match e.field.as_str() {
         "world.dt" if dt.is_some() => "--dt",
         "world.steps" if steps.is_some() => "--steps",
         "world.integrator" if integrator => "--integrator",
         "world.springs" if springs => "--springs",
+        "world.substeps" if substeps => "--substeps",
         _ => return e.into(),
     };
     Failure::new(exit::ERROR, format!("{flag}: {}", e.message))
+}
+
+/// The stages of a step of several (substeps, a composition), as `--plan` prints them: each
+/// stage's span as a multiple of `Δt`, and which substep it belongs to.
+fn stages_line(world: &World) -> Option<String> {
+    let settings = world.get_resource::<PhysicsSettings>()?;
+    let stages = settings.stages();
+    if stages.count() == 1 {
+        return None;
+    }
+    let dt = settings.dt();
+    let spans: Vec<String> = stages
+        .spans(dt)
+        .map(|s| format!("{:.6}", to_f64(s.h) / to_f64(dt)))
+        .collect();
+    Some(format!(
+        "stages per step: {} ({} substep(s) × {} of `{}`), h/Δt = {}",
+        stages.count(),
+        settings.substeps,
+        settings.integrator.composition().len(),
+        settings.integrator,
+        spans.join(", ")
+    ))
 }
 
 /// `tumble run`.
@@ -78,9 +105,23 @@ pub fn run(args: RunArgs) -> Result<(), Failure> {
         .springs
         .map(|v| crate::utf8("--springs", v))
         .transpose()?;
+    let substeps = match args.substeps {
+        Some(n) if !(1..=i64::from(MAX_SUBSTEPS)).contains(&n) => {
+            return Err(Failure::new(
+                exit::ERROR,
+                format!("--substeps: expected 1 to {MAX_SUBSTEPS} substeps, got {n}"),
+            ));
+        }
+        other => other.map(|n| n as u64),
+    };
     let loaded = crate::load(&args.scene)?;
     let mut scene = Scene::parse(&loaded.file, &loaded.text)?;
-    if steps.is_some() || args.dt.is_some() || integrator.is_some() || springs.is_some() {
+    if steps.is_some()
+        || args.dt.is_some()
+        || integrator.is_some()
+        || springs.is_some()
+        || substeps.is_some()
+    {
         // Overrides are applied to the file model, then validated like the file itself.
         let mut model = scene.file().clone();
         model.world.steps = steps.unwrap_or(model.world.steps);
@@ -89,13 +130,25 @@ pub fn run(args: RunArgs) -> Result<(), Failure> {
         model.world.integrator = integrator.or(model.world.integrator);
         let springs_overridden = springs.is_some();
         model.world.springs = springs.or(model.world.springs);
+        model.world.substeps = substeps.or(model.world.substeps);
         let text = tumble_scene::to_toml_string(&model)?;
-        scene = Scene::parse(&loaded.file, &text)
-            .map_err(|e| override_error(e, args.dt, steps, overridden, springs_overridden))?;
+        scene = Scene::parse(&loaded.file, &text).map_err(|e| {
+            override_error(
+                e,
+                args.dt,
+                steps,
+                overridden,
+                springs_overridden,
+                substeps.is_some(),
+            )
+        })?;
     }
     let mut built = scene.build();
     if args.plan {
         println!("{}", PhysicsPlan::for_world(&mut built.world));
+        if let Some(line) = stages_line(&built.world) {
+            println!("{line}");
+        }
         return Ok(());
     }
     let names = Names::new(&mut built.world, &built.bodies);
@@ -157,8 +210,7 @@ pub fn run(args: RunArgs) -> Result<(), Failure> {
         }
         None => {
             for step in 1..=steps {
-                built.schedule.run(&mut built.world);
-                built.world.clear_trackers();
+                built.step();
                 if on_step(step, &built.world).is_break() {
                     return Err(interrupted(step, None));
                 }
@@ -171,7 +223,11 @@ pub fn run(args: RunArgs) -> Result<(), Failure> {
     let body_steps = (steps as f64) * built.bodies.len().max(1) as f64;
     let (dt, integrator) = {
         let settings = built.world.resource::<PhysicsSettings>();
-        (settings.dt(), settings.integrator)
+        let integrator = match settings.substeps.get() {
+            1 => settings.integrator.to_string(),
+            n => format!("{}, {n} substeps", settings.integrator),
+        };
+        (settings.dt(), integrator)
     };
     let rejected = built.world.query::<&Rejected>().iter(&built.world).count();
     // With the trajectory on stdout, the summary goes to stderr so that the CSV stays clean.
@@ -342,7 +398,7 @@ pub fn stability_gate(built: &mut BuiltScene, names: &Names, allow: bool) -> Res
         ));
     }
     built.world.insert_resource(EnergyAudit::Always);
-    built.schedule = PhysicsPlan::for_world(&mut built.world).build_schedule();
+    built.replan();
     Ok(())
 }
 

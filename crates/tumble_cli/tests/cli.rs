@@ -46,8 +46,7 @@ fn run_writes_the_specified_csv_bit_identical_to_the_library() {
     let scene = load_scene(std::path::Path::new(&scene_path("spring_chain"))).unwrap();
     let mut built = scene.build();
     for _ in 0..50 {
-        built.schedule.run(&mut built.world);
-        built.world.clear_trackers();
+        built.step();
     }
     for (k, (name, e)) in built.bodies.iter().enumerate() {
         let row = &rows[5 * 3 + k];

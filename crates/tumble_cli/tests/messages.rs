@@ -50,6 +50,18 @@ fn negative_numbers_reach_tumbles_own_checks() {
             vec!["--every", "0"],
             "error: --every: expected a value >= 1, got 0",
         ),
+        (
+            vec!["--substeps", "0"],
+            "error: --substeps: expected 1 to 1000 substeps, got 0",
+        ),
+        (
+            vec!["--substeps", "-3"],
+            "error: --substeps: expected 1 to 1000 substeps, got -3",
+        ),
+        (
+            vec!["--substeps", "1001"],
+            "error: --substeps: expected 1 to 1000 substeps, got 1001",
+        ),
     ] {
         let output = tumble()
             .args(["run", "projectile"])
@@ -380,4 +392,50 @@ fn compare_never_reports_a_quarantined_body_as_agreement() {
         "{text}"
     );
     assert!(last_error_line(&output).contains("did not run cleanly"));
+}
+
+/// A scene's `[world] substeps` outside 1..=1000 names the file, the line and the field; a good
+/// value shows in the plan (the stages of a step) and in the summary.
+#[test]
+fn substeps_are_checked_and_shown() {
+    let dir = tempfile::tempdir().unwrap();
+    let bad = dir.path().join("bad.toml");
+    std::fs::write(
+        &bad,
+        "name = \"s\"\n[world]\ndt = 0.01\nsteps = 10\nsubsteps = 0\n\n[[bodies]]\nname = \"b\"\nmass = 1.0\ninertia = [1.0, 1.0, 1.0]\n",
+    )
+    .unwrap();
+    let output = tumble().arg("run").arg(&bad).output().unwrap();
+    assert_eq!(output.status.code(), Some(1));
+    let line = error_line(&output);
+    assert!(
+        line.contains("bad.toml:")
+            && line.ends_with("world.substeps: expected 1 to 1000 substeps, got 0"),
+        "{line}"
+    );
+    let plan = tumble()
+        .args([
+            "run",
+            "projectile",
+            "--plan",
+            "--substeps",
+            "2",
+            "--integrator",
+            "yoshida4",
+        ])
+        .output()
+        .unwrap();
+    assert!(plan.status.success());
+    let text = String::from_utf8_lossy(&plan.stdout);
+    assert!(text.contains("(× 6 stages per step)"), "{text}");
+    assert!(
+        text.contains("stages per step: 6 (2 substep(s) × 3 of `yoshida4`), h/Δt = 0.675604, -0.851207, 0.675604"),
+        "{text}"
+    );
+    let run = tumble()
+        .args(["run", "projectile", "--substeps", "3", "--steps", "5"])
+        .output()
+        .unwrap();
+    assert!(run.status.success());
+    assert!(String::from_utf8_lossy(&run.stdout).contains("(splitting, 3 substeps)"));
 }

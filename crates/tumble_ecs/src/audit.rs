@@ -79,6 +79,7 @@ use crate::components::{
     Static, Transform, Velocity, kinetic_energy_f64,
 };
 use crate::forces::{Spring, SpringEnd, spring_force};
+use crate::stages::StageCursor;
 use crate::systems::Dynamic;
 use crate::validate::{BodyError, BodyErrorKind, Rejected, reject};
 
@@ -191,6 +192,9 @@ pub struct EnergyLedger {
     groups: Vec<GroupStep>,
     accounts: HashMap<Entity, Account>,
     dt: f64,
+    /// The plain step with the stability of one substep (`Δt` unless there are substeps or a
+    /// composition, see `Stages::stability_span`): the span a spring's `ωh` is measured on.
+    stability_span: f64,
     /// Whether the integrator drifts–kicks–drifts (else it kicks, then drifts).
     midpoint: bool,
     /// Accounts were restored under some member of their group, not necessarily its smallest
@@ -318,13 +322,18 @@ fn end_of(index: &EntityHashMap<usize>, ends: &Ends, body: Entity, anchor: Vec3)
 /// the springs' ends, forms the spring groups and measures each group's `T + V`.
 pub fn audit_energy_start(
     settings: Res<PhysicsSettings>,
+    cursor: Res<StageCursor>,
     mut ledger: ResMut<EnergyLedger>,
     bodies: Query<(Entity, &Transform, &Velocity, &MassProps), Dynamic>,
     ends: Ends,
     springs: Query<(&Spring, Has<crate::stiff::ImplicitSpring>)>,
 ) {
     let ledger = &mut *ledger;
+    if !cursor.span(&settings).opens_step {
+        return;
+    }
     ledger.dt = settings.dt().widen();
+    ledger.stability_span = settings.stages().stability_span(settings.dt()).widen();
     ledger.midpoint = settings.integrator.samples_forces_at_midpoint();
     ledger.bodies.clear();
     ledger.index.clear();
@@ -394,7 +403,7 @@ pub fn audit_energy_start(
         } else {
             ma * mb / (ma + mb)
         };
-        let omega_dt = (link.spring.stiffness.widen() / reduced).sqrt() * ledger.dt;
+        let omega_dt = (link.spring.stiffness.widen() / reduced).sqrt() * ledger.stability_span;
         let elastic = ledger.elastic(&link, |b| b.start.0);
         let g = &mut ledger.groups[root];
         g.springs += 1;
@@ -413,14 +422,34 @@ pub fn audit_energy_start(
 /// state. (Spring dampers are not forces in the accumulators: they are the velocity flow of
 /// [`crate::damping`], an energy loss the balance sees and never flags.)
 pub fn audit_external_loads(
+    settings: Res<PhysicsSettings>,
+    cursor: Res<StageCursor>,
     mut ledger: ResMut<EnergyLedger>,
     accumulators: Query<(Entity, &ForceAccumulator), Dynamic>,
     states: Query<(&Transform, &MassProps), Dynamic>,
 ) {
     let ledger = &mut *ledger;
+    let span = cursor.span(&settings);
+    // Each stage's load counts with the stage's share `h/Δt` of the step (1 for a step of one
+    // stage, so its load is used as it is).
+    let share = if span.opens_step && span.closes_step {
+        None
+    } else {
+        Some(span.h / settings.dt())
+    };
     for (entity, acc) in &accumulators {
         if let Some(&i) = ledger.index.get(&entity) {
-            ledger.bodies[i].load = (acc.force, acc.torque);
+            let load = &mut ledger.bodies[i].load;
+            match share {
+                None => *load = (acc.force, acc.torque),
+                Some(w) => {
+                    if span.opens_step {
+                        *load = (Vec3::ZERO, Vec3::ZERO);
+                    }
+                    load.0 += w * acc.force;
+                    load.1 += w * acc.torque;
+                }
+            }
         }
     }
     // Anchor point and the centre of mass, on the (half-drifted) state the force systems saw.
@@ -441,7 +470,7 @@ pub fn audit_external_loads(
         else {
             continue;
         };
-        let f = spring_force(&link.spring, pa - pb);
+        let f = share.unwrap_or(1.0) * spring_force(&link.spring, pa - pb);
         if let End::Audited(i, _) = link.a {
             let load = &mut ledger.bodies[i].load;
             load.0 -= f;
@@ -459,6 +488,8 @@ pub fn audit_external_loads(
 /// groups whose integrator created more energy than the bound allows, putting them back to
 /// their state at the start of the step.
 pub fn audit_energy(
+    settings: Res<PhysicsSettings>,
+    cursor: Res<StageCursor>,
     mut ledger: ResMut<EnergyLedger>,
     gravity: Option<Res<Gravity>>,
     bodies: Query<
@@ -475,6 +506,9 @@ pub fn audit_energy(
     mut commands: Commands,
 ) {
     let ledger = &mut *ledger;
+    if !cursor.span(&settings).closes_step {
+        return;
+    }
     let dt = ledger.dt;
     let gravity = gravity.map(|g| g.0);
     for (entity, t, v, m, scale, has_accumulator) in &bodies {

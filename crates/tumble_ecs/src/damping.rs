@@ -31,6 +31,7 @@ use crate::components::{
     Kinematic, MassProps, PhysicsSettings, RigidBody, Static, Transform, Velocity,
 };
 use crate::forces::{Spring, SpringEnd};
+use crate::stages::StageCursor;
 use crate::validate::Rejected;
 
 /// The spring ends a damper reads and pushes: valid rigid bodies of any kind (a [`Static`] or
@@ -48,30 +49,41 @@ type DamperEnds<'w, 's> = Query<
     (With<RigidBody>, Without<Rejected>),
 >;
 
-/// First half of the spring dampers' flow, `D(Δt/2)`, before anything else moves the bodies:
-/// every [`Spring`] with `damping > 0`, in query order. Only in the plan when such a spring
-/// exists.
+/// First half of the spring dampers' flow over a substep `h` (the whole step without substeps),
+/// `D(h/2)`, before anything else moves the bodies: every [`Spring`] with `damping > 0`, in
+/// query order, in the first stage of each substep. Only in the plan when such a spring exists.
 pub fn damp_springs_start(
     settings: Res<PhysicsSettings>,
+    cursor: Res<StageCursor>,
     springs: Query<&Spring>,
     mut bodies: DamperEnds,
 ) {
-    let tau = 0.5 * settings.dt();
+    let span = cursor.span(&settings);
+    if !span.opens_substep {
+        return;
+    }
+    let tau = 0.5 * span.substep;
     for spring in &springs {
         damp_spring(spring, tau, &mut bodies);
     }
 }
 
-/// Second half of the spring dampers' flow, `D(Δt/2)`, after the integration: the springs of
-/// [`damp_springs_start`] in the reverse order (the adjoint sweep, so the step is symmetric).
-/// `order` is a reused buffer (no allocation once the world stops growing).
+/// Second half of the spring dampers' flow, `D(h/2)`, after the integration, in the last stage
+/// of each substep: the springs of [`damp_springs_start`] in the reverse order (the adjoint
+/// sweep, so the step is symmetric). `order` is a reused buffer (no allocation once the world
+/// stops growing).
 pub fn damp_springs_end(
     settings: Res<PhysicsSettings>,
+    cursor: Res<StageCursor>,
     springs: Query<&Spring>,
     mut bodies: DamperEnds,
     mut order: Local<Vec<Spring>>,
 ) {
-    let tau = 0.5 * settings.dt();
+    let span = cursor.span(&settings);
+    if !span.closes_substep {
+        return;
+    }
+    let tau = 0.5 * span.substep;
     order.clear();
     order.extend(springs.iter().filter(|s| is_damped(s)).copied());
     for spring in order.iter().rev() {

@@ -24,6 +24,7 @@ pub mod schedule;
 #[cfg(feature = "serde")]
 pub mod snapshot;
 pub mod stability;
+pub mod stages;
 pub mod stepper;
 pub mod stiff;
 pub mod systems;
@@ -39,7 +40,7 @@ pub mod prelude {
     };
     pub use crate::forces::{ConstantForce, ConstantTorque, Spring, SpringEnd};
     pub use crate::parallel::Parallelism;
-    pub use crate::runner::PhysicsRunner;
+    pub use crate::runner::{ForceSystems, PhysicsRunner};
     pub use crate::schedule::{PhysicsPlan, PhysicsSchedule, PhysicsSet, Stage};
     pub use crate::stability::{StabilityWarning, check_stability};
     pub use crate::stepper::{FixedStepper, FrameSteps, interpolate};

@@ -12,7 +12,10 @@ use crate::runner::PhysicsRunner;
 ///
 /// The step size is [`PhysicsSettings::dt`]; keep it equal to the app's fixed time step (Bevy's
 /// default is 64 Hz, the default here). Game systems that add forces run in `FixedUpdate` before
-/// [`TumbleStep`]:
+/// [`TumbleStep`]; their loads are held over the whole step (see
+/// [`ForceAccumulator`](crate::components::ForceAccumulator)). A force system that must see
+/// the state of every stage of a step (with substeps or `yoshida4`) goes in the
+/// [`ForceSystems`](crate::runner::ForceSystems) resource instead:
 ///
 /// ```
 /// use bevy_app::{App, FixedUpdate};

@@ -3,15 +3,90 @@
 use std::fmt;
 
 use bevy_ecs::prelude::*;
-use bevy_ecs::schedule::Schedule;
+use bevy_ecs::schedule::{IntoScheduleConfigs, Schedule};
+use bevy_ecs::system::ScheduleSystem;
 
-use crate::schedule::{PhysicsPlan, SpringQuery};
+use crate::schedule::{PhysicsPlan, PhysicsSet, SpringQuery};
 
-/// Runs one physics step per [`step`](Self::step), re-planning when the world changed: when it
+/// Game systems that compute forces inside the step: added to [`PhysicsSet::Forces`] of every
+/// schedule a [`PhysicsRunner`] builds (and builds again after a re-plan), so they run in every
+/// stage of a step (see [`crate::stages`]), on the state of that stage, like the built-in force
+/// generators. Insert this resource before the first step; a change to it rebuilds the schedule.
+///
+/// ```
+/// use bevy_ecs::prelude::*;
+/// use tumble_core::math::Vec3;
+/// use tumble_ecs::prelude::*;
+/// use tumble_ecs::runner::ForceSystems;
+///
+/// // A thruster that pushes harder the faster the body goes: it must see each stage's state.
+/// fn drag(mut bodies: Query<(&Velocity, &mut ForceAccumulator)>) {
+///     for (v, mut acc) in &mut bodies {
+///         acc.add_force(-0.5 * v.linear);
+///     }
+/// }
+///
+/// let mut world = World::new();
+/// let mut forces = ForceSystems::default();
+/// forces.add(drag);
+/// world.insert_resource(forces);
+/// world.spawn((RigidBody, Velocity::linear(Vec3::X), ForceAccumulator::default()));
+/// let mut physics = PhysicsRunner::new(&mut world);
+/// physics.step(&mut world);
+/// ```
+#[derive(Resource, Default)]
+pub struct ForceSystems(Vec<Box<dyn Fn(&mut Schedule) + Send + Sync>>);
+
+impl ForceSystems {
+    /// Adds `systems` (a system, or a tuple of them) to [`PhysicsSet::Forces`] of every schedule
+    /// built from now on.
+    pub fn add<M>(
+        &mut self,
+        systems: impl IntoScheduleConfigs<ScheduleSystem, M> + Clone + Send + Sync + 'static,
+    ) -> &mut Self {
+        self.0.push(Box::new(move |schedule: &mut Schedule| {
+            schedule.add_systems(systems.clone().in_set(PhysicsSet::Forces));
+        }));
+        self
+    }
+
+    /// Adds the systems to `schedule`.
+    fn apply(&self, schedule: &mut Schedule) {
+        for add in &self.0 {
+            add(schedule);
+        }
+    }
+}
+
+impl std::fmt::Debug for ForceSystems {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "ForceSystems({} entries)", self.0.len())
+    }
+}
+
+/// When the world's [`ForceSystems`] last changed (`None` without them).
+fn force_systems_changed(world: &World) -> Option<bevy_ecs::change_detection::Tick> {
+    world
+        .get_resource_ref::<ForceSystems>()
+        .map(|r| r.last_changed())
+}
+
+/// The schedule of `plan`, with the world's [`ForceSystems`].
+fn build(plan: &PhysicsPlan, world: &World) -> Schedule {
+    let mut schedule = plan.build_schedule();
+    if let Some(systems) = world.get_resource::<ForceSystems>() {
+        systems.apply(&mut schedule);
+    }
+    schedule
+}
+
+/// Runs one physics step per [`step`](Self::step) — the schedule once per stage of the step
+/// ([`PhysicsPlan::runs_per_step`]) — re-planning when the world changed: when it
 /// gains or loses a [`Gravity`](crate::components::Gravity) resource, a kind of force generator,
 /// its first damped spring or its last (a damping coefficient changed in place counts),
-/// dynamic bodies with or without accumulators, static or kinematic bodies, or when the
-/// integrator changes between a kick–drift and a drift–kick–drift method. Re-planning is one pass
+/// dynamic bodies with or without accumulators, static or kinematic bodies; when its
+/// [`ForceSystems`] change; or when the integrator changes between a kick–drift and a
+/// drift–kick–drift method, or it or the substeps change the stages of a step. Re-planning is one pass
 /// over the archetypes per step, plus, in a world with springs, a read of their damping
 /// coefficients up to the first damped one; the schedule is rebuilt only when the plan differs.
 ///
@@ -24,10 +99,10 @@ use crate::schedule::{PhysicsPlan, SpringQuery};
 /// world.spawn((RigidBody, ForceAccumulator::default()));
 /// let mut physics = PhysicsRunner::new(&mut world);
 /// physics.step(&mut world);
-/// assert_eq!(physics.plan().to_string(), "begin_step → integrate_with_forces");
+/// assert_eq!(physics.plan().to_string(), "begin_stage → integrate_with_forces");
 /// world.insert_resource(Gravity(Vec3::new(0.0, -9.81, 0.0)));
 /// physics.step(&mut world); // re-planned: gravity is now a system of the step
-/// assert_eq!(physics.plan().to_string(), "begin_step → apply_gravity → integrate_with_forces");
+/// assert_eq!(physics.plan().to_string(), "begin_stage → apply_gravity → integrate_with_forces");
 /// assert_eq!(physics.replans(), 1);
 /// ```
 pub struct PhysicsRunner {
@@ -37,18 +112,21 @@ pub struct PhysicsRunner {
     /// The springs, read by every re-planning (whether any is damped): kept so that planning
     /// every step builds no query.
     springs: Option<SpringQuery>,
+    /// When the [`ForceSystems`] the schedule holds were last changed.
+    force_systems: Option<bevy_ecs::change_detection::Tick>,
 }
 
 impl PhysicsRunner {
     /// Plans the step for `world` (see [`PhysicsPlan::for_world`]).
     pub fn new(world: &mut World) -> Self {
         let plan = PhysicsPlan::for_world(world);
-        let schedule = plan.build_schedule();
+        let schedule = build(&plan, world);
         Self {
             plan,
             schedule,
             replans: 0,
             springs: None,
+            force_systems: force_systems_changed(world),
         }
     }
 
@@ -57,14 +135,16 @@ impl PhysicsRunner {
     pub fn step(&mut self, world: &mut World) {
         if PhysicsPlan::of_with(world, &mut self.springs) != self.plan
             || crate::stiff::classification_is_stale(world)
+            || force_systems_changed(world) != self.force_systems
         {
             let plan = PhysicsPlan::for_world(world);
             tracing::debug!(from = %self.plan, to = %plan, "physics re-planned");
-            self.schedule = plan.build_schedule();
+            self.schedule = build(&plan, world);
             self.plan = plan;
             self.replans += 1;
+            self.force_systems = force_systems_changed(world);
         }
-        self.schedule.run(world);
+        self.plan.run_step(&mut self.schedule, world);
     }
 
     /// The current plan.

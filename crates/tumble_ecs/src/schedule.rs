@@ -1,12 +1,17 @@
 //! The physics schedule, built from what a world needs and nothing more.
 //!
-//! One step runs these sets in order:
+//! One run of the schedule is one *stage* of the step (see [`crate::stages`]): a step of one
+//! stage (the default) is one run; with substeps or `yoshida4`'s composition the schedule runs
+//! [`PhysicsPlan::runs_per_step`] times per step, and the force stage with it. One run goes
+//! through these sets in order:
 //!
-//! 0. [`PhysicsSet::Prepare`] — in audited worlds, the energy audit's start (see
-//!    [`crate::audit`]); with damped springs, the first half-step of the spring dampers' flow
-//!    (`damp_springs_start`, see [`crate::damping`]); for drift–kick–drift integrators
-//!    (`splitting`, `yoshida4`, `rk4`), the first half-step of the [`Damping`] flow and half a
-//!    drift, so forces are sampled at the midpoint of the step.
+//! 0. [`PhysicsSet::Prepare`] — in a plan of several stages, `hold_game_loads` (the load game
+//!    code added before the step, held over all stages); in audited worlds, the energy audit's
+//!    start (see [`crate::audit`]); with damped springs, at the start of each substep, the first
+//!    half of the spring dampers' flow (`damp_springs_start`, see [`crate::damping`]); for
+//!    drift–kick–drift integrators (`splitting`, `yoshida4`, `rk4`), the first half of the
+//!    [`Damping`] flow (at the start of a substep) and half a drift, so forces are sampled at
+//!    the midpoint of the stage.
 //! 1. [`PhysicsSet::Gravity`] — `m g s` into each accumulator; only if a [`Gravity`] resource
 //!    exists.
 //! 2. [`PhysicsSet::Forces`] — force generators that exist in the world (constant forces,
@@ -19,7 +24,8 @@
 //!    [`Damping`] flow for half a step after (and, for a whole step, before). Then, with damped
 //!    springs, the second half-step of the spring dampers' flow (`damp_springs_end`, the springs
 //!    in reverse order). In audited worlds the audit reads the loads just before the integration
-//!    and closes the energy balance at the very end.
+//!    and closes the energy balance at the very end of the step. In a plan of several stages,
+//!    `next_stage` moves the stage cursor on, last.
 //!
 //! Damping is thus a flow of its own, split symmetrically around the conservative step,
 //! `D(Δt/2) ∘ step ∘ D(Δt/2)`: second order with the drift–kick–drift methods, and never a gain
@@ -45,9 +51,10 @@ use crate::forces::{
     ConstantForce, ConstantTorque, Spring, apply_constant_forces, apply_constant_torques,
     apply_gravity, apply_springs,
 };
+use crate::stages::{StageCursor, hold_game_loads, next_stage};
 use crate::stiff::{ImplicitBody, ImplicitSpring, solve_implicit_springs};
 use crate::systems::{
-    HalfDrifted, begin_step, discard_fixed_body_forces, integrate_with_forces,
+    HalfDrifted, begin_stage, discard_fixed_body_forces, integrate_with_forces,
     integrate_without_forces,
 };
 
@@ -73,12 +80,14 @@ pub enum PhysicsSet {
 /// One system of the physics step.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Stage {
+    /// [`hold_game_loads`].
+    HoldGameLoads,
     /// [`audit_energy_start`].
     AuditEnergyStart,
     /// [`damp_springs_start`]: the spring dampers' flow over the first half step.
     DampSpringsStart,
-    /// [`begin_step`].
-    BeginStep,
+    /// [`begin_stage`].
+    BeginStage,
     /// [`apply_gravity`].
     Gravity,
     /// [`apply_constant_forces`].
@@ -102,14 +111,17 @@ pub enum Stage {
     DampSpringsEnd,
     /// [`audit_energy`].
     AuditEnergy,
+    /// [`next_stage`].
+    NextStage,
 }
 
 impl Stage {
     /// Every stage, in the order a step runs them.
-    pub const ALL: [Stage; 14] = [
+    pub const ALL: [Stage; 16] = [
+        Stage::HoldGameLoads,
         Stage::AuditEnergyStart,
         Stage::DampSpringsStart,
-        Stage::BeginStep,
+        Stage::BeginStage,
         Stage::Gravity,
         Stage::ConstantForces,
         Stage::ConstantTorques,
@@ -121,6 +133,7 @@ impl Stage {
         Stage::DiscardFixedBodyForces,
         Stage::DampSpringsEnd,
         Stage::AuditEnergy,
+        Stage::NextStage,
     ];
 
     /// How many stages there are (a plan holds each at most once).
@@ -129,12 +142,14 @@ impl Stage {
     /// The system's name.
     pub fn name(self) -> &'static str {
         match self {
+            Stage::HoldGameLoads => "hold_game_loads",
+            Stage::NextStage => "next_stage",
             Stage::AuditEnergyStart => "audit_energy_start",
             Stage::AuditExternalLoads => "audit_external_loads",
             Stage::AuditEnergy => "audit_energy",
             Stage::DampSpringsStart => "damp_springs_start",
             Stage::DampSpringsEnd => "damp_springs_end",
-            Stage::BeginStep => "begin_step",
+            Stage::BeginStage => "begin_stage",
             Stage::Gravity => "apply_gravity",
             Stage::ConstantForces => "apply_constant_forces",
             Stage::ConstantTorques => "apply_constant_torques",
@@ -151,7 +166,10 @@ impl Stage {
 ///
 /// - the energy audit's three systems only where [`EnergyAudit::applies`] (by default: worlds
 ///   with springs), `audit_external_loads` only with dynamic bodies that have accumulators;
-/// - `begin_step` only for a drift–kick–drift integrator and dynamic bodies with accumulators;
+/// - `hold_game_loads` and `next_stage` only when a step has several stages (substeps, or
+///   `yoshida4`; see [`crate::stages`]), the former only with dynamic bodies that have
+///   accumulators;
+/// - `begin_stage` only for a drift–kick–drift integrator and dynamic bodies with accumulators;
 /// - `apply_gravity` only with a [`Gravity`] resource and dynamic bodies with accumulators
 ///   (bodies without one get gravity inside `integrate_without_forces`, at no extra pass);
 /// - one system per kind of force generator that exists;
@@ -170,6 +188,7 @@ impl Stage {
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct PhysicsPlan {
     stages: ArrayVec<Stage, { Stage::COUNT }>,
+    runs_per_step: usize,
 }
 
 /// What the world holds, as far as planning cares.
@@ -260,6 +279,8 @@ impl PhysicsPlan {
         }
         world.init_resource::<HalfDrifted>();
         world.init_resource::<EnergyLedger>();
+        // A new plan starts at the first stage of a step.
+        world.insert_resource(StageCursor::default());
         Self::of(world)
     }
 
@@ -270,12 +291,13 @@ impl PhysicsPlan {
 
     /// The plan for a world holding `c`.
     fn from_contents(world: &World, c: Contents) -> Self {
-        let integrator = world
+        let settings = world
             .get_resource::<PhysicsSettings>()
             .copied()
-            .unwrap_or_default()
-            .integrator;
-        let midpoint = integrator.samples_forces_at_midpoint();
+            .unwrap_or_default();
+        let midpoint = settings.integrator.samples_forces_at_midpoint();
+        let runs_per_step = settings.stages().count();
+        let staged = runs_per_step > 1;
         let dynamic =
             c.dynamic_with_accumulator || c.dynamic_without_accumulator || c.implicit_bodies;
         let audit = dynamic
@@ -285,6 +307,9 @@ impl PhysicsPlan {
                 .unwrap_or_default()
                 .applies(c.springs);
         let mut stages = ArrayVec::new();
+        if staged && (c.dynamic_with_accumulator || c.implicit_bodies) {
+            stages.push(Stage::HoldGameLoads);
+        }
         if audit {
             stages.push(Stage::AuditEnergyStart);
         }
@@ -292,7 +317,7 @@ impl PhysicsPlan {
             stages.push(Stage::DampSpringsStart);
         }
         if midpoint && c.dynamic_with_accumulator {
-            stages.push(Stage::BeginStep);
+            stages.push(Stage::BeginStage);
         }
         if world.contains_resource::<Gravity>() && (c.dynamic_with_accumulator || c.implicit_bodies)
         {
@@ -328,7 +353,28 @@ impl PhysicsPlan {
         if audit {
             stages.push(Stage::AuditEnergy);
         }
-        Self { stages }
+        if staged {
+            stages.push(Stage::NextStage);
+        }
+        Self {
+            stages,
+            runs_per_step,
+        }
+    }
+
+    /// How many times the schedule runs per step: the number of stages of a step (see
+    /// [`crate::stages`]), 1 unless there are substeps or the integrator is a composition.
+    pub fn runs_per_step(&self) -> usize {
+        self.runs_per_step
+    }
+
+    /// Runs `schedule` — built by [`build_schedule`](Self::build_schedule) from this plan —
+    /// for one whole step: once per stage ([`runs_per_step`](Self::runs_per_step) times; once
+    /// unless there are substeps or a composition). A single `schedule.run` is one *stage*.
+    pub fn run_step(&self, schedule: &mut Schedule, world: &mut World) {
+        for _ in 0..self.runs_per_step {
+            schedule.run(world);
+        }
     }
 
     /// The planned systems, in run order.
@@ -342,7 +388,10 @@ impl PhysicsPlan {
     }
 
     /// Builds the [`PhysicsSchedule`] holding exactly the planned systems, strictly ordered (so
-    /// forces are summed in the same order every run: bit-identical results).
+    /// forces are summed in the same order every run: bit-identical results). One run of it is
+    /// one stage of a step: run a step with [`run_step`](Self::run_step) (or let
+    /// [`PhysicsRunner`](crate::runner::PhysicsRunner) do it), which is a single run unless
+    /// the step has several stages (substeps, `yoshida4`).
     pub fn build_schedule(&self) -> Schedule {
         let mut schedule = Schedule::new(PhysicsSchedule);
         // The stages run strictly one after another, so a multi-threaded executor (bevy's
@@ -367,9 +416,10 @@ impl PhysicsPlan {
         let mut previous: Option<Stage> = None;
         for &stage in &self.stages {
             let set = match stage {
-                Stage::AuditEnergyStart | Stage::DampSpringsStart | Stage::BeginStep => {
-                    PhysicsSet::Prepare
-                }
+                Stage::HoldGameLoads
+                | Stage::AuditEnergyStart
+                | Stage::DampSpringsStart
+                | Stage::BeginStage => PhysicsSet::Prepare,
                 Stage::Gravity => PhysicsSet::Gravity,
                 Stage::AuditExternalLoads
                 | Stage::AuditEnergy
@@ -377,7 +427,8 @@ impl PhysicsPlan {
                 | Stage::IntegrateWithForces
                 | Stage::IntegrateWithoutForces
                 | Stage::DiscardFixedBodyForces
-                | Stage::DampSpringsEnd => PhysicsSet::Integrate,
+                | Stage::DampSpringsEnd
+                | Stage::NextStage => PhysicsSet::Integrate,
                 _ => PhysicsSet::Forces,
             };
             add_stage(&mut schedule, stage, set, previous);
@@ -393,12 +444,14 @@ struct StageSet(Stage);
 
 fn add_stage(schedule: &mut Schedule, stage: Stage, set: PhysicsSet, after: Option<Stage>) {
     let config = match stage {
+        Stage::HoldGameLoads => hold_game_loads.into_configs(),
+        Stage::NextStage => next_stage.into_configs(),
         Stage::AuditEnergyStart => audit_energy_start.into_configs(),
         Stage::AuditExternalLoads => audit_external_loads.into_configs(),
         Stage::AuditEnergy => audit_energy.into_configs(),
         Stage::DampSpringsStart => damp_springs_start.into_configs(),
         Stage::DampSpringsEnd => damp_springs_end.into_configs(),
-        Stage::BeginStep => begin_step.into_configs(),
+        Stage::BeginStage => begin_stage.into_configs(),
         Stage::Gravity => apply_gravity.into_configs(),
         Stage::ConstantForces => apply_constant_forces.into_configs(),
         Stage::ConstantTorques => apply_constant_torques.into_configs(),
@@ -418,6 +471,10 @@ fn add_stage(schedule: &mut Schedule, stage: Stage, set: PhysicsSet, after: Opti
 impl fmt::Display for PhysicsPlan {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let names: Vec<&str> = self.stages.iter().map(|s| s.name()).collect();
-        write!(f, "{}", names.join(" → "))
+        write!(f, "{}", names.join(" → "))?;
+        if self.runs_per_step > 1 {
+            write!(f, " (× {} stages per step)", self.runs_per_step)?;
+        }
+        Ok(())
     }
 }

@@ -109,6 +109,13 @@ pub struct SpringClassification {
     springs: usize,
 }
 
+/// The span a spring's stability is judged on, as if it were one plain step (`Δt` without
+/// substeps, `Δt/N` with `N`, `1.27 Δt/N` for `yoshida4`'s composition: see
+/// [`Stages::stability_span`](tumble_core::integrate::Stages::stability_span)).
+fn stability_span(settings: &PhysicsSettings) -> Real {
+    settings.stages().stability_span(settings.dt())
+}
+
 /// Number of spring entities, from the archetypes (no query state needed).
 fn spring_count(world: &World) -> usize {
     let Some(id) = world.component_id::<Spring>() else {
@@ -132,7 +139,11 @@ pub fn classification_is_stale(world: &World) -> bool {
     let springs = spring_count(world);
     match world.get_resource::<SpringClassification>() {
         None => springs > 0,
-        Some(c) => c.dt != settings.dt() || c.solver != settings.springs || c.springs != springs,
+        Some(c) => {
+            c.dt != stability_span(&settings)
+                || c.solver != settings.springs
+                || c.springs != springs
+        }
     }
 }
 
@@ -161,7 +172,7 @@ pub fn classify_springs(world: &mut World) {
         .get_resource::<PhysicsSettings>()
         .copied()
         .unwrap_or_default();
-    let dt = settings.dt();
+    let dt = stability_span(&settings);
     let springs: Vec<(Entity, Spring)> = world
         .query::<(Entity, &Spring)>()
         .iter(world)
@@ -305,6 +316,7 @@ pub struct ImplicitScratch {
 /// fails keeps its state and is quarantined.
 pub fn solve_implicit_springs(
     settings: Res<PhysicsSettings>,
+    cursor: Res<crate::stages::StageCursor>,
     mut scratch: Local<ImplicitScratch>,
     mut commands: Commands,
     springs: Query<&Spring, With<ImplicitSpring>>,
@@ -326,13 +338,17 @@ pub fn solve_implicit_springs(
     s.entities.clear();
     s.parent.clear();
     s.all.clear();
-    let dt = settings.dt();
+    let span = cursor.span(&settings);
+    let dt = span.h;
+    let half_substep = 0.5 * span.substep;
     for (entity, t, mut v, m, mut acc, damping) in &mut bodies {
-        // `Damping` is a flow of its own, half a step before the step and half after (see
+        // `Damping` is a flow of its own, half a substep before the substep and half after (see
         // `tumble_core::damping`), as on the explicit path.
-        if let Some(d) = damping {
+        if let Some(d) = damping
+            && span.opens_substep
+        {
             let v = &mut *v;
-            damp(d, 0.5 * dt, &mut v.linear, &mut v.angular);
+            damp(d, half_substep, &mut v.linear, &mut v.angular);
         }
         s.index.insert(entity, s.entities.len());
         s.parent.push(s.entities.len());
@@ -452,9 +468,11 @@ pub fn solve_implicit_springs(
                 for (k, &i) in s.members[members].iter().enumerate() {
                     if let Ok((_, mut t, mut v, m, _, damping)) = bodies.get_mut(s.entities[i]) {
                         write_body_state(&s.bodies[k].state, m, &mut t, &mut v);
-                        if let Some(d) = damping {
+                        if let Some(d) = damping
+                            && span.closes_substep
+                        {
                             let v = &mut *v;
-                            damp(d, 0.5 * dt, &mut v.linear, &mut v.angular);
+                            damp(d, half_substep, &mut v.linear, &mut v.angular);
                         }
                     }
                 }

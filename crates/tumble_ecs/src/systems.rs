@@ -13,7 +13,7 @@ use crate::components::{
 };
 use crate::parallel::Parallelism;
 use crate::stiff::ImplicitBody;
-use crate::table::{Bodies, Loads, step_table};
+use crate::table::{Bodies, Loads, StageTiming, step_table};
 use crate::validate::{BodyError, Rejected, reject};
 
 /// Quarantines the bodies in `errors` (in the order found: table by table, entity order
@@ -49,18 +49,21 @@ pub fn discard_fixed_body_forces(
     }
 }
 
-/// Set by [`begin_step`] when it has drifted the bodies with accumulators half a step, so that
-/// [`integrate_with_forces`] finishes the step instead of taking a whole one. Reset every step.
+/// Set by [`begin_stage`] when it has drifted the bodies with accumulators half a stage, so
+/// that [`integrate_with_forces`] finishes the stage instead of taking a whole one. Reset every
+/// stage.
 #[derive(Resource, Debug, Default, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct HalfDrifted(pub bool);
 
-/// First phase of a drift–kick–drift step for bodies with a [`ForceAccumulator`]: the first half
-/// of the [`Damping`] flow, then half a drift before the force systems run, so forces are sampled
-/// at the midpoint. Does nothing for methods that sample forces at the start of the step. Bodies without an accumulator feel no
-/// state-dependent force and take their whole step in [`integrate_without_forces`].
-pub fn begin_step(
+/// First phase of a drift–kick–drift stage for bodies with a [`ForceAccumulator`]: the first
+/// half of the [`Damping`] flow (when the stage opens a substep), then half a drift before the
+/// force systems run, so forces are sampled at the midpoint of the stage. Does nothing for
+/// methods that sample forces at the start. Bodies without an accumulator feel no
+/// state-dependent force and take their whole stage in [`integrate_without_forces`].
+pub fn begin_stage(
     settings: Res<PhysicsSettings>,
+    cursor: Res<crate::stages::StageCursor>,
     parallelism: Option<Res<Parallelism>>,
     mut drifted: ResMut<HalfDrifted>,
     mut commands: Commands,
@@ -80,6 +83,7 @@ pub fn begin_step(
         return;
     }
     drifted.0 = true;
+    let stage = StageTiming::new(&settings, *cursor, StepPhase::Begin);
     let parallelism = parallelism.map_or_else(Parallelism::default, |p| *p);
     let mut errors = Vec::new();
     for (entities, mut t, mut v, masses, accs, dampings) in dense(bodies.contiguous_iter_mut()) {
@@ -91,25 +95,21 @@ pub fn begin_step(
             dampings,
             loads: Loads::Checked(accs),
         };
-        step_table(
-            &settings,
-            &parallelism,
-            StepPhase::Begin,
-            bodies,
-            &mut errors,
-        );
+        step_table(&stage, &parallelism, bodies, &mut errors);
     }
     reject_all(&mut commands, errors);
 }
 
 /// Integrates bodies that have a [`ForceAccumulator`], consuming (reading and zeroing) it.
 ///
-/// For a drift–kick–drift method this finishes the step that [`begin_step`] began; if the
-/// schedule was planned without `begin_step` (the integrator was changed afterwards) it takes the
-/// whole step with the forces sampled at the start, and warns once. A whole step applies both
-/// halves of the [`Damping`] flow around it, a finished one the second half after it.
+/// For a drift–kick–drift method this finishes the stage that [`begin_stage`] began; if the
+/// schedule was planned without `begin_stage` (the integrator was changed afterwards) it takes
+/// the whole stage with the forces sampled at its start, and warns once. The [`Damping`] flow
+/// runs for half a substep before a whole stage that opens a substep and after any stage that
+/// closes one.
 pub fn integrate_with_forces(
     settings: Res<PhysicsSettings>,
+    cursor: Res<crate::stages::StageCursor>,
     parallelism: Option<Res<Parallelism>>,
     mut drifted: ResMut<HalfDrifted>,
     mut warned: Local<bool>,
@@ -135,11 +135,12 @@ pub fn integrate_with_forces(
         *warned = true;
         tracing::warn!(
             integrator = %settings.integrator,
-            "schedule planned without begin_step: forces are sampled at the start of the step; \
+            "schedule planned without begin_stage: forces are sampled at the start of the stage; \
              plan again after changing the integrator"
         );
     }
     drifted.0 = false;
+    let stage = StageTiming::new(&settings, *cursor, phase);
     let parallelism = parallelism.map_or_else(Parallelism::default, |p| *p);
     let mut errors = Vec::new();
     for (entities, mut t, mut v, masses, mut accs, dampings) in dense(bodies.contiguous_iter_mut())
@@ -152,16 +153,18 @@ pub fn integrate_with_forces(
             dampings,
             loads: Loads::Consumed(&mut accs),
         };
-        step_table(&settings, &parallelism, phase, bodies, &mut errors);
+        step_table(&stage, &parallelism, bodies, &mut errors);
     }
     reject_all(&mut commands, errors);
 }
 
 /// Integrates bodies without a [`ForceAccumulator`]: free motion, plus gravity when a
-/// [`Gravity`] resource exists (a uniform field needs no accumulator), with the [`Damping`] flow
-/// for half a step before and after.
+/// [`Gravity`] resource exists (a uniform field needs no accumulator), one whole stage, with the
+/// [`Damping`] flow for half a substep before a stage that opens a substep and after one that
+/// closes it.
 pub fn integrate_without_forces(
     settings: Res<PhysicsSettings>,
+    cursor: Res<crate::stages::StageCursor>,
     parallelism: Option<Res<Parallelism>>,
     gravity: Option<Res<Gravity>>,
     mut commands: Commands,
@@ -178,6 +181,7 @@ pub fn integrate_without_forces(
     >,
 ) {
     let gravity = gravity.map(|g| g.0);
+    let stage = StageTiming::new(&settings, *cursor, StepPhase::Whole);
     let parallelism = parallelism.map_or_else(Parallelism::default, |p| *p);
     let mut errors = Vec::new();
     for (entities, mut t, mut v, masses, scales, dampings) in dense(bodies.contiguous_iter_mut()) {
@@ -189,13 +193,7 @@ pub fn integrate_without_forces(
             dampings,
             loads: Loads::Field { gravity, scales },
         };
-        step_table(
-            &settings,
-            &parallelism,
-            StepPhase::Whole,
-            bodies,
-            &mut errors,
-        );
+        step_table(&stage, &parallelism, bodies, &mut errors);
     }
     reject_all(&mut commands, errors);
 }

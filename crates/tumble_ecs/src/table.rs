@@ -1,5 +1,5 @@
 //! One table's run of bodies, stepped through the core's batched step: the [`BodyBatch`] the
-//! integrate systems hand to [`Integrator::step_batch`], reading and writing the components in
+//! integrate systems hand to [`Integrator::stage_batch`], reading and writing the components in
 //! place, split over the compute pool's threads for big tables.
 //!
 //! Each body is checked before it is stepped (game code may have written bad data through a
@@ -19,6 +19,7 @@ use crate::components::{
     body_state, write_body_state,
 };
 use crate::parallel::Parallelism;
+use crate::stages::StageCursor;
 use crate::validate::{BodyError, BodyErrorKind, check_accumulator, check_body};
 
 /// Where each body's load comes from.
@@ -128,15 +129,45 @@ impl<'a> Bodies<'a> {
 /// whose step diverges keeps its state; both are reported in `errors`.
 struct TableBatch<'a, 'e> {
     bodies: Bodies<'a>,
-    /// [`Damping`]'s first half-step flow applies to the velocity read by the phases that begin
-    /// a step (`Begin`, `Whole`), its second to the velocity written by the phases that end one
-    /// (`Finish`, `Whole`).
+    /// [`Damping`]'s first half-substep flow applies to the velocity read by a phase that
+    /// begins a substep, its second to the velocity written by a phase that ends one.
     damp_read: bool,
     damp_write: bool,
-    /// Half the step, `Δt/2`: the span of each damping flow.
+    /// Half the substep, `Δt/(2N)`: the span of each damping flow.
     half_dt: Real,
     integrator: Integrator,
     errors: &'e mut Vec<BodyError>,
+}
+
+/// What one integrate system does to its bodies: which phase of which stage, and where the
+/// [`Damping`] flow runs.
+pub(crate) struct StageTiming {
+    integrator: Integrator,
+    phase: StepPhase,
+    /// The stage's span `h`.
+    h: Real,
+    /// Half the substep: the span of each half of the damping flow.
+    half_substep: Real,
+    damp_read: bool,
+    damp_write: bool,
+}
+
+impl StageTiming {
+    /// `phase` of the stage `cursor` points at, under `settings`: the damping flow's first half
+    /// before a phase that begins the stage (`Begin`, `Whole`) when the stage opens its
+    /// substep, its second half after a phase that ends the stage (`Finish`, `Whole`) when the
+    /// stage closes it.
+    pub(crate) fn new(settings: &PhysicsSettings, cursor: StageCursor, phase: StepPhase) -> Self {
+        let span = cursor.span(settings);
+        Self {
+            integrator: settings.integrator,
+            phase,
+            h: span.h,
+            half_substep: 0.5 * span.substep,
+            damp_read: phase != StepPhase::Finish && span.opens_substep,
+            damp_write: phase != StepPhase::Begin && span.closes_substep,
+        }
+    }
 }
 
 impl BodyBatch for TableBatch<'_, '_> {
@@ -219,26 +250,21 @@ pub(crate) fn damp(damping: &Damping, tau: Real, linear: &mut Vec3, angular: &mu
     *angular -= decrement(damping.angular * tau) * *angular;
 }
 
-/// Steps every body of `bodies` through `phase` with the core's batched step (bit-identical
-/// to stepping each body alone). Errors are appended sorted by entity.
-fn step_bodies(
-    settings: &PhysicsSettings,
-    phase: StepPhase,
-    bodies: Bodies<'_>,
-    errors: &mut Vec<BodyError>,
-) {
+/// Steps every body of `bodies` through the stage's phase with the core's batched step
+/// (bit-identical to stepping each body alone). Errors are appended sorted by entity.
+fn step_bodies(stage: &StageTiming, bodies: Bodies<'_>, errors: &mut Vec<BodyError>) {
     let found = errors.len();
     let mut batch = TableBatch {
         bodies,
-        damp_read: phase != StepPhase::Finish,
-        damp_write: phase != StepPhase::Begin,
-        half_dt: 0.5 * settings.dt(),
-        integrator: settings.integrator,
+        damp_read: stage.damp_read,
+        damp_write: stage.damp_write,
+        half_dt: stage.half_substep,
+        integrator: stage.integrator,
         errors,
     };
-    settings
+    stage
         .integrator
-        .step_batch(phase, &mut batch, settings.dt());
+        .stage_batch(stage.phase, &mut batch, stage.h);
     errors[found..].sort_by_key(|e| e.entity);
 }
 
@@ -246,15 +272,14 @@ fn step_bodies(
 /// the table is big enough. Each body is stepped by the same code in any split, so the result
 /// does not depend on the number of threads. Errors are returned sorted by entity.
 pub(crate) fn step_table(
-    settings: &PhysicsSettings,
+    stage: &StageTiming,
     parallelism: &Parallelism,
-    phase: StepPhase,
     bodies: Bodies<'_>,
     errors: &mut Vec<BodyError>,
 ) {
     let threads = parallelism.threads_for(bodies.len());
     if threads <= 1 {
-        step_bodies(settings, phase, bodies, errors);
+        step_bodies(stage, bodies, errors);
         return;
     }
     let parts = split_evenly(bodies, threads);
@@ -264,7 +289,7 @@ pub(crate) fn step_table(
             let found = &found;
             spawn(Box::new(move || {
                 let mut local = Vec::new();
-                step_bodies(settings, phase, part, &mut local);
+                step_bodies(stage, part, &mut local);
                 if !local.is_empty() {
                     found
                         .lock()

@@ -75,9 +75,10 @@ fn chain(world: &mut World, n: usize, x0: Real, omega_dt: Real) -> Vec<Entity> {
 }
 
 fn run(world: &mut World, steps: usize) -> Schedule {
-    let mut schedule = PhysicsPlan::for_world(world).build_schedule();
+    let plan = PhysicsPlan::for_world(world);
+    let mut schedule = plan.build_schedule();
     for _ in 0..steps {
-        schedule.run(world);
+        plan.run_step(&mut schedule, world);
         world.clear_trackers();
     }
     schedule
@@ -189,7 +190,8 @@ fn work_of_gravity_forces_torques_and_game_code_is_credited() {
             body: b,
             torque: Vec3::new(0.1, 0.0, 0.0),
         });
-        let mut schedule = PhysicsPlan::for_world(&mut w).build_schedule();
+        let plan = PhysicsPlan::for_world(&mut w);
+        let mut schedule = plan.build_schedule();
         schedule.add_systems(thrust.in_set(PhysicsSet::Forces));
         for step in 0..3000 {
             // Game code kicks a body between steps, and adds a force before one.
@@ -200,7 +202,7 @@ fn work_of_gravity_forces_torques_and_game_code_is_credited() {
                     torque: Vec3::new(0.0, 5.0, 0.0),
                 });
             }
-            schedule.run(&mut w);
+            plan.run_step(&mut schedule, &mut w);
             w.clear_trackers();
         }
         assert!(errors(&w).is_empty(), "{integrator}: {:?}", errors(&w));

@@ -30,9 +30,10 @@ fn warned(world: &mut World) -> bool {
 
 /// Relative error of the distance travelled in `STEPS` steps at 1 m/s.
 fn measured_error(world: &mut World, body: Entity, distance: Real) -> f64 {
-    let mut schedule = PhysicsPlan::for_world(world).build_schedule();
+    let plan = PhysicsPlan::for_world(world);
+    let mut schedule = plan.build_schedule();
     for _ in 0..STEPS {
-        schedule.run(world);
+        plan.run_step(&mut schedule, world);
         world.clear_trackers();
     }
     let x = world.get::<Transform>(body).unwrap().translation.x.widen();

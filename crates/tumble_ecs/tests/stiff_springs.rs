@@ -176,7 +176,7 @@ fn stiff_springs_keep_their_energy_at_every_omega_dt() {
                 "{name} ωΔt {omega_dt}: {plan}"
             );
             assert!(
-                !plan.contains("begin_step"),
+                !plan.contains("begin_stage"),
                 "nothing is left for the explicit path: {plan}"
             );
             assert!(

@@ -13,6 +13,7 @@ use crate::scene::{ComparisonScene, ComparisonSpringEnd, Load};
 pub struct TumbleScene {
     world: World,
     schedule: Schedule,
+    plan: PhysicsPlan,
     entities: Vec<Entity>,
 }
 
@@ -96,10 +97,12 @@ impl TumbleScene {
                 rest_length: spring.rest_length,
             });
         }
-        let schedule = PhysicsPlan::for_world(&mut world).build_schedule();
+        let plan = PhysicsPlan::for_world(&mut world);
+        let schedule = plan.build_schedule();
         Self {
             world,
             schedule,
+            plan,
             entities,
         }
     }
@@ -111,7 +114,7 @@ impl TumbleScene {
 
     /// Advances tumble by one step.
     pub fn step(&mut self) {
-        self.schedule.run(&mut self.world);
+        self.plan.run_step(&mut self.schedule, &mut self.world);
         self.world.clear_trackers();
     }
 

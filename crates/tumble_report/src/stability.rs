@@ -91,12 +91,13 @@ fn run(
     };
     let floor = gravity_floor(world);
     let e0 = total_energy(world, floor);
-    let mut schedule = PhysicsPlan::for_world(world).build_schedule();
+    let plan = PhysicsPlan::for_world(world);
+    let mut schedule = plan.build_schedule();
     let mut max_q = 0.0_f64;
     let mut finite = true;
     let mut range = [1.0_f64, 1.0];
     for _ in 0..steps {
-        schedule.run(world);
+        plan.run_step(&mut schedule, world);
         world.clear_trackers();
         let mut q = world.query::<(&Transform, Option<&Rejected>)>();
         for (t, rejected) in q.iter(world) {

@@ -1,6 +1,7 @@
 //! A validated scene, and the world built from it.
 
 use std::collections::HashMap;
+use std::num::NonZeroU32;
 use tumble_core::math::{Quat, REAL_NAME, Real, Vec3};
 
 use bevy_ecs::prelude::*;
@@ -86,14 +87,21 @@ enum ValidForce {
 pub struct BuiltScene {
     /// The world.
     pub world: World,
-    /// The schedule holding only the systems the scene needs.
+    /// The schedule holding only the systems the scene needs (one run is one stage of a step:
+    /// step with [`step`](Self::step)).
     pub schedule: Schedule,
+    /// The plan the schedule was built from.
+    pub plan: PhysicsPlan,
     /// `(name, entity)` of every body, in file order.
     pub bodies: Vec<(String, Entity)>,
 }
 
 /// Largest accepted step count.
 pub const MAX_STEPS: u64 = 1_000_000_000;
+
+/// Most substeps per step a scene may ask for: each costs a whole step, so beyond this a smaller
+/// `dt` is the honest setting.
+pub const MAX_SUBSTEPS: u32 = 1000;
 
 impl Scene {
     /// Parses and validates scene text; `file` names it in errors.
@@ -177,9 +185,25 @@ impl Scene {
                 .parse()
                 .map_err(|e: String| ck.error("world", None, "springs", e))?,
         };
+        let substeps = match w.substeps {
+            None => NonZeroU32::MIN,
+            Some(n) => u32::try_from(n)
+                .ok()
+                .filter(|&n| n <= MAX_SUBSTEPS)
+                .and_then(NonZeroU32::new)
+                .ok_or_else(|| {
+                    ck.error(
+                        "world",
+                        None,
+                        "substeps",
+                        format!("expected 1 to {MAX_SUBSTEPS} substeps, got {n}"),
+                    )
+                })?,
+        };
         let settings = PhysicsSettings::new(dt, integrator)
             .map_err(|e| ck.error("world", None, "dt", e.to_string()))?
-            .with_springs(springs);
+            .with_springs(springs)
+            .with_substeps(substeps);
         if let Some(why) = bad_text(&parsed.name) {
             return Err(ck.top_error("name", why));
         }
@@ -410,7 +434,8 @@ impl Scene {
                 }
             }
         }
-        let schedule = PhysicsPlan::for_world(&mut world).build_schedule();
+        let plan = PhysicsPlan::for_world(&mut world);
+        let schedule = plan.build_schedule();
         let bodies = self
             .bodies
             .iter()
@@ -420,8 +445,24 @@ impl Scene {
         BuiltScene {
             world,
             schedule,
+            plan,
             bodies,
         }
+    }
+}
+
+impl BuiltScene {
+    /// Advances the world by one step (the schedule once per stage) and clears its change
+    /// trackers.
+    pub fn step(&mut self) {
+        self.plan.run_step(&mut self.schedule, &mut self.world);
+        self.world.clear_trackers();
+    }
+
+    /// Plans the world again (after a change of its resources) and rebuilds the schedule.
+    pub fn replan(&mut self) {
+        self.plan = PhysicsPlan::for_world(&mut self.world);
+        self.schedule = self.plan.build_schedule();
     }
 }
 

@@ -36,6 +36,10 @@ pub struct WorldDef {
     /// `dt`), `explicit` or `implicit`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub springs: Option<String>,
+    /// Substeps per step, `1..=`[`crate::MAX_SUBSTEPS`] (default 1): the force stage runs in
+    /// each (see `PhysicsSettings::substeps`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub substeps: Option<u64>,
     /// Uniform gravity; absent means no gravity system at all.
     #[serde(
         default,

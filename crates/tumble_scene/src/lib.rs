@@ -17,7 +17,7 @@ pub mod text;
 mod trajectory;
 mod validate;
 
-pub use build::{BuiltScene, MAX_NAME_BYTES, MAX_STEPS, Scene, SceneBody};
+pub use build::{BuiltScene, MAX_NAME_BYTES, MAX_STEPS, MAX_SUBSTEPS, Scene, SceneBody};
 pub use error::{SaveError, SceneError};
 pub use format::{BodyDef, ForceDef, SceneFile, ShapeDef, WorldDef};
 pub use trajectory::{CSV_HEADER, TrajectoryError, csv_text_cell, write_trajectory};

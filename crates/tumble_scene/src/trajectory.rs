@@ -81,8 +81,7 @@ pub fn write_trajectory(
     writeln!(w, "{CSV_HEADER}")?;
     write_rows(&mut w, scene, &names, 0, dt)?;
     for step in 1..=steps {
-        scene.schedule.run(&mut scene.world);
-        scene.world.clear_trackers();
+        scene.step();
         if step.is_multiple_of(every.get()) {
             write_rows(&mut w, scene, &names, step, dt)?;
         }

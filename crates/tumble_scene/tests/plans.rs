@@ -35,7 +35,7 @@ fn every_bundled_scene_has_exactly_the_systems_it_needs() {
         // every spring network gets).
         (
             "spinning_top",
-            "begin_step → apply_constant_forces → integrate_with_forces",
+            "begin_stage → apply_constant_forces → integrate_with_forces",
         ),
         // The chain is stiff for its step (√(2k/m)Δt = 1.05, above the implicit threshold
         // 0.3): the implicit spring step takes the whole group, and nothing is left for the

@@ -4,9 +4,10 @@
 //! A batch reads each body from a [`BodyBatch`] (plain arrays, or an ECS table without an
 //! intermediate copy), steps it and writes it back. For `splitting` (the default) the free
 //! rotations of up to eight non-spherical bodies are computed together in SIMD lanes by the
-//! kernel of `symmetric_kernel`, on the [`kernel_path`](super::kernel_path); the translation,
+//! kernel of `symmetric_kernel`, on the [`kernel_path`](super::kernel_path) (and so for each
+//! stage of `yoshida4`, a composition of `splitting` steps); the translation,
 //! the kicks and spherical bodies stay scalar. Every other method steps body by body. Either way each body's result is bit-identical
-//! to [`Integrator::try_step`] and friends on that body alone, whatever the batch, its order or
+//! to [`Integrator::try_step`] and the stage functions on that body alone, whatever the batch, its order or
 //! the thread that runs it.
 
 use crate::math::{Quat, Real, Vec3};
@@ -23,22 +24,22 @@ use crate::prefetch::prefetch;
 use crate::rotation::rotate_exact;
 use crate::state::{BodyState, Wrench};
 
-/// Which part of a step a batch performs (see [`Integrator::begin_step`] and
-/// [`Integrator::finish_step`]).
+/// Which part of a stage a batch performs (see [`Integrator::begin_stage`] and
+/// [`Integrator::finish_stage`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum StepPhase {
-    /// The whole step, [`Integrator::step`], under the body's constant load.
+    /// The whole stage, [`Integrator::whole_stage`], under the body's constant load.
     Whole,
-    /// The first phase, [`Integrator::begin_step`]; the load is not used.
+    /// The first phase, [`Integrator::begin_stage`]; the load is not used.
     Begin,
-    /// The second phase, [`Integrator::finish_step`], under the load sampled after
+    /// The second phase, [`Integrator::finish_stage`], under the load sampled after
     /// [`Begin`](Self::Begin).
     Finish,
 }
 
 /// Where a batched step finds its bodies and puts them back.
 ///
-/// [`Integrator::step_batch`] calls [`read`](Self::read) once for every index in `0..len()`,
+/// [`Integrator::stage_batch`] calls [`read`](Self::read) once for every index in `0..len()`,
 /// in increasing order, then exactly one of [`write`](Self::write) (the new state is valid:
 /// finite, with a unit rotation, [`BodyState::is_valid`]) or [`diverged`](Self::diverged) (it is
 /// not: the body keeps its old state) for every body that `read` returned, not necessarily in
@@ -69,7 +70,7 @@ pub enum StepPhase {
 /// let mass = MassProperties::new(Mass::new(2.0).unwrap(), Vec3::new(1.0, 2.0, 3.0)).unwrap();
 /// let body = |frozen| Crate { state: BodyState::default(), mass, frozen };
 /// let mut crates = Crates(vec![body(false), body(true)]);
-/// Integrator::Splitting.step_batch(StepPhase::Whole, &mut crates, 0.5);
+/// Integrator::Splitting.stage_batch(StepPhase::Whole, &mut crates, 0.5);
 /// // Drift–kick–drift is exact under constant gravity: y = −g t²/2.
 /// assert!((crates.0[0].state.position.y + 9.81 * 0.125).abs() < 1e-5);
 /// assert_eq!(crates.0[1].state.position.y, 0.0); // frozen: never read, never written
@@ -300,58 +301,62 @@ impl<M: Borrow<MassProperties>> BodyBatch for Slices<'_, M> {
 }
 
 impl Integrator {
-    /// Steps every body of `bodies` through `phase` by `dt` (each body's load held constant),
-    /// reading and writing through the [`BodyBatch`]. A body whose result is not valid
-    /// ([`BodyState::is_valid`]) keeps its state and is reported to [`BodyBatch::diverged`]; no
-    /// other body is affected. Does not allocate.
+    /// Steps every body of `bodies` through `phase` of one stage of span `h` (each body's load
+    /// held constant), reading and writing through the [`BodyBatch`]. For a method of one stage
+    /// per step (every method but `yoshida4`, see [`Integrator::composition`]) a
+    /// [`Whole`](StepPhase::Whole) stage of `Δt` is the whole step. A body whose result is not
+    /// valid ([`BodyState::is_valid`]) keeps its state and is reported to
+    /// [`BodyBatch::diverged`]; no other body is affected. Does not allocate.
     ///
-    /// `splitting` rotates its bodies in SIMD lanes on the [`kernel_path`](super::kernel_path)
-    /// (every path gives the same bits).
+    /// `splitting` and `yoshida4` rotate their bodies in SIMD lanes on the
+    /// [`kernel_path`](super::kernel_path) (every path gives the same bits).
     ///
     /// # Panics
     ///
-    /// For `splitting`, when the environment variable [`KERNEL_ENV`](super::KERNEL_ENV) names a
-    /// kernel path this CPU cannot run (see [`KernelPath::selected`](super::KernelPath::selected)).
-    pub fn step_batch(self, phase: StepPhase, bodies: &mut impl BodyBatch, dt: Real) {
-        let kernel = if self == Integrator::Splitting {
+    /// For `splitting` and `yoshida4`, when the environment variable
+    /// [`KERNEL_ENV`](super::KERNEL_ENV) names a kernel path this CPU cannot run (see
+    /// [`KernelPath::selected`](super::KernelPath::selected)).
+    pub fn stage_batch(self, phase: StepPhase, bodies: &mut impl BodyBatch, h: Real) {
+        let kernel = if self.rotates_on_symmetric_kernel() {
             Kernel::selected()
         } else {
             Kernel::Portable
         };
-        self.step_batch_on(kernel, phase, bodies, dt);
+        self.stage_batch_on(kernel, phase, bodies, h);
     }
 
-    /// [`step_batch`](Self::step_batch) with the SIMD lanes of `splitting` on `kernel`.
-    pub(crate) fn step_batch_on(
+    /// [`stage_batch`](Self::stage_batch) with the SIMD lanes of the symmetric-top flow on
+    /// `kernel`.
+    pub(crate) fn stage_batch_on(
         self,
         kernel: Kernel,
         phase: StepPhase,
         bodies: &mut impl BodyBatch,
-        dt: Real,
+        h: Real,
     ) {
         let alone = |s: &mut BodyState, m: &MassProperties, w: &Wrench| {
-            self.step_phase(phase, s, m, w, dt);
+            self.stage(phase, s, m, w, h);
         };
-        if self != Integrator::Splitting {
+        if !self.rotates_on_symmetric_kernel() {
             return each_alone(bodies, alone);
         }
         // One loop per phase, each with its phase a constant, as if written out three times.
         match phase {
-            StepPhase::Whole => batched(kernel, StepPhase::Whole, bodies, dt, alone),
-            StepPhase::Begin => batched(kernel, StepPhase::Begin, bodies, dt, alone),
-            StepPhase::Finish => batched(kernel, StepPhase::Finish, bodies, dt, alone),
+            StepPhase::Whole => batched(kernel, StepPhase::Whole, bodies, h, alone),
+            StepPhase::Begin => batched(kernel, StepPhase::Begin, bodies, h, alone),
+            StepPhase::Finish => batched(kernel, StepPhase::Finish, bodies, h, alone),
         }
     }
 
-    /// Runs [`step_batch`](Self::step_batch) over plain arrays; returns the diverged indices
+    /// Runs [`stage_batch`](Self::stage_batch) over plain arrays; returns the diverged indices
     /// in increasing order.
-    fn step_slices<M: Borrow<MassProperties>>(
+    fn stage_slices<M: Borrow<MassProperties>>(
         self,
         phase: StepPhase,
         states: &mut [BodyState],
         masses: &[M],
         wrenches: Option<&[Wrench]>,
-        dt: Real,
+        h: Real,
     ) -> Vec<usize> {
         assert!(states.len() == masses.len());
         assert!(wrenches.is_none_or(|w| w.len() == states.len()));
@@ -361,7 +366,7 @@ impl Integrator {
             wrenches,
             diverged: Vec::new(),
         };
-        self.step_batch(phase, &mut slices, dt);
+        self.stage_batch(phase, &mut slices, h);
         let mut diverged = slices.diverged;
         diverged.sort_unstable();
         diverged
@@ -378,29 +383,44 @@ impl Integrator {
         wrenches: &[Wrench],
         dt: Real,
     ) -> Vec<usize> {
-        self.step_slices(StepPhase::Whole, states, masses, Some(wrenches), dt)
+        if let [c] = self.composition() {
+            return self.stage_slices(StepPhase::Whole, states, masses, Some(wrenches), c * dt);
+        }
+        // A composed step is checked once, at its end, body by body (as `try_step`): a body
+        // that fails in the middle keeps its state from before the step.
+        assert!(states.len() == masses.len() && wrenches.len() == states.len());
+        let mut diverged = Vec::new();
+        for (i, state) in states.iter_mut().enumerate() {
+            if self
+                .try_step(state, masses[i].borrow(), &wrenches[i], dt)
+                .is_err()
+            {
+                diverged.push(i);
+            }
+        }
+        diverged
     }
 
-    /// [`try_begin_step`](Self::try_begin_step) for every body (see
+    /// [`try_begin_stage`](Self::try_begin_stage) for every body (see
     /// [`try_step_many`](Self::try_step_many) for the contract).
-    pub fn try_begin_step_many<M: Borrow<MassProperties>>(
+    pub fn try_begin_stage_many<M: Borrow<MassProperties>>(
         self,
         states: &mut [BodyState],
         masses: &[M],
-        dt: Real,
+        h: Real,
     ) -> Vec<usize> {
-        self.step_slices(StepPhase::Begin, states, masses, None, dt)
+        self.stage_slices(StepPhase::Begin, states, masses, None, h)
     }
 
-    /// [`try_finish_step`](Self::try_finish_step) for every body (see
+    /// [`try_finish_stage`](Self::try_finish_stage) for every body (see
     /// [`try_step_many`](Self::try_step_many) for the contract).
-    pub fn try_finish_step_many<M: Borrow<MassProperties>>(
+    pub fn try_finish_stage_many<M: Borrow<MassProperties>>(
         self,
         states: &mut [BodyState],
         masses: &[M],
         wrenches: &[Wrench],
-        dt: Real,
+        h: Real,
     ) -> Vec<usize> {
-        self.step_slices(StepPhase::Finish, states, masses, Some(wrenches), dt)
+        self.stage_slices(StepPhase::Finish, states, masses, Some(wrenches), h)
     }
 }

@@ -1,29 +1,31 @@
 //! Time integrators: one file per method, one [`Integrator`] enum, one entry point per step.
 //!
-//! Every method advances a [`BodyState`] by `Δt` under a [`Wrench`] held constant over the step
-//! (zero-order hold: forces are sampled once per step, as a game loop does). A step has two
-//! phases so that the ECS can sample forces where each method wants them:
+//! A step of `Δt` is a sequence of *stages* ([`Stages`]): one for most methods, three for
+//! `yoshida4`'s composition, and `N` times as many with `N` substeps. Each stage advances a
+//! [`BodyState`] over its span `h` under a [`Wrench`] held constant over the stage (sampled once
+//! per stage). A stage has two phases so that the ECS can sample forces where each method wants
+//! them:
 //!
-//! - [`Integrator::begin_step`] — before the forces are computed. The drift–kick–drift methods
-//!   (`splitting`, `yoshida4`, `rk4`) drift half a step here, so forces are sampled at the
+//! - [`Integrator::begin_stage`] — before the forces are computed. The drift–kick–drift methods
+//!   (`splitting`, `yoshida4`, `rk4`) drift half a stage here, so forces are sampled at the
 //!   midpoint (exact for constant forces, symplectic second order for springs). The kick–drift
 //!   methods (`symplectic-euler*`, `lclamp`, `implicit-gyroscopic`) sample at the start and do
 //!   nothing here.
-//! - [`Integrator::finish_step`] — after the forces: kick, then the rest of the drift.
+//! - [`Integrator::finish_stage`] — after the forces: kick, then the rest of the drift.
 //!
-//! [`Integrator::step`] runs both with a given constant wrench; [`Integrator::step_with`] samples
-//! a state-dependent load between them.
+//! [`Integrator::step`] runs a whole step under a given constant wrench;
+//! [`Integrator::step_with`] samples a state-dependent load in every stage.
 //!
-//! | method | rotation | order (torque-free) | `\|L\|` | energy |
-//! |---|---|---|---|---|
-//! | `symplectic-euler` | explicit `ω × Iω`, exact `exp` | 1 | grows | grows, diverges for fast spins |
-//! | `symplectic-euler-linear` | as above, `q += ½Δt ω q` | 1 | grows | grows |
-//! | `lclamp` | explicit, `\|L\|` rescaled | 1 | kept | drifts (stable spins tumble) |
-//! | `implicit-gyroscopic` | one Newton step, backward Euler | 1 | decays | decays |
-//! | `splitting` | Lie–Poisson, exact symmetric top + residual | 2 | round-off | bounded |
-//! | `splitting-xyz` | Lie–Poisson Strang 1-2-3-2-1 | 2 | round-off | bounded (poorly for rods) |
-//! | `yoshida4` | Yoshida composition of `splitting` | 4 | round-off | bounded |
-//! | `rk4` | RK4 on `Q̇ = ½ ω(Q) Q` at constant `L` | 4 | exact | slow drift |
+//! | method | rotation | order (torque-free) | order (with loads) | `\|L\|` | energy |
+//! |---|---|---|---|---|---|
+//! | `symplectic-euler` | explicit `ω × Iω`, exact `exp` | 1 | 1 | grows | grows, diverges for fast spins |
+//! | `symplectic-euler-linear` | as above, `q += ½Δt ω q` | 1 | 1 | grows | grows |
+//! | `lclamp` | explicit, `\|L\|` rescaled | 1 | 1 | kept | drifts (stable spins tumble) |
+//! | `implicit-gyroscopic` | one Newton step, backward Euler | 1 | 1 | decays | decays |
+//! | `splitting` | Lie–Poisson, exact symmetric top + residual | 2 | 2 | round-off | bounded |
+//! | `splitting-xyz` | Lie–Poisson Strang 1-2-3-2-1 | 2 | 2 | round-off | bounded (poorly for rods) |
+//! | `yoshida4` | triple jump of `splitting`'s whole step | 4 | 4 | round-off | bounded |
+//! | `rk4` | RK4 on `Q̇ = ½ ω(Q) Q` at constant `L` | 4 | 2 | exact | slow drift |
 
 mod batch;
 pub use batch::{BodyBatch, StepPhase};
@@ -33,11 +35,12 @@ mod lclamp;
 mod rk4;
 mod simd;
 mod splitting;
+mod stages;
+pub use stages::{StageSpan, Stages, TRIPLE_JUMP_LIMIT};
 mod symmetric_kernel;
 mod symplectic_euler;
 #[cfg(test)]
 mod tests;
-mod yoshida;
 
 use crate::math::Real;
 use std::fmt;
@@ -55,9 +58,7 @@ use implicit_gyroscopic::implicit_gyroscopic;
 use lclamp::lclamp;
 use rk4::rk4_free_flow;
 pub use simd::{KERNEL_ENV, KernelError, KernelPath, kernel_path};
-use splitting::{
-    Rotation, drift_kick_drift, rotate_freely, rotate_symmetric, rotate_yoshida, strang_free_flow,
-};
+use splitting::{Rotation, drift_kick_drift, rotate_freely, rotate_symmetric, strang_free_flow};
 use symplectic_euler::{symplectic_euler, symplectic_euler_linear};
 
 /// A time-integration method, selectable per world.
@@ -84,9 +85,13 @@ pub enum Integrator {
     /// Lie–Poisson splitting one principal axis at a time (Strang 1-2-3-2-1), in a
     /// drift–kick–drift step. Second order, symplectic; unstable in energy for fast thin rods.
     SplittingXyz,
-    /// Yoshida's fourth-order composition of [`Splitting`](Self::Splitting)'s free flow.
+    /// Yoshida's fourth-order triple jump of [`Splitting`](Self::Splitting)'s whole
+    /// drift–kick–drift step (three stages, forces sampled in each; see [`Stages`]): fourth
+    /// order with forces, springs and torques, symplectic and time-reversible.
     Yoshida4,
-    /// Classic RK4 on the free rotation at constant `L`, in a drift–kick–drift step.
+    /// Classic RK4 on the free rotation at constant `L`, in a drift–kick–drift step: fourth
+    /// order torque-free only; with any load the step is second order (the forces are sampled
+    /// once per step, at its midpoint: it is not an RK4 of the whole motion).
     Rk4,
 }
 
@@ -117,7 +122,8 @@ impl Integrator {
         }
     }
 
-    /// Nominal order of accuracy of the torque-free rotational motion.
+    /// Nominal order of accuracy of the torque-free rotational motion (with loads: 4 for
+    /// `yoshida4`, at most 2 for the others).
     pub fn order(self) -> u32 {
         match self {
             Integrator::SymplecticEuler
@@ -129,8 +135,8 @@ impl Integrator {
         }
     }
 
-    /// True when the method drifts half a step before forces are sampled (see
-    /// [`begin_step`](Self::begin_step)); false when it samples forces at the start of the step.
+    /// True when the method drifts half a stage before forces are sampled (see
+    /// [`begin_stage`](Self::begin_stage)); false when it samples forces at the start.
     pub fn samples_forces_at_midpoint(self) -> bool {
         !matches!(
             self,
@@ -141,103 +147,141 @@ impl Integrator {
         )
     }
 
+    /// The weights of the stages one step (or substep) is made of, summing to 1: the
+    /// triple jump `(c₁, c₀, c₁)` for `yoshida4` (see [`Stages`]), a single stage of weight 1 for
+    /// every other method.
+    pub fn composition(self) -> &'static [Real] {
+        match self {
+            Integrator::Yoshida4 => &stages::TRIPLE_JUMP,
+            _ => &stages::SINGLE,
+        }
+    }
+
+    /// True when the method's free rotation is `splitting`'s symmetric-top flow, which the
+    /// batched step runs in SIMD lanes (`splitting`, and `yoshida4`, a composition of it).
+    fn rotates_on_symmetric_kernel(self) -> bool {
+        matches!(self, Integrator::Splitting | Integrator::Yoshida4)
+    }
+
     /// The free rotation of a drift–kick–drift method.
     fn free_rotation(self) -> Rotation {
         match self {
-            Integrator::Yoshida4 => rotate_yoshida,
             Integrator::Rk4 => |s, m, h| rotate_freely(s, m, h, rk4_free_flow),
             Integrator::SplittingXyz => |s, m, h| rotate_freely(s, m, h, strang_free_flow),
             _ => rotate_symmetric,
         }
     }
 
-    /// First phase of a step, before forces are sampled: half a drift for the drift–kick–drift
-    /// methods, nothing for the others.
+    /// First phase of one stage of span `h`, before forces are sampled: half a drift for the
+    /// drift–kick–drift methods, nothing for the others. A whole step is the stages of
+    /// [`composition`](Self::composition) (see [`step_with`](Self::step_with)).
     #[inline]
-    pub fn begin_step(self, state: &mut BodyState, mass: &MassProperties, dt: Real) {
+    pub fn begin_stage(self, state: &mut BodyState, mass: &MassProperties, h: Real) {
         if self.samples_forces_at_midpoint() {
             let rotation = self.free_rotation();
-            drift_kick_drift(StepPhase::Begin, state, mass, &Wrench::ZERO, dt, rotation);
+            drift_kick_drift(StepPhase::Begin, state, mass, &Wrench::ZERO, h, rotation);
         }
     }
 
-    /// Second phase of a step, with the load sampled after [`begin_step`](Self::begin_step).
+    /// Second phase of one stage of span `h`, with the load sampled after
+    /// [`begin_stage`](Self::begin_stage): kick, then the rest of the drift.
     #[inline]
-    pub fn finish_step(
+    pub fn finish_stage(
         self,
         state: &mut BodyState,
         mass: &MassProperties,
         wrench: &Wrench,
-        dt: Real,
+        h: Real,
     ) {
         match self {
-            Integrator::SymplecticEuler => symplectic_euler(state, mass, wrench, dt),
-            Integrator::SymplecticEulerLinear => symplectic_euler_linear(state, mass, wrench, dt),
-            Integrator::Lclamp => lclamp(state, mass, wrench, dt),
-            Integrator::ImplicitGyroscopic => implicit_gyroscopic(state, mass, wrench, dt),
+            Integrator::SymplecticEuler => symplectic_euler(state, mass, wrench, h),
+            Integrator::SymplecticEulerLinear => symplectic_euler_linear(state, mass, wrench, h),
+            Integrator::Lclamp => lclamp(state, mass, wrench, h),
+            Integrator::ImplicitGyroscopic => implicit_gyroscopic(state, mass, wrench, h),
             Integrator::Splitting
             | Integrator::SplittingXyz
             | Integrator::Yoshida4
             | Integrator::Rk4 => {
                 let rotation = self.free_rotation();
-                drift_kick_drift(StepPhase::Finish, state, mass, wrench, dt, rotation);
+                drift_kick_drift(StepPhase::Finish, state, mass, wrench, h, rotation);
             }
         }
     }
 
-    /// A whole step under a constant `wrench`. The caller checks the result (see
-    /// [`try_step`](Self::try_step)).
+    /// One whole stage of span `h` under a constant `wrench`.
     ///
-    /// For the drift–kick–drift methods a torque-free step takes its rotation as one free flow
-    /// over `Δt` instead of two halves (nothing is kicked between them): half the cost, same
+    /// For the drift–kick–drift methods a torque-free stage takes its rotation as one free flow
+    /// over `h` instead of two halves (nothing is kicked between them): half the cost, same
     /// order. The ECS takes this path for bodies without a `ForceAccumulator`.
     #[inline]
-    pub fn step(self, state: &mut BodyState, mass: &MassProperties, wrench: &Wrench, dt: Real) {
+    pub fn whole_stage(
+        self,
+        state: &mut BodyState,
+        mass: &MassProperties,
+        wrench: &Wrench,
+        h: Real,
+    ) {
         if self.samples_forces_at_midpoint() {
             let rotation = self.free_rotation();
-            drift_kick_drift(StepPhase::Whole, state, mass, wrench, dt, rotation);
+            drift_kick_drift(StepPhase::Whole, state, mass, wrench, h, rotation);
         } else {
-            // The kick–drift methods do nothing before the forces: the step is its second phase.
-            self.finish_step(state, mass, wrench, dt);
+            // The kick–drift methods do nothing before the forces: the stage is its second phase.
+            self.finish_stage(state, mass, wrench, h);
         }
     }
 
-    /// `phase` of a step: [`step`](Self::step), [`begin_step`](Self::begin_step) (the load is
-    /// not used) or [`finish_step`](Self::finish_step).
+    /// `phase` of one stage of span `h`: [`whole_stage`](Self::whole_stage),
+    /// [`begin_stage`](Self::begin_stage) (the load is not used) or
+    /// [`finish_stage`](Self::finish_stage).
     #[inline]
-    fn step_phase(
+    fn stage(
         self,
         phase: StepPhase,
         state: &mut BodyState,
         mass: &MassProperties,
         wrench: &Wrench,
-        dt: Real,
+        h: Real,
     ) {
         match phase {
-            StepPhase::Whole => self.step(state, mass, wrench, dt),
-            StepPhase::Begin => self.begin_step(state, mass, dt),
-            StepPhase::Finish => self.finish_step(state, mass, wrench, dt),
+            StepPhase::Whole => self.whole_stage(state, mass, wrench, h),
+            StepPhase::Begin => self.begin_stage(state, mass, h),
+            StepPhase::Finish => self.finish_stage(state, mass, wrench, h),
         }
     }
 
-    /// A whole step with a state-dependent load, sampled where the method wants it (after
-    /// [`begin_step`](Self::begin_step)).
+    /// A whole step of `dt` under a constant `wrench`: the stages of
+    /// [`composition`](Self::composition), each a [`whole_stage`](Self::whole_stage) of span
+    /// `c dt`. The caller checks the result (see [`try_step`](Self::try_step)).
+    #[inline]
+    pub fn step(self, state: &mut BodyState, mass: &MassProperties, wrench: &Wrench, dt: Real) {
+        for &c in self.composition() {
+            self.whole_stage(state, mass, wrench, c * dt);
+        }
+    }
+
+    /// A whole step of `dt` with a state-dependent load, sampled afresh in every stage of the
+    /// [`composition`](Self::composition), where the method wants it (after
+    /// [`begin_stage`](Self::begin_stage)): `yoshida4` is then fourth order with any smooth
+    /// load, the other drift–kick–drift methods second order.
     #[inline]
     pub fn step_with(
         self,
         state: &mut BodyState,
         mass: &MassProperties,
         dt: Real,
-        load: impl FnOnce(&BodyState) -> Wrench,
+        mut load: impl FnMut(&BodyState) -> Wrench,
     ) {
-        self.begin_step(state, mass, dt);
-        let wrench = load(state);
-        self.finish_step(state, mass, &wrench, dt);
+        for &c in self.composition() {
+            let h = c * dt;
+            self.begin_stage(state, mass, h);
+            let wrench = load(state);
+            self.finish_stage(state, mass, &wrench, h);
+        }
     }
 
-    /// Advances `state` by `dt` and commits the result only if it is valid (finite, with a unit
-    /// rotation: [`BodyState::is_valid`]); otherwise `state` is left unchanged and
-    /// [`StepError::Diverged`] is returned.
+    /// Advances `state` by `dt` ([`step`](Self::step)) and commits the result only if it is
+    /// valid (finite, with a unit rotation: [`BodyState::is_valid`]); otherwise `state` is left
+    /// unchanged and [`StepError::Diverged`] is returned.
     #[inline]
     pub fn try_step(
         self,
@@ -249,17 +293,17 @@ impl Integrator {
         self.commit_if_valid(state, |next| self.step(next, mass, wrench, dt))
     }
 
-    /// [`finish_step`](Self::finish_step) that commits only a valid result (see
+    /// [`finish_stage`](Self::finish_stage) that commits only a valid result (see
     /// [`try_step`](Self::try_step)).
     #[inline]
-    pub fn try_finish_step(
+    pub fn try_finish_stage(
         self,
         state: &mut BodyState,
         mass: &MassProperties,
         wrench: &Wrench,
-        dt: Real,
+        h: Real,
     ) -> Result<(), StepError> {
-        self.commit_if_valid(state, |next| self.finish_step(next, mass, wrench, dt))
+        self.commit_if_valid(state, |next| self.finish_stage(next, mass, wrench, h))
     }
 
     /// Runs `advance` on a copy of `state` and commits the copy only if it is valid.
@@ -279,16 +323,16 @@ impl Integrator {
         }
     }
 
-    /// [`begin_step`](Self::begin_step) that commits only a valid result (see
+    /// [`begin_stage`](Self::begin_stage) that commits only a valid result (see
     /// [`try_step`](Self::try_step)).
     #[inline]
-    pub fn try_begin_step(
+    pub fn try_begin_stage(
         self,
         state: &mut BodyState,
         mass: &MassProperties,
-        dt: Real,
+        h: Real,
     ) -> Result<(), StepError> {
-        self.commit_if_valid(state, |next| self.begin_step(next, mass, dt))
+        self.commit_if_valid(state, |next| self.begin_stage(next, mass, h))
     }
 }
 

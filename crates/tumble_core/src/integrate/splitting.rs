@@ -39,7 +39,7 @@
 //!
 //! **Where the code is.** The `splitting` flow is written once, lane-generic, in
 //! `symmetric_kernel` (`Flowing::symmetric_flow`): one body runs it in `f64`, a batch in SIMD
-//! lanes, and `yoshida4` composes three of it. The one-axis flows of `splitting-xyz` (and
+//! lanes (`yoshida4` is a composition of whole `splitting` steps, see `stages`). The one-axis flows of `splitting-xyz` (and
 //! `rk4`'s free flow) advance a [`FreeBody`] here. The drift–kick–drift phases are
 //! [`drift_kick_drift_translation`] plus the method's free rotation, on both the scalar and the
 //! batched paths.
@@ -50,13 +50,12 @@
 //! first drift before the force systems), so constant forces are integrated exactly and springs
 //! get the second-order, symplectic position-Verlet scheme.
 
-use crate::math::{Narrow, Quat, Real, Vec3, Widen};
+use crate::math::{Narrow, Real, Vec3, Widen};
 use glam::{DQuat, DVec3};
 
 use super::StepPhase;
 use super::frame::{reciprocal, rotate64};
 use super::symmetric_kernel::{SymmetricInput, rotate_symmetric_one};
-use super::yoshida::rotate_yoshida_one;
 use crate::mass::MassProperties;
 use crate::rotation::rotate_exact;
 use crate::state::{BodyState, Wrench};
@@ -128,30 +127,12 @@ pub type Rotation = fn(&mut BodyState, &MassProperties, Real);
 /// the same code the batched step runs, so one body gets the same bits alone or in a batch.
 #[inline]
 pub fn rotate_symmetric(state: &mut BodyState, mass: &MassProperties, h: Real) {
-    rotate_lie_poisson(state, mass, h, rotate_symmetric_one);
-}
-
-/// The free rotation of `yoshida4` over `h`: three of `splitting`'s flows (see `yoshida`).
-#[inline]
-pub fn rotate_yoshida(state: &mut BodyState, mass: &MassProperties, h: Real) {
-    rotate_lie_poisson(state, mass, h, rotate_yoshida_one);
-}
-
-/// A free rotation on the symmetric-top kernel: spherical bodies exactly about `ω`, the others
-/// by `flow` from their kernel inputs.
-#[inline(always)]
-fn rotate_lie_poisson(
-    state: &mut BodyState,
-    mass: &MassProperties,
-    h: Real,
-    flow: fn(&SymmetricInput, Real) -> (Quat, Vec3),
-) {
     if mass.is_spherical() {
         state.rotation = rotate_exact(state.rotation, state.angular_velocity, h);
         return;
     }
     let input = SymmetricInput::new(state.rotation, state.angular_velocity, mass);
-    (state.rotation, state.angular_velocity) = flow(&input, h);
+    (state.rotation, state.angular_velocity) = rotate_symmetric_one(&input, h);
 }
 
 /// The rotational part of a drift: the free flow over `h` at constant world `L`.

@@ -49,7 +49,7 @@ fn a_non_unit_rotation_after_a_step_is_a_divergence_on_the_scalar_path() {
     );
     assert_eq!(state, before, "a diverged body keeps its old state");
     assert_eq!(
-        integrator.try_finish_step(&mut state, &mass, &Wrench::ZERO, dt),
+        integrator.try_finish_stage(&mut state, &mass, &Wrench::ZERO, dt),
         Err(StepError::Diverged { integrator })
     );
     assert_eq!(state, before);
@@ -74,7 +74,7 @@ fn a_non_unit_rotation_after_a_step_is_a_divergence_on_the_batched_path() {
             .unwrap();
         assert_eq!(states[i], alone[i], "body {i} must be stepped as if alone");
     }
-    let diverged = integrator.try_finish_step_many(&mut states, &masses, &wrenches, dt);
+    let diverged = integrator.try_finish_stage_many(&mut states, &masses, &wrenches, dt);
     assert_eq!(diverged, vec![2]);
     assert_eq!(states[2], overspun);
 }
@@ -196,8 +196,10 @@ fn every_kernel_path_the_cpu_has_gives_the_same_bits_as_the_scalar_step() {
         for (i, state) in scalar.states.iter_mut().enumerate() {
             let (mass, wrench) = (&scalar.masses[i], &scalar.wrenches[i]);
             integrator.try_step(state, mass, wrench, dt).unwrap();
-            integrator.try_begin_step(state, mass, dt).unwrap();
-            integrator.try_finish_step(state, mass, wrench, dt).unwrap();
+            integrator.try_begin_stage(state, mass, dt).unwrap();
+            integrator
+                .try_finish_stage(state, mass, wrench, dt)
+                .unwrap();
         }
     }
     let kernels = Kernel::available();
@@ -206,7 +208,7 @@ fn every_kernel_path_the_cpu_has_gives_the_same_bits_as_the_scalar_step() {
         let mut batch = population();
         for _ in 0..20 {
             for phase in [StepPhase::Whole, StepPhase::Begin, StepPhase::Finish] {
-                integrator.step_batch_on(kernel, phase, &mut batch, dt);
+                integrator.stage_batch_on(kernel, phase, &mut batch, dt);
             }
         }
         assert!(batch.diverged.is_empty());

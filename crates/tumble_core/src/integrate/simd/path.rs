@@ -15,7 +15,7 @@ use super::{Avx2, Avx512};
 pub const KERNEL_ENV: &str = "TUMBLE_KERNEL";
 
 /// A compilation of the batched `splitting` free rotation, by instruction set. Every path gives
-/// the same bits (see [`Integrator::step_batch`](crate::Integrator::step_batch)); they differ
+/// the same bits (see [`Integrator::stage_batch`](crate::Integrator::stage_batch)); they differ
 /// in speed only.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum KernelPath {
