@@ -243,6 +243,30 @@ pub fn springs_markdown(springs: &SpringResults) -> String {
         );
     }
     s.push('\n');
+    let _ = writeln!(
+        s,
+        "**Stages** (the same loaded chains, explicit springs at ωΔt = 0.5, through the ECS): \
+         substeps and `yoshida4`'s fourth-order composition, ns per body-step (median) and \
+         relative to `splitting` in one stage\n"
+    );
+    let _ = writeln!(
+        s,
+        "| bodies | integrator | substeps | stages | ns/body-step | × one stage |"
+    );
+    let _ = writeln!(s, "|---:|---|---:|---:|---:|---:|");
+    for r in &springs.stages {
+        let _ = writeln!(
+            s,
+            "| {} | `{}` | {} | {} | {} | {:.2} |",
+            r.bodies,
+            r.integrator,
+            r.substeps,
+            r.stages,
+            fmt_ns(r.ns_per_body_step),
+            r.ratio
+        );
+    }
+    s.push('\n');
     s
 }
 

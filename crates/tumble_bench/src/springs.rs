@@ -3,9 +3,10 @@
 //! a force at a body point and damping on every body).
 
 use serde::Serialize;
+use std::num::NonZeroU32;
 use tumble_core::math::{Real, Vec3, to_f64};
 use tumble_core::{BodyState, Integrator};
-use tumble_ecs::prelude::SpringSolver;
+use tumble_ecs::prelude::{PhysicsSettings, SpringSolver};
 use tumble_rapier::presets::{ChainStart, spring_chain};
 use tumble_rapier::{Load, TumbleScene};
 
@@ -29,13 +30,35 @@ pub struct SpringWorld {
 }
 
 impl SpringWorld {
-    /// The world; see [`Loads`] for what acts besides the springs.
+    /// The world, stepped by the default integrator in one stage; see [`Loads`] for what acts
+    /// besides the springs.
     pub fn new(
         chains: usize,
         omega_dt: Real,
         start: ChainStart,
         springs: SpringSolver,
         loads: Loads,
+    ) -> Self {
+        Self::staged(
+            chains,
+            omega_dt,
+            start,
+            springs,
+            loads,
+            Integrator::default(),
+            1,
+        )
+    }
+
+    /// [`new`](Self::new) stepped by `integrator` in `substeps` substeps.
+    pub fn staged(
+        chains: usize,
+        omega_dt: Real,
+        start: ChainStart,
+        springs: SpringSolver,
+        loads: Loads,
+        integrator: Integrator,
+        substeps: u32,
     ) -> Self {
         let mut scene = spring_chain(omega_dt, start, chains);
         if loads == Loads::GravityForcesDamping {
@@ -49,8 +72,17 @@ impl SpringWorld {
                 body.angular_damping = 0.05;
             }
         }
+        let mut tumble = TumbleScene::with_springs(&scene, integrator, springs);
+        if substeps > 1 {
+            let substeps = NonZeroU32::new(substeps).expect("more than one substep");
+            tumble
+                .world_mut()
+                .resource_mut::<PhysicsSettings>()
+                .substeps = substeps;
+            tumble.replan();
+        }
         Self {
-            tumble: TumbleScene::with_springs(&scene, Integrator::default(), springs),
+            tumble,
             bodies: scene.bodies.len(),
         }
     }
@@ -99,6 +131,24 @@ pub struct ThroughputRow {
     pub ns_per_spring_step: f64,
 }
 
+/// Steps of several stages: a loaded spring world stepped with substeps or the fourth-order
+/// composition, against the same world in one stage.
+#[derive(Debug, Clone, Serialize)]
+pub struct StagesRow {
+    /// Bodies (ten per chain).
+    pub bodies: usize,
+    /// The integrator.
+    pub integrator: String,
+    /// Substeps per step.
+    pub substeps: u32,
+    /// Stages per step (substeps × the integrator's composition).
+    pub stages: usize,
+    /// Median ns per body-step.
+    pub ns_per_body_step: f64,
+    /// Relative to the same world with `splitting` in one stage.
+    pub ratio: f64,
+}
+
 /// Everything the spring part of the bench measured.
 #[derive(Debug, Clone, Serialize)]
 pub struct SpringResults {
@@ -106,6 +156,8 @@ pub struct SpringResults {
     pub stiffness: Vec<StiffnessRow>,
     /// Many chains with loads.
     pub throughput: Vec<ThroughputRow>,
+    /// Steps of several stages on the loaded chains.
+    pub stages: Vec<StagesRow>,
 }
 
 impl SpringResults {
@@ -197,8 +249,50 @@ pub fn run(quick: bool, mut progress: impl FnMut(&str)) -> SpringResults {
             });
         }
     }
+    let mut stages = Vec::new();
+    for &springs in sizes {
+        let chains = springs / 10;
+        let effort = Effort {
+            body_steps: if quick { 10_000 } else { 300_000 },
+            min_steps: 2,
+            max_steps: 200,
+            repetitions: 3,
+        };
+        // The first row of each size: `splitting` in one stage.
+        let mut one_stage = None;
+        for (integrator, substeps) in [
+            (Integrator::Splitting, 1),
+            (Integrator::Splitting, 4),
+            (Integrator::Yoshida4, 1),
+            (Integrator::Yoshida4, 2),
+        ] {
+            progress(&format!(
+                "{springs} springs with forces, {integrator} × {substeps} substeps"
+            ));
+            let mut world = SpringWorld::staged(
+                chains,
+                0.5,
+                ChainStart::Relaxed,
+                SpringSolver::Explicit,
+                Loads::GravityForcesDamping,
+                integrator,
+                substeps,
+            );
+            let ns = compare(&mut [&mut world], chains * 10, &effort)[0];
+            let base = *one_stage.get_or_insert(ns);
+            stages.push(StagesRow {
+                bodies: chains * 10,
+                integrator: integrator.name().to_owned(),
+                substeps,
+                stages: substeps as usize * integrator.composition().len(),
+                ns_per_body_step: ns,
+                ratio: ns / base,
+            });
+        }
+    }
     SpringResults {
         stiffness,
         throughput,
+        stages,
     }
 }

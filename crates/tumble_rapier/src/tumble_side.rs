@@ -107,6 +107,13 @@ impl TumbleScene {
         }
     }
 
+    /// Plans the world again (after a change of its settings or resources) and rebuilds the
+    /// schedule.
+    pub fn replan(&mut self) {
+        self.plan = PhysicsPlan::for_world(&mut self.world);
+        self.schedule = self.plan.build_schedule();
+    }
+
     /// The world, to add resources (e.g. a threading policy) or read components.
     pub fn world_mut(&mut self) -> &mut World {
         &mut self.world

@@ -18,6 +18,7 @@
 #![warn(missing_docs)]
 
 pub mod energy;
+pub mod linkage;
 pub mod output;
 pub mod reference;
 pub mod run;

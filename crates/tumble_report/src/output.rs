@@ -119,7 +119,10 @@ pub fn headline_error(p: &Point) -> f64 {
 }
 
 fn sci(x: f64) -> String {
-    if x.is_finite() {
+    if x.is_nan() {
+        // Not measured (the linkage's energy is not conserved: its force and torque work).
+        "—".to_owned()
+    } else if x.is_finite() {
         format!("{x:.1e}")
     } else {
         "∞".to_owned()
@@ -170,6 +173,82 @@ pub fn headline_table(points: &[Point]) -> String {
     out
 }
 
+/// The error each method reaches at the same run time: per scene, the time `splitting` takes to
+/// the horizon at Δt = 1/60 s, and each method's error at that time, interpolated log–log
+/// between the two measured Δt whose run times bracket it (`—` when none do, or when the
+/// method diverged there). A cheap first-order method may then take many small steps, and an
+/// expensive high-order one few large ones: this is the comparison that matters.
+pub fn equal_time_table(points: &[Point]) -> String {
+    let mut scenes: Vec<&str> = Vec::new();
+    let mut methods: Vec<&str> = Vec::new();
+    for p in points {
+        if !scenes.contains(&p.scene.as_str()) {
+            scenes.push(&p.scene);
+        }
+        if !methods.contains(&p.method.as_str()) {
+            methods.push(&p.method);
+        }
+    }
+    let budget = |scene: &str| {
+        points
+            .iter()
+            .find(|p| {
+                p.scene == scene && p.method == "splitting" && (p.dt_s - 1.0 / 60.0).abs() < 1e-6
+            })
+            .map(work_us)
+    };
+    let mut out = String::from("| method |");
+    for s in &scenes {
+        let _ = write!(out, " {s} |");
+    }
+    out.push_str("\n|---|");
+    for _ in &scenes {
+        out.push_str("---|");
+    }
+    out.push('\n');
+    for m in &methods {
+        let _ = write!(out, "| `{m}` |");
+        for s in &scenes {
+            let mut curve: Vec<(f64, f64)> = points
+                .iter()
+                .filter(|p| p.method == *m && p.scene == *s)
+                .map(|p| {
+                    (
+                        work_us(p),
+                        if p.finite {
+                            headline_error(p)
+                        } else {
+                            f64::INFINITY
+                        },
+                    )
+                })
+                .collect();
+            curve.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let at = budget(s).and_then(|t| {
+                curve.windows(2).find_map(|w| {
+                    let ((t0, e0), (t1, e1)) = (w[0], w[1]);
+                    (t0 <= t && t <= t1 && t0 < t1).then(|| {
+                        if !(e0.is_finite() && e1.is_finite() && e0 > 0.0 && e1 > 0.0) {
+                            return f64::INFINITY;
+                        }
+                        let f = (t / t0).ln() / (t1 / t0).ln();
+                        (e0.ln() + f * (e1.ln() - e0.ln())).exp()
+                    })
+                })
+            });
+            match at {
+                Some(e) if e.is_finite() => {
+                    let _ = write!(out, " {} |", sci(e));
+                }
+                Some(_) => out.push_str(" diverged |"),
+                None => out.push_str(" — |"),
+            }
+        }
+        out.push('\n');
+    }
+    out
+}
+
 /// The full markdown report.
 pub fn markdown(results: &Results, plots: &[String]) -> String {
     let mut out = String::new();
@@ -191,6 +270,13 @@ pub fn markdown(results: &Results, plots: &[String]) -> String {
          ns/body-step is the median over scenes.\n"
     );
     out.push_str(&headline_table(&results.work_precision));
+    let _ = writeln!(
+        out,
+        "\n## Headline: error at equal run time\n\nEach method's error when it runs as long as \
+         `splitting` at Δt = 1/60 s (interpolated on its work–precision curve; — where the \
+         measured Δt do not reach that run time).\n"
+    );
+    out.push_str(&equal_time_table(&results.work_precision));
     let _ = writeln!(out, "\n## Work–precision\n");
     for plot in plots {
         let _ = writeln!(out, "![{plot}]({plot})\n");

@@ -63,7 +63,9 @@ pub fn run_report(options: &ReportOptions) -> Result<(), Box<dyn std::error::Err
     };
     let cases = cases();
     let methods = Method::all();
+    let integrators = tumble_core::Integrator::ALL;
     let total = cases.len() * methods.len() * dts.len()
+        + integrators.len() * dts.len()
         + tumble_core::Integrator::ALL.len()
         + 2 * crate::springs::OMEGA_DTS.len();
     let bar = ProgressBar::new(total as u64);
@@ -82,6 +84,21 @@ pub fn run_report(options: &ReportOptions) -> Result<(), Box<dyn std::error::Err
                 points.push(measure(case, method, dt, effort));
                 bar.inc(1);
             }
+        }
+    }
+    bar.set_message(format!("{} · reference", crate::linkage::NAME));
+    let exact = crate::linkage::reference(crate::linkage::HORIZON, crate::linkage::REFERENCE_STEPS);
+    for &integrator in integrators {
+        bar.set_message(format!("{} · {integrator}", crate::linkage::NAME));
+        for &dt in &dts {
+            points.push(crate::linkage::measure(
+                integrator,
+                dt,
+                effort.batch,
+                effort.repetitions,
+                &exact,
+            ));
+            bar.inc(1);
         }
     }
     bar.set_message("stability matrix");
@@ -108,12 +125,8 @@ pub fn run_report(options: &ReportOptions) -> Result<(), Box<dyn std::error::Err
         .tempdir_in(out)
         .map_err(|e| OutputError::io(out, e))?;
     let mut plots = Vec::new();
-    for case in &cases {
-        plots.push(plot_scene(
-            staging.path(),
-            case.name,
-            &results.work_precision,
-        )?);
+    for name in cases.iter().map(|c| c.name).chain([crate::linkage::NAME]) {
+        plots.push(plot_scene(staging.path(), name, &results.work_precision)?);
     }
     for (spin, _) in spins() {
         plots.push(plot_energy(staging.path(), spin, &results.energy)?);
@@ -141,7 +154,12 @@ pub fn run_report(options: &ReportOptions) -> Result<(), Box<dyn std::error::Err
         markdown(&results, &plots).as_bytes(),
         &[],
     )?;
-    let headline = headline_table(&results.work_precision);
+    let headline = format!(
+        "{}\nAt equal run time (each method run as long as `splitting` at Δt = 1/60 s, its error \
+         interpolated on its work–precision curve):\n\n{}",
+        headline_table(&results.work_precision),
+        crate::output::equal_time_table(&results.work_precision)
+    );
     println!("{headline}");
     if let Some(readme) = &options.readme {
         let text = std::fs::read_to_string(readme).map_err(|e| OutputError::io(readme, e))?;
