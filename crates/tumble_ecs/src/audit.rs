@@ -22,7 +22,10 @@
 //! where `F`, `τ` are every load on the body except the springs (gravity, constant forces and
 //! torques, forces game code or its own systems added) and `e_step` is the integrator's energy
 //! error. The `(v_start + v_end)/2` form is the drift–kick–drift displacement exactly, so a
-//! constant force credits exactly the work the step did. Spring dampers and
+//! constant force credits exactly the work the step did. In a step of several stages (substeps,
+//! `yoshida4`; see [`crate::stages`]) the balance is still closed once per step, with `F`, `τ`
+//! the loads of the stages weighted by their spans, `Σ (h/Δt) F_stage`, and `ω_max Δt` below
+//! measured on the step's stability span (`Stages::stability_span`). Spring dampers and
 //! [`Damping`](crate::components::Damping) are velocity flows at the start and end of the step
 //! ([`crate::damping`]); they only remove energy, are not credited, and lower `D`. The audit keeps the running sum `D = Σ e_step` per group
 //! (the energy the integrator made up; changes game code makes between steps are not part of

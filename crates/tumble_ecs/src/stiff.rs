@@ -11,7 +11,11 @@
 //! Gershgorin-style bound on the group's stiffness matrix, exact for the top mode of a uniform
 //! chain; one spring's own `k (ι_a + ι_b)` misses that a body pulled by several springs vibrates
 //! faster, by up to √degree). So a group is never stiffer than the classification assumed. Soft
-//! groups pay nothing: their bodies stay on the explicit path.
+//! groups pay nothing: their bodies stay on the explicit path. `Δt` here is the step's stability
+//! span (`Stages::stability_span`: `Δt/N` with `N` substeps, `1.27 Δt/N` with `yoshida4`'s
+//! composition); in a step of several stages the implicit step runs once per stage, over the
+//! stage's span (the backward stage of the composition included: implicit midpoint is
+//! symmetric, so the composition keeps its order).
 //!
 //! [`PhysicsSettings::springs`](crate::components::PhysicsSettings::springs) overrides the choice
 //! for a world ([`SpringSolver`]). The classification is made when the schedule is planned and
@@ -22,7 +26,7 @@
 //! Bodies of an implicit group are marked [`ImplicitBody`] and their springs [`ImplicitSpring`]:
 //! the half drift and the explicit integrate systems skip them, `apply_springs` skips their
 //! springs, and [`solve_implicit_springs`] steps them, reading every other load (gravity,
-//! constant forces, game forces) from their accumulators, held constant over the step.
+//! constant forces, game forces) from their accumulators, held constant over the stage.
 
 use bevy_ecs::entity::EntityHashMap;
 use bevy_ecs::prelude::*;
