@@ -216,14 +216,14 @@ pub fn run(quick: bool, mut progress: impl FnMut(&str)) -> SpringResults {
     }
     let mut throughput = Vec::new();
     let sizes: &[usize] = if quick { &[1_000] } else { &[1_000, 100_000] };
+    let effort = Effort {
+        body_steps: if quick { 10_000 } else { 300_000 },
+        min_steps: 2,
+        max_steps: 200,
+        repetitions: 3,
+    };
     for &springs in sizes {
         let chains = springs / 10;
-        let effort = Effort {
-            body_steps: if quick { 10_000 } else { 300_000 },
-            min_steps: 2,
-            max_steps: 200,
-            repetitions: 3,
-        };
         for (mode, omega_dt) in [
             (SpringSolver::Explicit, 0.5),
             (SpringSolver::Implicit, 0.5),
@@ -252,12 +252,6 @@ pub fn run(quick: bool, mut progress: impl FnMut(&str)) -> SpringResults {
     let mut stages = Vec::new();
     for &springs in sizes {
         let chains = springs / 10;
-        let effort = Effort {
-            body_steps: if quick { 10_000 } else { 300_000 },
-            min_steps: 2,
-            max_steps: 200,
-            repetitions: 3,
-        };
         // The first row of each size: `splitting` in one stage.
         let mut one_stage = None;
         for (integrator, substeps) in [

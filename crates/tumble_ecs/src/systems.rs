@@ -161,7 +161,8 @@ pub fn integrate_with_forces(
 /// Integrates bodies without a [`ForceAccumulator`]: free motion, plus gravity when a
 /// [`Gravity`] resource exists (a uniform field needs no accumulator), one whole stage, with the
 /// [`Damping`] flow for half a substep before a stage that opens a substep and after one that
-/// closes it.
+/// closes it. With a composed integrator (`yoshida4`) such a body takes its whole substep in the
+/// stage that opens it (nothing samples its state in between), its free rotation rounded once.
 pub fn integrate_without_forces(
     settings: Res<PhysicsSettings>,
     cursor: Res<crate::stages::StageCursor>,
@@ -181,7 +182,9 @@ pub fn integrate_without_forces(
     >,
 ) {
     let gravity = gravity.map(|g| g.0);
-    let stage = StageTiming::new(&settings, *cursor, StepPhase::Whole);
+    let Some(stage) = StageTiming::free_motion(&settings, *cursor) else {
+        return;
+    };
     let parallelism = parallelism.map_or_else(Parallelism::default, |p| *p);
     let mut errors = Vec::new();
     for (entities, mut t, mut v, masses, scales, dampings) in dense(bodies.contiguous_iter_mut()) {

@@ -150,9 +150,31 @@ pub(crate) struct StageTiming {
     half_substep: Real,
     damp_read: bool,
     damp_write: bool,
+    /// The whole substep at once (`h` is the substep): [`Integrator::step_batch`].
+    whole_substep: bool,
 }
 
 impl StageTiming {
+    /// A whole substep, for bodies whose only load is constant (no accumulator): in a plan whose
+    /// integrator is a composition, the substep's stages run at once in the stage that opens
+    /// it (`None` in its other stages), so that a torque-free composed step rounds its rotation
+    /// once (see [`Integrator::step`]); otherwise the stage's [`Whole`](StepPhase::Whole) phase.
+    pub(crate) fn free_motion(settings: &PhysicsSettings, cursor: StageCursor) -> Option<Self> {
+        if settings.integrator.composition().len() == 1 {
+            return Some(Self::new(settings, cursor, StepPhase::Whole));
+        }
+        let span = cursor.span(settings);
+        span.opens_substep.then_some(Self {
+            integrator: settings.integrator,
+            phase: StepPhase::Whole,
+            h: span.substep,
+            half_substep: 0.5 * span.substep,
+            damp_read: true,
+            damp_write: true,
+            whole_substep: true,
+        })
+    }
+
     /// `phase` of the stage `cursor` points at, under `settings`: the damping flow's first half
     /// before a phase that begins the stage (`Begin`, `Whole`) when the stage opens its
     /// substep, its second half after a phase that ends the stage (`Finish`, `Whole`) when the
@@ -166,6 +188,7 @@ impl StageTiming {
             half_substep: 0.5 * span.substep,
             damp_read: phase != StepPhase::Finish && span.opens_substep,
             damp_write: phase != StepPhase::Begin && span.closes_substep,
+            whole_substep: false,
         }
     }
 }
@@ -262,9 +285,13 @@ fn step_bodies(stage: &StageTiming, bodies: Bodies<'_>, errors: &mut Vec<BodyErr
         integrator: stage.integrator,
         errors,
     };
-    stage
-        .integrator
-        .stage_batch(stage.phase, &mut batch, stage.h);
+    if stage.whole_substep {
+        stage.integrator.step_batch(&mut batch, stage.h);
+    } else {
+        stage
+            .integrator
+            .stage_batch(stage.phase, &mut batch, stage.h);
+    }
     errors[found..].sort_by_key(|e| e.entity);
 }
 

@@ -129,8 +129,8 @@ fn sci(x: f64) -> String {
     }
 }
 
-/// The headline table: error at Δt = 1/60 s and ns per body-step, per scene and method.
-pub fn headline_table(points: &[Point]) -> String {
+/// The scenes and the methods of `points`, each in order of first appearance.
+fn scenes_and_methods(points: &[Point]) -> (Vec<&str>, Vec<&str>) {
     let mut scenes: Vec<&str> = Vec::new();
     let mut methods: Vec<&str> = Vec::new();
     for p in points {
@@ -141,15 +141,29 @@ pub fn headline_table(points: &[Point]) -> String {
             methods.push(&p.method);
         }
     }
+    (scenes, methods)
+}
+
+/// The header rows of a table with a method column, one column per scene and optionally a
+/// last column.
+fn table_head(scenes: &[&str], last: Option<&str>) -> String {
     let mut out = String::from("| method |");
-    for s in &scenes {
+    for s in scenes {
         let _ = write!(out, " {s} |");
     }
-    out.push_str(" ns/body-step |\n|---|");
-    for _ in &scenes {
-        out.push_str("---|");
+    if let Some(last) = last {
+        let _ = write!(out, " {last} |");
     }
-    out.push_str("---|\n");
+    out.push_str("\n|---|");
+    out.push_str(&"---|".repeat(scenes.len() + usize::from(last.is_some())));
+    out.push('\n');
+    out
+}
+
+/// The headline table: error at Δt = 1/60 s and ns per body-step, per scene and method.
+pub fn headline_table(points: &[Point]) -> String {
+    let (scenes, methods) = scenes_and_methods(points);
+    let mut out = table_head(&scenes, Some("ns/body-step"));
     for m in &methods {
         let _ = write!(out, "| `{m}` |");
         let mut ns = Vec::new();
@@ -179,16 +193,7 @@ pub fn headline_table(points: &[Point]) -> String {
 /// method diverged there). A cheap first-order method may then take many small steps, and an
 /// expensive high-order one few large ones: this is the comparison that matters.
 pub fn equal_time_table(points: &[Point]) -> String {
-    let mut scenes: Vec<&str> = Vec::new();
-    let mut methods: Vec<&str> = Vec::new();
-    for p in points {
-        if !scenes.contains(&p.scene.as_str()) {
-            scenes.push(&p.scene);
-        }
-        if !methods.contains(&p.method.as_str()) {
-            methods.push(&p.method);
-        }
-    }
+    let (scenes, methods) = scenes_and_methods(points);
     let budget = |scene: &str| {
         points
             .iter()
@@ -197,15 +202,7 @@ pub fn equal_time_table(points: &[Point]) -> String {
             })
             .map(work_us)
     };
-    let mut out = String::from("| method |");
-    for s in &scenes {
-        let _ = write!(out, " {s} |");
-    }
-    out.push_str("\n|---|");
-    for _ in &scenes {
-        out.push_str("---|");
-    }
-    out.push('\n');
+    let mut out = table_head(&scenes, None);
     for m in &methods {
         let _ = write!(out, "| `{m}` |");
         for s in &scenes {

@@ -348,6 +348,18 @@ impl Integrator {
         }
     }
 
+    /// One whole step of `dt` for every body of `bodies` under its constant load
+    /// ([`step`](Self::step) for each: the stages of the [`composition`](Self::composition));
+    /// for a method of one stage, [`stage_batch`](Self::stage_batch) of the
+    /// [`Whole`](StepPhase::Whole) stage. The same contract as `stage_batch`; a composed step is
+    /// checked once, at its end.
+    pub fn step_batch(self, bodies: &mut impl BodyBatch, dt: Real) {
+        if let [c] = self.composition() {
+            return self.stage_batch(StepPhase::Whole, bodies, c * dt);
+        }
+        each_alone(bodies, |s, m, w| self.step(s, m, w, dt));
+    }
+
     /// Runs [`stage_batch`](Self::stage_batch) over plain arrays; returns the diverged indices
     /// in increasing order.
     fn stage_slices<M: Borrow<MassProperties>>(
@@ -383,21 +395,16 @@ impl Integrator {
         wrenches: &[Wrench],
         dt: Real,
     ) -> Vec<usize> {
-        if let [c] = self.composition() {
-            return self.stage_slices(StepPhase::Whole, states, masses, Some(wrenches), c * dt);
-        }
-        // A composed step is checked once, at its end, body by body (as `try_step`): a body
-        // that fails in the middle keeps its state from before the step.
         assert!(states.len() == masses.len() && wrenches.len() == states.len());
-        let mut diverged = Vec::new();
-        for (i, state) in states.iter_mut().enumerate() {
-            if self
-                .try_step(state, masses[i].borrow(), &wrenches[i], dt)
-                .is_err()
-            {
-                diverged.push(i);
-            }
-        }
+        let mut slices = Slices {
+            states,
+            masses,
+            wrenches: Some(wrenches),
+            diverged: Vec::new(),
+        };
+        self.step_batch(&mut slices, dt);
+        let mut diverged = slices.diverged;
+        diverged.sort_unstable();
         diverged
     }
 

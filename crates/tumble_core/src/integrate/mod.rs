@@ -42,7 +42,7 @@ mod symplectic_euler;
 #[cfg(test)]
 mod tests;
 
-use crate::math::Real;
+use crate::math::{Real, Vec3};
 use std::fmt;
 use std::str::FromStr;
 
@@ -58,7 +58,10 @@ use implicit_gyroscopic::implicit_gyroscopic;
 use lclamp::lclamp;
 use rk4::rk4_free_flow;
 pub use simd::{KERNEL_ENV, KernelError, KernelPath, kernel_path};
-use splitting::{Rotation, drift_kick_drift, rotate_freely, rotate_symmetric, strang_free_flow};
+use splitting::{
+    Rotation, drift_kick_drift, drift_kick_drift_translation, rotate_freely, rotate_symmetric,
+    strang_free_flow,
+};
 use symplectic_euler::{symplectic_euler, symplectic_euler_linear};
 
 /// A time-integration method, selectable per world.
@@ -252,9 +255,20 @@ impl Integrator {
     /// A whole step of `dt` under a constant `wrench`: the stages of
     /// [`composition`](Self::composition), each a [`whole_stage`](Self::whole_stage) of span
     /// `c dt`. The caller checks the result (see [`try_step`](Self::try_step)).
+    ///
+    /// Without torque a composed step's translation and rotation do not interact: under the
+    /// constant force every drift–kick–drift translation is exact, so the stages' translations
+    /// are one over `dt`, and their free rotations are composed in `f64` and rounded once (the
+    /// ECS takes this path for bodies without a `ForceAccumulator`).
     #[inline]
     pub fn step(self, state: &mut BodyState, mass: &MassProperties, wrench: &Wrench, dt: Real) {
-        for &c in self.composition() {
+        let weights = self.composition();
+        if weights.len() > 1 && wrench.torque == Vec3::ZERO {
+            drift_kick_drift_translation(StepPhase::Whole, state, mass, wrench, dt);
+            stages::rotate_composed(state, mass, weights, dt);
+            return;
+        }
+        for &c in weights {
             self.whole_stage(state, mass, wrench, c * dt);
         }
     }
