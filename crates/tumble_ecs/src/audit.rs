@@ -75,7 +75,7 @@
 use bevy_ecs::entity::EntityHashMap;
 use bevy_ecs::prelude::*;
 use std::collections::HashMap;
-use tumble_core::math::{Real, Vec3, Widen};
+use tumble_core::math::{Quat, Real, Vec3, Widen};
 
 use crate::components::{
     ForceAccumulator, Gravity, GravityScale, Kinematic, MassProps, PhysicsSettings, RigidBody,
@@ -428,7 +428,14 @@ pub fn audit_external_loads(
     settings: Res<PhysicsSettings>,
     cursor: Res<StageCursor>,
     mut ledger: ResMut<EnergyLedger>,
-    accumulators: Query<(Entity, &ForceAccumulator), Dynamic>,
+    accumulators: Query<
+        (
+            Entity,
+            &ForceAccumulator,
+            Option<&crate::stiff::ImplicitBody>,
+        ),
+        Dynamic,
+    >,
     states: Query<(&Transform, &MassProps), Dynamic>,
 ) {
     let ledger = &mut *ledger;
@@ -440,17 +447,26 @@ pub fn audit_external_loads(
     } else {
         Some(span.h / settings.dt())
     };
-    for (entity, acc) in &accumulators {
+    for (entity, acc, implicit) in &accumulators {
         if let Some(&i) = ledger.index.get(&entity) {
+            // The torque of the forces at points an implicit body's solve takes at mid-step,
+            // credited here at the pose the forces were sampled at.
+            let torque = acc.torque
+                + implicit.map_or(Vec3::ZERO, |b| {
+                    let rotation = states
+                        .get(entity)
+                        .map_or(Quat::IDENTITY, |(t, _)| t.rotation);
+                    b.point_torque(rotation)
+                });
             let load = &mut ledger.bodies[i].load;
             match share {
-                None => *load = (acc.force, acc.torque),
+                None => *load = (acc.force, torque),
                 Some(w) => {
                     if span.opens_step {
                         *load = (Vec3::ZERO, Vec3::ZERO);
                     }
                     load.0 += w * acc.force;
-                    load.1 += w * acc.torque;
+                    load.1 += w * torque;
                 }
             }
         }

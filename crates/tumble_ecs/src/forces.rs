@@ -11,6 +11,7 @@ use tumble_core::math::{Real, Vec3, Widen};
 use crate::components::{
     ForceAccumulator, Gravity, GravityScale, MassProps, RigidBody, Transform, Velocity,
 };
+use crate::stiff::ImplicitBody;
 use crate::validate::Rejected;
 
 /// A constant world-frame force on `body`, through a body-local point (or the centre of mass).
@@ -148,15 +149,27 @@ pub fn apply_gravity(
     }
 }
 
-/// Applies every [`ConstantForce`].
-pub fn apply_constant_forces(generators: Query<&ConstantForce>, mut bodies: ForceTargets) {
+/// Applies every [`ConstantForce`]: its force, and the torque of a force at a body point about
+/// the centre of mass (for a body of an implicit spring group, the point goes to the implicit
+/// solve instead, which takes that torque at mid-step: see [`ImplicitBody`]).
+pub fn apply_constant_forces(
+    generators: Query<&ConstantForce>,
+    mut bodies: ForceTargets,
+    mut implicit: Query<&mut ImplicitBody>,
+) {
     for gen_force in &generators {
         let Ok((transform, _, mass, mut acc)) = bodies.get_mut(gen_force.body) else {
             continue;
         };
-        match gen_force.local_point {
-            None => acc.add_force(gen_force.force),
-            Some(local) => acc.add_force_at_point(
+        match (gen_force.local_point, implicit.get_mut(gen_force.body)) {
+            (None, _) => acc.add_force(gen_force.force),
+            // The implicit step takes the torque of a force at a point at mid-step (it turns
+            // with the body): the force goes to the accumulator, its point to the solve.
+            (Some(local), Ok(mut implicit)) => {
+                acc.add_force(gen_force.force);
+                implicit.add_point_force(local - mass.local_center_of_mass(), gen_force.force);
+            }
+            (Some(local), Err(_)) => acc.add_force_at_point(
                 gen_force.force,
                 transform.transform_point(local),
                 transform.center_of_mass(mass),

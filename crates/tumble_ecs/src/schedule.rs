@@ -306,56 +306,33 @@ impl PhysicsPlan {
                 .copied()
                 .unwrap_or_default()
                 .applies(c.springs);
-        let mut stages = ArrayVec::new();
-        if staged && (c.dynamic_with_accumulator || c.implicit_bodies) {
-            stages.push(Stage::HoldGameLoads);
-        }
-        if audit {
-            stages.push(Stage::AuditEnergyStart);
-        }
-        if c.damped_springs {
-            stages.push(Stage::DampSpringsStart);
-        }
-        if midpoint && c.dynamic_with_accumulator {
-            stages.push(Stage::BeginStage);
-        }
-        if world.contains_resource::<Gravity>() && (c.dynamic_with_accumulator || c.implicit_bodies)
-        {
-            stages.push(Stage::Gravity);
-        }
-        if c.constant_forces {
-            stages.push(Stage::ConstantForces);
-        }
-        if c.constant_torques {
-            stages.push(Stage::ConstantTorques);
-        }
-        if c.explicit_springs {
-            stages.push(Stage::Springs);
-        }
-        if audit && (c.dynamic_with_accumulator || c.implicit_bodies) {
-            stages.push(Stage::AuditExternalLoads);
-        }
-        if c.implicit_bodies {
-            stages.push(Stage::SolveImplicitSprings);
-        }
-        if c.dynamic_with_accumulator {
-            stages.push(Stage::IntegrateWithForces);
-        }
-        if c.dynamic_without_accumulator {
-            stages.push(Stage::IntegrateWithoutForces);
-        }
-        if c.fixed_with_accumulator {
-            stages.push(Stage::DiscardFixedBodyForces);
-        }
-        if c.damped_springs {
-            stages.push(Stage::DampSpringsEnd);
-        }
-        if audit {
-            stages.push(Stage::AuditEnergy);
-        }
-        if staged {
-            stages.push(Stage::NextStage);
-        }
+        // Whether each stage is needed, in the order a step runs them (`Stage::ALL`'s).
+        let loaded = c.dynamic_with_accumulator || c.implicit_bodies;
+        let needed = [
+            (Stage::HoldGameLoads, staged && loaded),
+            (Stage::AuditEnergyStart, audit),
+            (Stage::DampSpringsStart, c.damped_springs),
+            (Stage::BeginStage, midpoint && c.dynamic_with_accumulator),
+            (
+                Stage::Gravity,
+                world.contains_resource::<Gravity>() && loaded,
+            ),
+            (Stage::ConstantForces, c.constant_forces),
+            (Stage::ConstantTorques, c.constant_torques),
+            (Stage::Springs, c.explicit_springs),
+            (Stage::AuditExternalLoads, audit && loaded),
+            (Stage::SolveImplicitSprings, c.implicit_bodies),
+            (Stage::IntegrateWithForces, c.dynamic_with_accumulator),
+            (Stage::IntegrateWithoutForces, c.dynamic_without_accumulator),
+            (Stage::DiscardFixedBodyForces, c.fixed_with_accumulator),
+            (Stage::DampSpringsEnd, c.damped_springs),
+            (Stage::AuditEnergy, audit),
+            (Stage::NextStage, staged),
+        ];
+        let stages = needed
+            .into_iter()
+            .filter_map(|(stage, needed)| needed.then_some(stage))
+            .collect();
         Self {
             stages,
             runs_per_step,

@@ -30,18 +30,19 @@
 
 use bevy_ecs::entity::EntityHashMap;
 use bevy_ecs::prelude::*;
-use tumble_core::math::Real;
+use glam::{DMat3, DVec3};
+use tumble_core::math::{Narrow, Real, Vec3, Widen};
 use tumble_core::springs::{
     GroupBody, GroupSpring, IMPLICIT_OMEGA_DT, ImplicitSpringSolver, LinkEnd,
     inverse_effective_mass_bound, omega_dt_bound,
 };
 
 use crate::components::{
-    Damping, ForceAccumulator, MassProps, PhysicsSettings, RigidBody, Transform, Velocity,
-    body_state, write_body_state,
+    ForceAccumulator, MassProps, PhysicsSettings, RigidBody, Transform, body_state,
+    write_body_state,
 };
 use crate::forces::{Spring, SpringEnd};
-use crate::systems::Dynamic;
+use crate::systems::{Dynamic, Stepped};
 use crate::table::damp;
 use crate::validate::{BodyError, BodyErrorKind, reject};
 
@@ -102,8 +103,46 @@ impl std::str::FromStr for SpringSolver {
 pub struct ImplicitSpring;
 
 /// Marks a body of a spring group stepped by the implicit step.
-#[derive(Component, Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub struct ImplicitBody;
+#[derive(Component, Debug, Clone, Copy, PartialEq)]
+pub struct ImplicitBody {
+    /// The moment `P = Σ aᵢ Fᵢᵀ` of the [`ConstantForce`](crate::forces::ConstantForce)s at body
+    /// points this stage (`aᵢ` the arm from the centre of mass in the body frame, `Fᵢ` the world
+    /// force): their forces are in the accumulator, their torque is taken at mid-step inside the
+    /// implicit solve (see [`GroupBody::load_moment`]), which consumes it.
+    load_moment: DMat3,
+}
+
+impl Default for ImplicitBody {
+    /// No point forces recorded. (Not derived: `DMat3::default()` is the identity.)
+    fn default() -> Self {
+        Self {
+            load_moment: DMat3::ZERO,
+        }
+    }
+}
+
+impl ImplicitBody {
+    /// Records a force `force` (world) at the arm `arm` (body frame, from the centre of mass).
+    pub(crate) fn add_point_force(&mut self, arm: Vec3, force: Vec3) {
+        self.load_moment += outer(arm.widen(), force.widen());
+    }
+
+    /// The torque `Σ (R aᵢ) × Fᵢ` of the recorded point forces with the body at `rotation`.
+    pub(crate) fn point_torque(&self, rotation: tumble_core::math::Quat) -> Vec3 {
+        let x = DMat3::from_quat(rotation.widen()) * self.load_moment;
+        DVec3::new(
+            x.z_axis.y - x.y_axis.z,
+            x.x_axis.z - x.z_axis.x,
+            x.y_axis.x - x.x_axis.y,
+        )
+        .narrow()
+    }
+}
+
+/// `a bᵀ`.
+fn outer(a: DVec3, b: DVec3) -> DMat3 {
+    DMat3::from_cols(a * b.x, a * b.y, a * b.z)
+}
 
 /// What the classification was made for; a change re-classifies.
 #[derive(Resource, Debug, Clone, Copy, PartialEq)]
@@ -273,7 +312,7 @@ pub fn classify_springs(world: &mut World) {
         let stiff = index.get(&entity).is_some_and(|&i| implicit_body[i]);
         let has = world.get::<ImplicitBody>(entity).is_some();
         if stiff && !has {
-            world.entity_mut(entity).insert(ImplicitBody);
+            world.entity_mut(entity).insert(ImplicitBody::default());
         } else if !stiff && has {
             world.entity_mut(entity).remove::<ImplicitBody>();
         }
@@ -325,14 +364,7 @@ pub fn solve_implicit_springs(
     mut commands: Commands,
     springs: Query<&Spring, With<ImplicitSpring>>,
     mut bodies: Query<
-        (
-            Entity,
-            &mut Transform,
-            &mut Velocity,
-            &MassProps,
-            &mut ForceAccumulator,
-            Option<&Damping>,
-        ),
+        (Stepped<&mut ForceAccumulator>, &mut ImplicitBody),
         (Dynamic, With<ImplicitBody>),
     >,
     others: Query<&Transform, (With<RigidBody>, Without<ImplicitBody>)>,
@@ -345,7 +377,7 @@ pub fn solve_implicit_springs(
     let span = cursor.span(&settings);
     let dt = span.h;
     let half_substep = 0.5 * span.substep;
-    for (entity, t, mut v, m, mut acc, damping) in &mut bodies {
+    for ((entity, t, mut v, m, mut acc, damping), mut implicit) in &mut bodies {
         // `Damping` is a flow of its own, half a substep before the substep and half after (see
         // `tumble_core::damping`), as on the explicit path.
         if let Some(d) = damping
@@ -361,6 +393,7 @@ pub fn solve_implicit_springs(
             state: body_state(&t, &v, m),
             mass: m.0,
             load: acc.take(),
+            load_moment: std::mem::replace(&mut implicit.load_moment, DMat3::ZERO),
         });
     }
     for spring in &springs {
@@ -470,7 +503,8 @@ pub fn solve_implicit_springs(
                     "implicit spring group stepped"
                 );
                 for (k, &i) in s.members[members].iter().enumerate() {
-                    if let Ok((_, mut t, mut v, m, _, damping)) = bodies.get_mut(s.entities[i]) {
+                    if let Ok(((_, mut t, mut v, m, _, damping), _)) = bodies.get_mut(s.entities[i])
+                    {
                         write_body_state(&s.bodies[k].state, m, &mut t, &mut v);
                         if let Some(d) = damping
                             && span.closes_substep

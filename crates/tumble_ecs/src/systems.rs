@@ -33,6 +33,17 @@ pub type Dynamic = (
     Without<Kinematic>,
 );
 
+/// What an integrate system reads and writes of a body: its pose, velocity, mass, its load
+/// component `L` and its damping.
+pub(crate) type Stepped<L> = (
+    Entity,
+    &'static mut Transform,
+    &'static mut Velocity,
+    &'static MassProps,
+    L,
+    Option<&'static Damping>,
+);
+
 /// Zeroes the accumulators of [`Static`] and [`Kinematic`] bodies (springs may push on them;
 /// they are never integrated, so the forces are discarded rather than left to pile up). In the
 /// schedule only when such a body has an accumulator.
@@ -67,17 +78,7 @@ pub fn begin_stage(
     parallelism: Option<Res<Parallelism>>,
     mut drifted: ResMut<HalfDrifted>,
     mut commands: Commands,
-    mut bodies: Query<
-        (
-            Entity,
-            &mut Transform,
-            &mut Velocity,
-            &MassProps,
-            &ForceAccumulator,
-            Option<&Damping>,
-        ),
-        (Dynamic, Without<ImplicitBody>),
-    >,
+    mut bodies: Query<Stepped<&ForceAccumulator>, (Dynamic, Without<ImplicitBody>)>,
 ) {
     if !settings.integrator.samples_forces_at_midpoint() {
         return;
@@ -114,17 +115,7 @@ pub fn integrate_with_forces(
     mut drifted: ResMut<HalfDrifted>,
     mut warned: Local<bool>,
     mut commands: Commands,
-    mut bodies: Query<
-        (
-            Entity,
-            &mut Transform,
-            &mut Velocity,
-            &MassProps,
-            &mut ForceAccumulator,
-            Option<&Damping>,
-        ),
-        (Dynamic, Without<ImplicitBody>),
-    >,
+    mut bodies: Query<Stepped<&mut ForceAccumulator>, (Dynamic, Without<ImplicitBody>)>,
 ) {
     let phase = if drifted.0 {
         StepPhase::Finish
@@ -169,17 +160,7 @@ pub fn integrate_without_forces(
     parallelism: Option<Res<Parallelism>>,
     gravity: Option<Res<Gravity>>,
     mut commands: Commands,
-    mut bodies: Query<
-        (
-            Entity,
-            &mut Transform,
-            &mut Velocity,
-            &MassProps,
-            Option<&GravityScale>,
-            Option<&Damping>,
-        ),
-        (Dynamic, Without<ForceAccumulator>),
-    >,
+    mut bodies: Query<Stepped<Option<&GravityScale>>, (Dynamic, Without<ForceAccumulator>)>,
 ) {
     let gravity = gravity.map(|g| g.0);
     let Some(stage) = StageTiming::free_motion(&settings, *cursor) else {

@@ -33,7 +33,11 @@
 //! `h v̄·F̄ + h Ω̄·T = F̄·(h v̄ + Q₀(h Ω̄ × b)) = F̄·Δp`, the anchor's exact displacement, and summed over both ends
 //! `F̄·Δd = −k (ℓ̄ − L₀)/ℓ̄ · (ℓ₁² − ℓ₀²)/2 = −ΔV`. Kinetic plus elastic energy is therefore
 //! conserved exactly, for any stiffness and step, up to the solver's tolerance; a constant force
-//! through the centre of mass does exactly its work `h v̄·F`. Linear momentum is conserved too (the
+//! through the centre of mass does exactly its work `h v̄·F`, and a constant world force at a
+//! body point ([`GroupBody::load_moment`]), whose torque is taken like a spring end's (arm
+//! `b_m`, force in the mid-step frame), exactly its work `F·Δp` (its torque taken in the start
+//! frame would be first order; the point's torque is left out of the Newton matrix, which only
+//! slows convergence where such loads rival the springs). Linear momentum is conserved too (the
 //! pair forces cancel). The scheme is symmetric (swapping the ends of the step and `h → −h`
 //! maps it to itself), hence second order. On a linear spring it is the implicit midpoint rule:
 //! unit amplification and the phase `2 atan(ωh/2)` per step, so a spring far too stiff for the
@@ -77,6 +81,13 @@ pub struct GroupBody {
     /// Force (through the centre of mass) and torque (world frame) held constant over the step:
     /// gravity, constant forces and whatever game code added.
     pub load: Wrench,
+    /// Forces of `load.force` that act at body points rather than through the centre of mass,
+    /// as their moment `P = Σ aᵢ Fᵢᵀ` (`aᵢ` the point's arm from the centre of mass in the body
+    /// frame, `Fᵢ` the world force; in `f64`, zero for none). Their torque `Σ (R aᵢ) × Fᵢ` turns with the
+    /// body, so the solve takes it at mid-step like a spring end's (see the module docs): it
+    /// does exactly the work `Fᵢ·Δpᵢ` and keeps the step symmetric. `load.torque` must not
+    /// contain it.
+    pub load_moment: DMat3,
 }
 
 /// The second end of a [`GroupSpring`].
@@ -181,6 +192,8 @@ struct Start {
     free: DVec3,
     force: DVec3,
     torque: DVec3,
+    /// `P` of [`GroupBody::load_moment`] with the arms in the principal frame.
+    moment: DMat3,
     /// Inertia scale of the locked-axis rows (keeps the block well conditioned).
     lock_scale: f64,
 }
@@ -331,6 +344,26 @@ fn cayley(w: DVec3) -> DQuat {
 }
 
 /// `√c` for a unit quaternion with `w > −1` (always, for a Cayley rotation): `c + 1`
+/// The mid-step torque (principal frame) of the forces a body feels at its points, from their
+/// moment `P = Σ aᵢ Fᵢᵀ` (arms in the principal frame): `Σ ((S aᵢ + Sᵀ aᵢ)/2) × (Mᵀ Fᵢ)` with
+/// `M = Q₀ S` the mid-step frame, i.e. the axial vector of `X = A P M` with `A = (S + Sᵀ)/2`,
+/// `Tₖ = εₖₐᵦ Xₐᵦ`.
+fn point_torque(s: &Start, half: DQuat) -> DVec3 {
+    if s.moment == DMat3::ZERO {
+        return DVec3::ZERO;
+    }
+    let turn = DMat3::from_quat(half);
+    let arm = 0.5 * (turn + turn.transpose());
+    let mid = s.r * turn;
+    let x = arm * s.moment * mid;
+    s.free
+        * DVec3::new(
+            x.z_axis.y - x.y_axis.z,
+            x.x_axis.z - x.z_axis.x,
+            x.y_axis.x - x.x_axis.y,
+        )
+}
+
 /// normalized, half the angle about the same axis, without trigonometry.
 #[inline]
 fn half_rotation(c: DQuat) -> DQuat {
@@ -614,6 +647,7 @@ impl ImplicitSpringSolver {
                 free,
                 force: body.load.force.widen(),
                 torque: body.load.torque.widen(),
+                moment: DMat3::from_quat(m.principal_frame().widen().inverse()) * body.load_moment,
                 lock_scale: inertia.max_element(),
             });
         }
@@ -753,8 +787,10 @@ impl ImplicitSpringSolver {
                 .push(DMat3::IDENTITY + (u + u * u) * (1.0 / (1.0 + uu)));
             let r = &mut self.residual[6 * i..6 * i + 6];
             put(&mut r[..3], s.mass * (vbar - s.v) - 0.5 * h * s.force);
-            // External torque in the principal frame at mid-step (symmetric in the two ends).
-            let torque = (s.q * half).inverse() * s.torque;
+            // External torque in the principal frame at mid-step (symmetric in the two ends),
+            // with the forces at body points taken like spring ends: arm (S a + Sᵀ a)/2 across
+            // the mid-step force.
+            let torque = (s.q * half).inverse() * s.torque + point_torque(s, half);
             let iw = s.inertia * wbar;
             let rot = iw - s.pi + 0.5 * h * wbar.cross(iw) - 0.5 * h * torque;
             // A locked axis has no equation of motion: its row pins Ω̄ to 0.
@@ -1269,6 +1305,7 @@ mod jacobian_tests {
             },
             mass: MassProperties::new(Mass::new(m).unwrap(), Vec3::new(0.02, 0.03, 0.04)).unwrap(),
             load,
+            load_moment: DMat3::ZERO,
         }
     }
 
