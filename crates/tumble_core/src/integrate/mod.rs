@@ -36,7 +36,7 @@ mod rk4;
 mod simd;
 mod splitting;
 mod stages;
-pub use stages::{StageSpan, Stages, TRIPLE_JUMP_LIMIT};
+pub use stages::{StageSpan, Stages, TRIPLE_JUMP_LIMIT, TRIPLE_JUMP_SWING_MATCH};
 mod symmetric_kernel;
 mod symplectic_euler;
 #[cfg(test)]

@@ -145,14 +145,35 @@ impl Stages {
     /// stage; for the triple jump, whose substep is stable for `ωh <` [`TRIPLE_JUMP_LIMIT`]
     /// (against 2 for one plain step), `(2 / 1.5734) Δt/N ≈ 1.271 Δt/N`.
     pub fn stability_span(&self, dt: Real) -> Real {
+        self.equivalent_span(dt, 2.0 / TRIPLE_JUMP_LIMIT)
+    }
+
+    /// The span of one plain drift–kick–drift step whose explicit spring step is as accurate,
+    /// at the explicit step's accuracy limit (an energy swing of 2.3 % on a linear spring, `ωh`
+    /// = 0.3 for a plain step), as one substep of this step: `Δt/N` for a method of one stage;
+    /// for the triple jump, which swings that much only at `ωh =` [`TRIPLE_JUMP_SWING_MATCH`],
+    /// `(0.3 / 0.68) Δt/N ≈ 0.44 Δt/N`. What the choice between the explicit and the implicit
+    /// spring step is judged on.
+    pub fn accuracy_span(&self, dt: Real) -> Real {
+        self.equivalent_span(dt, 0.3 / TRIPLE_JUMP_SWING_MATCH)
+    }
+
+    /// `Δt/N`, times `composed` for a composition.
+    fn equivalent_span(&self, dt: Real, composed: Real) -> Real {
         let substep = dt / self.substeps.get() as Real;
         if self.weights.len() == 1 {
             substep
         } else {
-            substep * (2.0 / TRIPLE_JUMP_LIMIT)
+            substep * composed
         }
     }
 }
+
+/// The `ωh` per substep at which one triple-jump substep swings a linear spring's energy as
+/// much as one plain drift–kick–drift step does at `ωh = 0.3` (by 2.3 % of it; the explicit
+/// spring step's accuracy limit, `tumble_core::springs::IMPLICIT_OMEGA_DT`), found numerically
+/// like [`TRIPLE_JUMP_LIMIT`]; a test measures both swings.
+pub const TRIPLE_JUMP_SWING_MATCH: Real = 0.68;
 
 /// The largest `ωh` at which one triple-jump substep `S(c₁h) S(c₀h) S(c₁h)` of drift–kick–drift
 /// steps keeps a linear spring `ẍ = −ω²x` bounded: the trace of its 2×2 map reaches ±2 there
@@ -194,6 +215,39 @@ mod tests {
         assert!(below < 50.0, "bounded below the limit: {below}");
         let above = largest_swing(1.001 * TRIPLE_JUMP_LIMIT, 10_000);
         assert!(above > 1e6, "grows above the limit: {above}");
+    }
+
+    /// Largest over smallest energy of `ẍ = −x` from `x = 1` under `integrator` at `ωh = h`.
+    fn energy_swing(integrator: Integrator, h: Real) -> f64 {
+        let mass = MassProperties::new(Mass::new(1.0).unwrap(), Vec3::ONE).unwrap();
+        let mut state = BodyState {
+            position: Vec3::X,
+            ..BodyState::default()
+        };
+        let (mut low, mut high) = (f64::INFINITY, 0.0_f64);
+        for _ in 0..2000 {
+            integrator.step_with(&mut state, &mass, h, |s| Wrench {
+                force: -s.position,
+                torque: Vec3::ZERO,
+            });
+            let e =
+                (state.position.length_squared() + state.linear_velocity.length_squared()).widen();
+            (low, high) = (low.min(e), high.max(e));
+        }
+        high / low - 1.0
+    }
+
+    /// The triple jump at ωh = 0.68 swings a spring's energy as much as one plain step at 0.3
+    /// (2.3 %), within a tenth of it.
+    #[test]
+    fn the_swing_match_is_where_the_swings_match() {
+        let plain = energy_swing(Integrator::Splitting, 0.3);
+        let composed = energy_swing(Integrator::Yoshida4, TRIPLE_JUMP_SWING_MATCH);
+        assert!((plain - 0.023).abs() < 0.002, "plain: {plain}");
+        assert!(
+            (composed / plain - 1.0).abs() < 0.1,
+            "{composed} vs {plain}"
+        );
     }
 
     #[test]
