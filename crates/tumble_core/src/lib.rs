@@ -13,6 +13,7 @@
 //! - A zero principal moment locks that axis (its inverse is 0), never NaN.
 
 pub mod damping;
+pub mod elliptic;
 pub mod error;
 pub mod exact;
 pub mod integrate;

@@ -7,16 +7,16 @@
 //!   critically and over-damped, `x = e^{−γt}(x₀ C(t) + (v₀ + γx₀) S(t))`, `γ = c/(2m)`;
 //! - [`TorqueFreeTop`]: the torque-free rigid body through Jacobi elliptic functions (Landau &
 //!   Lifshitz, *Mechanics*, §37), with the symmetric top and steady spins in closed form;
-//! - [`elliptic`]: the Jacobi functions `sn, cn, dn` and the integrals `K(m)`, `F(φ | m)` it
-//!   rests on (descending Landen / AGM, Carlson's `R_F`).
+//! - [`elliptic`] (re-exported from the crate root, where the exact free flow uses it): the
+//!   Jacobi functions `sn, cn, dn` and the integrals `K(m)`, `F(φ | m)` it rests on.
 
-pub mod elliptic;
 pub mod linear;
 pub mod top;
 
 use thiserror::Error;
 
-pub use elliptic::{complete_k, incomplete_f, jacobi_amplitude, jacobi_sn_cn_dn};
+pub use crate::elliptic;
+pub use crate::elliptic::{complete_k, incomplete_f, jacobi_amplitude, jacobi_sn_cn_dn};
 pub use linear::{
     DampedSpring, DampingRegime, HarmonicSpring, damped_spring, harmonic_spring, projectile,
 };

@@ -26,8 +26,10 @@
 //! | `splitting-xyz` | Lie–Poisson Strang 1-2-3-2-1 | 2 | 2 | round-off | bounded (poorly for rods) |
 //! | `yoshida4` | triple jump of `splitting`'s whole step | 4 | 4 | round-off | bounded |
 //! | `rk4` | RK4 on `Q̇ = ½ ω(Q) Q` at constant `L` | 4 | 2 | exact | slow drift |
+//! | `exact` | exact torque-free flow (Jacobi elliptic functions, Carlson `R_J`) | exact | 2 | round-off | round-off torque-free |
 
 mod batch;
+mod exact_flow;
 pub use batch::{BodyBatch, StepPhase};
 mod frame;
 mod implicit_gyroscopic;
@@ -53,6 +55,7 @@ use crate::state::{BodyState, Wrench};
 
 // The public surface is the `Integrator` enum, the batch interface, the kernel path and the two
 // frame rotations the tests and reports measure with; each method's functions are internal.
+use exact_flow::exact_free_flow;
 pub use frame::{rotate, rotate_inv};
 use implicit_gyroscopic::implicit_gyroscopic;
 use lclamp::lclamp;
@@ -96,6 +99,12 @@ pub enum Integrator {
     /// order torque-free only; with any load the step is second order (the forces are sampled
     /// once per step, at its midpoint: it is not an RK4 of the whole motion).
     Rk4,
+    /// Drift–kick–drift with the *exact* torque-free rotation as its free flow (Jacobi's
+    /// elliptic functions for the body momentum, an elliptic integral of the third kind for the
+    /// attitude; see `exact_flow`): torque-free bodies of any inertia are exact to round-off at
+    /// any `Δt` and any spin rate, thin asymmetric bodies included; with loads it is second
+    /// order, like `splitting`, whose step it shares.
+    Exact,
 }
 
 impl Integrator {
@@ -109,6 +118,7 @@ impl Integrator {
         Integrator::SplittingXyz,
         Integrator::Yoshida4,
         Integrator::Rk4,
+        Integrator::Exact,
     ];
 
     /// The kebab-case name used in scene files and on the command line.
@@ -122,13 +132,17 @@ impl Integrator {
             Integrator::SplittingXyz => "splitting-xyz",
             Integrator::Yoshida4 => "yoshida4",
             Integrator::Rk4 => "rk4",
+            Integrator::Exact => "exact",
         }
     }
 
     /// Nominal order of accuracy of the torque-free rotational motion (with loads: 4 for
-    /// `yoshida4`, at most 2 for the others).
+    /// `yoshida4`, at most 2 for the others). `exact` is exact torque-free (see
+    /// [`is_exact_torque_free`](Self::is_exact_torque_free)); its order here is the one it has
+    /// with loads, 2.
     pub fn order(self) -> u32 {
         match self {
+            Integrator::Exact => 2,
             Integrator::SymplecticEuler
             | Integrator::SymplecticEulerLinear
             | Integrator::Lclamp
@@ -136,6 +150,11 @@ impl Integrator {
             Integrator::Splitting | Integrator::SplittingXyz => 2,
             Integrator::Yoshida4 | Integrator::Rk4 => 4,
         }
+    }
+
+    /// True when the torque-free motion is exact to round-off at any step (`exact`).
+    pub fn is_exact_torque_free(self) -> bool {
+        self == Integrator::Exact
     }
 
     /// True when the method drifts half a stage before forces are sampled (see
@@ -170,6 +189,7 @@ impl Integrator {
     fn free_rotation(self) -> Rotation {
         match self {
             Integrator::Rk4 => |s, m, h| rotate_freely(s, m, h, rk4_free_flow),
+            Integrator::Exact => |s, m, h| rotate_freely(s, m, h, exact_free_flow),
             Integrator::SplittingXyz => |s, m, h| rotate_freely(s, m, h, strang_free_flow),
             _ => rotate_symmetric,
         }
@@ -204,7 +224,8 @@ impl Integrator {
             Integrator::Splitting
             | Integrator::SplittingXyz
             | Integrator::Yoshida4
-            | Integrator::Rk4 => {
+            | Integrator::Rk4
+            | Integrator::Exact => {
                 let rotation = self.free_rotation();
                 drift_kick_drift(StepPhase::Finish, state, mass, wrench, h, rotation);
             }

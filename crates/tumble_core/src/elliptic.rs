@@ -17,6 +17,10 @@
 //! `*_complement` variants therefore take `m` and `m₁` separately, so a caller that knows `m₁`
 //! to full relative accuracy (the torque-free top near its separatrix does) keeps it.
 
+mod carlson;
+
+pub use carlson::{carlson_rc1, carlson_rf, carlson_rj, integral_sn2_over};
+
 use std::f64::consts::{FRAC_PI_2, PI};
 
 /// Most AGM/Landen levels ever needed: with `m₁` as small as the least positive f64 the scale
@@ -149,30 +153,6 @@ pub fn complete_k_complement(m1: f64) -> f64 {
         return f64::INFINITY;
     }
     PI / (2.0 * agm(1.0, m1.sqrt()))
-}
-
-/// Carlson's symmetric integral `R_F(x, y, z) = ½ ∫₀^∞ dt / √((t+x)(t+y)(t+z))` for `x, y, z ≥ 0`
-/// with at most one of them zero, by the duplication theorem and the fifth-order Taylor series
-/// (Carlson 1995, Numer. Algorithms 10, 13–26).
-fn carlson_rf(mut x: f64, mut y: f64, mut z: f64) -> f64 {
-    for _ in 0..200 {
-        let mean = (x + y + z) / 3.0;
-        let (dx, dy, dz) = (1.0 - x / mean, 1.0 - y / mean, 1.0 - z / mean);
-        if dx.abs().max(dy.abs()).max(dz.abs()) < 1e-3 {
-            // Relative truncation error of the series is below δ⁶/(4(1 − δ)) ≈ 3e-19 for
-            // δ < 1e-3 (Carlson 1995, eq. 2.2).
-            let e2 = dx * dy - dz * dz;
-            let e3 = dx * dy * dz;
-            return (1.0 - e2 / 10.0 + e3 / 14.0 + e2 * e2 / 24.0 - 3.0 * e2 * e3 / 44.0)
-                / mean.sqrt();
-        }
-        let (sx, sy, sz) = (x.sqrt(), y.sqrt(), z.sqrt());
-        let lambda = sx * (sy + sz) + sy * sz;
-        x = 0.25 * (x + lambda);
-        y = 0.25 * (y + lambda);
-        z = 0.25 * (z + lambda);
-    }
-    1.0 / ((x + y + z) / 3.0).sqrt()
 }
 
 /// Incomplete elliptic integral of the first kind `F(φ | m) = ∫₀^φ dθ/√(1 − m sin²θ)` for every

@@ -1,0 +1,298 @@
+//! The exact torque-free rotation of a rigid body over any span: the free rotation of the
+//! `exact` integrator.
+//!
+//! **Body momentum** (Jacobi; Landau & Lifshitz §37), in reciprocal moments so that nothing
+//! divides by a moment. Sort the principal axes so that `r₁ ≥ r₂ ≥ r₃ > 0` (`rᵢ = 1/Iᵢ`; one axis
+//! is negated when the sort is an odd permutation, so the frame stays right-handed), write
+//! `m` for the body momentum, `2E = Σ rᵢmᵢ²`, `M² = Σ mᵢ²`, `dᵢⱼ = rᵢ − rⱼ ≥ 0`, and form the
+//! three invariants without cancellation:
+//!
+//! ```text
+//! P = 2E − r₃M² = d₁₃m₁² + d₂₃m₂²,   R = r₁M² − 2E = d₁₂m₂² + d₁₃m₃²,   D = 2E − r₂M² = d₁₂m₁² − d₂₃m₃².
+//! ```
+//!
+//! Euler's equations `ṁ = m × (r ∘ m)` are solved with `τ = λt + τ₀` by
+//!
+//! ```text
+//! D ≤ 0 (circles axis 3): m = (a₁ cn τ, a₂ sn τ, a₃ dn τ),  λ² = R d₂₃,  m = P d₁₂ / (R d₂₃),
+//!                          a₁² = P/d₁₃, a₂² = P/d₂₃, a₃² = R/d₁₃,  1 − m = d₁₃(−D)/(R d₂₃);
+//! D > 0 (circles axis 1): m = (a₁ dn τ, a₂ sn τ, a₃ cn τ),  λ² = P d₁₂,  m = R d₂₃ / (P d₁₂),
+//!                          a₁² = P/d₁₃, a₂² = R/d₁₂, a₃² = R/d₁₃,  1 − m = d₁₃ D/(P d₁₂),
+//! ```
+//!
+//! (substitute into `ṁ₁ = d₂₃·(−m₂m₃)`, `ṁ₂ = d₁₃ m₃m₁`, `ṁ₃ = −d₁₂ m₁m₂` and compare
+//! coefficients). The coefficient of `cn` takes the sign of its initial momentum, so `cn τ₀ ≥ 0`
+//! and `τ₀ = F(φ₀ | m)` on the principal branch, with `(sin φ₀, cos φ₀) = (sn τ₀, cn τ₀)` read
+//! off the momentum directly; `dn`'s takes the sign of its own (it never changes sign), and
+//! `sign a₂ = sign a₁ · sign a₃` makes time run forward for `λ > 0`. `D = 0` is the separatrix
+//! (`m = 1`: `sn = tanh`, `cn = dn = sech`). After the span `h`: `τ₁ = τ₀ + λh` is reduced by the
+//! half-period `2K(m)` to `|τ₁ − 2jK| ≤ K`, where `(sn, cn, dn)` come from the Landen
+//! transformation, and `sn, cn` change sign with `j`.
+//!
+//! **Attitude.** Take Euler angles `(φ, θ, ψ)` of the body axes `(a, b, c) = (2, 3, 1)` about
+//! the constant `L` (body → L-frame `= R_z(φ) R_x(θ) R_z(ψ)`, so `m_a = M sin θ sin ψ`,
+//! `m_b = M sin θ cos ψ`, `m_c = M cos θ`). Then `B(m) = R_x(θ) R_z(ψ)` is a function of the body
+//! momentum alone, built from `cos θ = m_c/M` and `tan ψ = m_a/m_b` without any angle, and the
+//! orientation moves as `Q(t + h) = Q(t) B(m₀)ᵀ R_z(Δφ) B(m₁)`, where (Landau & Lifshitz 37.17,
+//! with `c` the axis of *smallest* moment in both cases so the rate stays between `Mr₃` and
+//! `Mr₂`, and `m₂² + m₃²` never vanishes off a steady spin)
+//!
+//! ```text
+//! φ̇ = M (r₂m₂² + r₃m₃²)/(m₂² + m₃²) = M r₃ + M d₂₃ g,   g = m₂²/(m₂² + m₃²) = κ sn²τ/(1 + ν sn²τ),
+//! D ≤ 0: κ = P d₁₃/(R d₂₃), ν = P/R;    D > 0: κ = d₁₃/d₁₂, ν = d₂₃/d₁₂,
+//! Δφ = M r₃ h + (M d₂₃ κ/λ) ∫_{τ₀}^{τ₁} sn²/(1 + ν sn²) dτ.
+//! ```
+//!
+//! The integral is an elliptic integral of the third kind, `G(am τ)` with
+//! `G(φ) = (sin³φ/3) R_J(cos²φ, 1 − m sin²φ, 1, 1 + ν sin²φ)` on `|φ| ≤ π/2` (Carlson; every term
+//! positive, so a thin body's huge `ν` costs no digits) and `G(φ + π) = G(φ) + 2G(π/2)`:
+//! `∫ = 2jG(π/2) + G(am(τ₁ − 2jK)) − G(am τ₀)`. Every piece is closed-form, so the flow is exact
+//! to round-off for any span `h` and any spin rate.
+//!
+//! **Degenerate bodies.** A steady spin (`ṁ = 0`: `m` along a principal axis, or in the plane of
+//! two equal moments, or a spherical body) rotates about its fixed axis by `h |r ∘ m|`. Two equal
+//! moments give `m = 0` above (`sn = sin`, the symmetric top's regular precession). A locked axis
+//! (`r = 0`) holds no rotation about it: the constraint torque about that body axis cancels the
+//! gyroscopic torque, so the body rates are constant and the body turns steadily about the
+//! fixed `ω` — that is the exact motion (it is also what every splitting tends to as `h → 0`).
+
+use glam::{DQuat, DVec3};
+
+use super::splitting::FreeBody;
+use crate::elliptic::{
+    complete_k_complement, incomplete_f_sin_cos, integral_sn2_over, jacobi_sn_cn_dn_complement,
+};
+
+/// `sign(x)` as `±1`, `+1` for `+0`.
+#[inline]
+fn sign(x: f64) -> f64 {
+    if x < 0.0 { -1.0 } else { 1.0 }
+}
+
+/// The rotation by the body-frame rotation vector `v`: `exp(½ v)` as a unit quaternion.
+#[inline]
+fn exp_body(v: DVec3) -> DQuat {
+    let angle = v.length();
+    if angle == 0.0 {
+        return DQuat::IDENTITY;
+    }
+    let (s, c) = (0.5 * angle).sin_cos();
+    let axis = v * (s / angle);
+    DQuat::from_xyzw(axis.x, axis.y, axis.z, c)
+}
+
+/// Unit quaternion of the rotation by the angle with cosine `c` and sine `s` (`c² + s² = 1`)
+/// about the unit vector `axis`: half-angle values without the cancellation of `1 + c` near
+/// `c = −1` (the larger of `cos ½α = √((1 + c)/2)` and `|sin ½α| = √((1 − c)/2)` is taken from
+/// its root, the other as `s / (2 · that)`).
+#[inline]
+fn rotation_from_cos_sin(axis: DVec3, c: f64, s: f64) -> DQuat {
+    let (half_sin, half_cos) = if c >= 0.0 {
+        let half_cos = (0.5 * (1.0 + c)).sqrt();
+        (s / (2.0 * half_cos), half_cos)
+    } else {
+        let half_sin = (0.5 * (1.0 - c)).sqrt().copysign(s);
+        (half_sin, s / (2.0 * half_sin))
+    };
+    let v = axis * half_sin;
+    DQuat::from_xyzw(v.x, v.y, v.z, half_cos)
+}
+
+/// `B(μ) = R_x(θ) R_z(ψ)` for the momentum `μ = (m_a, m_b, m_c)` in the Euler frame: it maps `μ`
+/// to `|μ| ẑ`. `m_a² + m_b² > 0`.
+#[inline]
+fn to_momentum_frame(mu: DVec3, magnitude: f64) -> DQuat {
+    let rho = mu.x.hypot(mu.y);
+    let rz = rotation_from_cos_sin(DVec3::Z, mu.y / rho, mu.x / rho);
+    let rx = rotation_from_cos_sin(DVec3::X, mu.z / magnitude, rho / magnitude);
+    rx * rz
+}
+
+/// The principal axes sorted by decreasing reciprocal moment, as a right-handed frame: axis `k`
+/// of the sorted frame is `sign[k] · e_{index[k]}`.
+#[derive(Debug, Clone, Copy)]
+struct SortedAxes {
+    index: [usize; 3],
+    sign: [f64; 3],
+}
+
+impl SortedAxes {
+    fn new(r: DVec3) -> Self {
+        let mut index = [0, 1, 2];
+        index.sort_by(|&i, &j| r[j].total_cmp(&r[i]));
+        // An odd permutation of a right-handed frame is left-handed: negate the middle axis.
+        let even = matches!(index, [0, 1, 2] | [1, 2, 0] | [2, 0, 1]);
+        let sign = if even { [1.0; 3] } else { [1.0, -1.0, 1.0] };
+        Self { index, sign }
+    }
+
+    /// Principal components → sorted components.
+    fn to_sorted(self, v: DVec3) -> DVec3 {
+        DVec3::new(
+            self.sign[0] * v[self.index[0]],
+            self.sign[1] * v[self.index[1]],
+            self.sign[2] * v[self.index[2]],
+        )
+    }
+
+    /// Sorted components → principal components.
+    fn to_principal(self, v: DVec3) -> DVec3 {
+        let mut out = DVec3::ZERO;
+        for k in 0..3 {
+            out[self.index[k]] = self.sign[k] * v[k];
+        }
+        out
+    }
+}
+
+/// The elliptic motion of the body momentum in the sorted frame (see the module docs).
+#[derive(Debug, Clone, Copy)]
+struct Polhode {
+    /// `D > 0`: the momentum circles axis 1 (`m₁ ∝ dn`, `m₃ ∝ cn`).
+    about_smallest: bool,
+    /// Signed coefficients `(a₁, a₂, a₃)`.
+    coeff: DVec3,
+    lambda: f64,
+    m: f64,
+    m1: f64,
+    /// `κ` and `ν` of the phase rate `g = κ sn²/(1 + ν sn²)`.
+    kappa: f64,
+    nu: f64,
+}
+
+impl Polhode {
+    /// The motion through the sorted momentum `s` with sorted reciprocal moments `r`, not a
+    /// steady spin (`P > 0` and `R > 0`).
+    fn new(s: DVec3, r: DVec3) -> Self {
+        let (d12, d13, d23) = (r.x - r.y, r.x - r.z, r.y - r.z);
+        let (s1, s2, s3) = (s.x * s.x, s.y * s.y, s.z * s.z);
+        let p = d13 * s1 + d23 * s2;
+        let big_r = d12 * s2 + d13 * s3;
+        let d = d12 * s1 - d23 * s3;
+        let (sign1, sign3) = (sign(s.x), sign(s.z));
+        if d > 0.0 {
+            Self {
+                about_smallest: true,
+                coeff: DVec3::new(
+                    sign1 * (p / d13).sqrt(),
+                    sign1 * sign3 * (big_r / d12).sqrt(),
+                    sign3 * (big_r / d13).sqrt(),
+                ),
+                lambda: (p * d12).sqrt(),
+                m: big_r * d23 / (p * d12),
+                m1: d13 * d / (p * d12),
+                kappa: d13 / d12,
+                nu: d23 / d12,
+            }
+        } else {
+            Self {
+                about_smallest: false,
+                coeff: DVec3::new(
+                    sign1 * (p / d13).sqrt(),
+                    sign1 * sign3 * (p / d23).sqrt(),
+                    sign3 * (big_r / d13).sqrt(),
+                ),
+                lambda: (big_r * d23).sqrt(),
+                m: p * d12 / (big_r * d23),
+                m1: d13 * -d / (big_r * d23),
+                kappa: p * d13 / (big_r * d23),
+                nu: p / big_r,
+            }
+        }
+    }
+
+    /// `(sn, cn, dn)` of the momentum `s` on this motion.
+    fn phase_of(&self, s: DVec3) -> (f64, f64, f64) {
+        let a = self.coeff;
+        if self.about_smallest {
+            (s.y / a.y, s.z / a.z, s.x / a.x)
+        } else {
+            (s.y / a.y, s.x / a.x, s.z / a.z)
+        }
+    }
+
+    /// The momentum at phase `(sn, cn, dn)`.
+    fn momentum_at(&self, sn: f64, cn: f64, dn: f64) -> DVec3 {
+        let a = self.coeff;
+        if self.about_smallest {
+            DVec3::new(a.x * dn, a.y * sn, a.z * cn)
+        } else {
+            DVec3::new(a.x * cn, a.y * sn, a.z * dn)
+        }
+    }
+
+    /// `G(φ)` of the module docs for `(sin φ, cos φ)`, normalized here.
+    fn phase_integral(&self, sn: f64, cn: f64) -> f64 {
+        let norm = sn.hypot(cn);
+        integral_sn2_over(sn / norm, cn / norm, self.m1, self.nu)
+    }
+
+    /// Advances the sorted momentum `s` by `h`: the new momentum and
+    /// `∫ sn²/(1 + ν sn²) dτ` over the span.
+    fn advance(&self, s: DVec3, h: f64) -> (DVec3, f64) {
+        let (sn0, cn0, _) = self.phase_of(s);
+        let tau0 = incomplete_f_sin_cos(sn0, cn0, self.m, self.m1);
+        let tau1 = tau0 + self.lambda * h;
+        let quarter = complete_k_complement(self.m1);
+        let half_periods = if quarter.is_finite() {
+            (tau1 / (2.0 * quarter)).round()
+        } else {
+            0.0
+        };
+        let reduced = if half_periods == 0.0 {
+            tau1
+        } else {
+            tau1 - 2.0 * half_periods * quarter
+        };
+        let (sn, cn, dn) = jacobi_sn_cn_dn_complement(reduced, self.m, self.m1);
+        let mut integral = self.phase_integral(sn, cn) - self.phase_integral(sn0, cn0);
+        if half_periods != 0.0 {
+            integral += 2.0 * half_periods * integral_sn2_over(1.0, 0.0, self.m1, self.nu);
+        }
+        let parity = if half_periods.rem_euclid(2.0) == 0.0 {
+            1.0
+        } else {
+            -1.0
+        };
+        (self.momentum_at(parity * sn, parity * cn, dn), integral)
+    }
+}
+
+/// The exact torque-free flow over `h` of the principal orientation `Q` and body momentum `m` of
+/// `body`, given the reciprocal principal moments `r` (`0` on a locked axis); see the module docs.
+/// `L = Q m` is unchanged, and so are `E` and `|m|`, to round-off.
+pub fn exact_free_flow(body: &mut FreeBody, r: DVec3, h: f64) {
+    let m = body.m;
+    let omega = r * m;
+    // Steady: ṁ = m × (r ∘ m) = 0 (principal-axis spins, spheres, the plane of two equal
+    // moments), or a locked axis (the constraint holds the body rates).
+    let steady = m.cross(omega) == DVec3::ZERO || r.min_element() == 0.0;
+    if steady {
+        body.q = (body.q * exp_body(h * omega)).normalize();
+        return;
+    }
+    let axes = SortedAxes::new(r);
+    let (rs, s0) = (axes.to_sorted(r).abs(), axes.to_sorted(m));
+    let polhode = Polhode::new(s0, rs);
+    let (s1, integral) = polhode.advance(s0, h);
+    let magnitude = s0.length();
+    let d23 = rs.y - rs.z;
+    let delta_phi =
+        magnitude * rs.z * h + magnitude * d23 * polhode.kappa / polhode.lambda * integral;
+
+    // Euler frame (a, b, c) = sorted (2, 3, 1).
+    let euler = |s: DVec3| DVec3::new(s.y, s.z, s.x);
+    let (sin_half, cos_half) = (0.5 * delta_phi).sin_cos();
+    let spin = DQuat::from_xyzw(0.0, 0.0, sin_half, cos_half);
+    let before = to_momentum_frame(euler(s0), magnitude);
+    let after = to_momentum_frame(euler(s1), magnitude);
+    let turn = before.conjugate() * spin * after;
+    // The turn's axis from Euler-frame to principal components: (a, b, c) → sorted (y, z, x).
+    let axis = axes.to_principal(DVec3::new(turn.z, turn.x, turn.y));
+    let turn = DQuat::from_xyzw(axis.x, axis.y, axis.z, turn.w);
+    body.q = (body.q * turn).normalize();
+    body.m = axes.to_principal(s1);
+}
+
+#[cfg(test)]
+mod tests;
