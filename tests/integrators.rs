@@ -5,6 +5,7 @@ mod integrators {
     pub mod batch;
     pub mod convergence;
     pub mod damping;
+    pub mod exact;
     pub mod extremes;
     pub mod gyroscopic;
     pub mod harness;
