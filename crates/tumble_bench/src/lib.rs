@@ -11,6 +11,7 @@
 
 pub mod bandwidth;
 pub mod engines;
+pub mod exact;
 pub mod measure;
 pub mod output;
 pub mod population;
@@ -116,6 +117,8 @@ pub struct BenchResults {
     pub unused_feature: UnusedFeature,
     /// Spring chains: the cost of stiffness and spring throughput.
     pub springs: springs::SpringResults,
+    /// The exact free flow against the default, ECS, one thread.
+    pub exact: Vec<exact::ExactRow>,
     /// The targets of issue #7 and of the stiff-springs issue.
     pub targets: Vec<Target>,
 }
@@ -211,6 +214,12 @@ pub fn run_bench(options: &BenchOptions, mut progress: impl FnMut(&str)) -> Benc
     progress("unused feature: no gravity vs zero gravity");
     let unused_feature = unused_gravity(sizes.last().copied().unwrap_or(1).min(10_000), &effort);
     let springs = springs::run(options.quick, &mut progress);
+    let exact_sizes: &[usize] = if options.quick {
+        &[1_000]
+    } else {
+        &[1_000, 100_000]
+    };
+    let exact = exact::run(exact_sizes, &effort, &mut progress);
     let mut results = BenchResults {
         schema: 1,
         pool_threads: pool_threads(),
@@ -220,6 +229,7 @@ pub fn run_bench(options: &BenchOptions, mut progress: impl FnMut(&str)) -> Benc
         fixed_cost_ns,
         unused_feature,
         springs,
+        exact,
         targets: Vec::new(),
     };
     results.targets = output::targets(&results);

@@ -111,6 +111,14 @@ pub fn targets(results: &BenchResults) -> Vec<Target> {
         "<=",
         1.05,
     ));
+    for row in &results.exact {
+        out.push(target(
+            &format!("exact / splitting, ECS 1 thread, {} bodies", row.bodies),
+            row.ratio(),
+            "<=",
+            10.0,
+        ));
+    }
     if let Some(explicit) = results.springs.explicit_reference() {
         for row in results
             .springs
@@ -193,7 +201,34 @@ pub fn markdown(results: &BenchResults) -> String {
         fmt_ns(u.with_zero)
     );
     s.push_str(&springs_markdown(&results.springs));
+    s.push_str(&exact_markdown(&results.exact));
     s.push_str(&targets_table(&results.targets));
+    s
+}
+
+/// The exact free flow's cost against the default.
+pub fn exact_markdown(rows: &[crate::exact::ExactRow]) -> String {
+    let mut s = String::new();
+    if rows.is_empty() {
+        return s;
+    }
+    let _ = writeln!(
+        s,
+        "**exact** free rotation against `splitting` — ns per body-step, ECS, 1 thread\n"
+    );
+    let _ = writeln!(s, "| bodies | splitting | exact | exact / splitting |");
+    let _ = writeln!(s, "|---:|---:|---:|---:|");
+    for r in rows {
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {:.1}× |",
+            r.bodies,
+            fmt_ns(r.splitting_ns),
+            fmt_ns(r.exact_ns),
+            r.ratio()
+        );
+    }
+    s.push('\n');
     s
 }
 
@@ -328,6 +363,7 @@ pub fn readme_section(results: &BenchResults) -> String {
     }
     s.push('\n');
     s.push_str(&springs_markdown(&results.springs));
+    s.push_str(&exact_markdown(&results.exact));
     s.push_str(&targets_table(&results.targets));
     s
 }

@@ -194,7 +194,14 @@ pub fn incomplete_f_complement(phi: f64, m: f64, m1: f64) -> f64 {
 /// should use this form. A negative `cos φ` is treated as zero.
 pub fn incomplete_f_sin_cos(sin_phi: f64, cos_phi: f64, m: f64, m1: f64) -> f64 {
     let (m, m1) = (clamp_parameter(m), clamp_parameter(m1));
-    let r = sin_phi.hypot(cos_phi);
+    let sum = sin_phi * sin_phi + cos_phi * cos_phi;
+    // `hypot` only where the squares could underflow or overflow (it costs more than R_F's
+    // first duplication).
+    let r = if (1e-290..1e290).contains(&sum) {
+        sum.sqrt()
+    } else {
+        sin_phi.hypot(cos_phi)
+    };
     if r == 0.0 {
         return 0.0;
     }

@@ -69,6 +69,17 @@ fn sign(x: f64) -> f64 {
     if x < 0.0 { -1.0 } else { 1.0 }
 }
 
+/// `√(x² + y²)`, without the cost of `hypot` where the squares cannot underflow or overflow.
+#[inline]
+fn norm2(x: f64, y: f64) -> f64 {
+    let sum = x * x + y * y;
+    if (1e-290..1e290).contains(&sum) {
+        sum.sqrt()
+    } else {
+        x.hypot(y)
+    }
+}
+
 /// The rotation by the body-frame rotation vector `v`: `exp(½ v)` as a unit quaternion.
 #[inline]
 fn exp_body(v: DVec3) -> DQuat {
@@ -102,7 +113,7 @@ fn rotation_from_cos_sin(axis: DVec3, c: f64, s: f64) -> DQuat {
 /// to `|μ| ẑ`. `m_a² + m_b² > 0`.
 #[inline]
 fn to_momentum_frame(mu: DVec3, magnitude: f64) -> DQuat {
-    let rho = mu.x.hypot(mu.y);
+    let rho = norm2(mu.x, mu.y);
     let rz = rotation_from_cos_sin(DVec3::Z, mu.y / rho, mu.x / rho);
     let rx = rotation_from_cos_sin(DVec3::X, mu.z / magnitude, rho / magnitude);
     rx * rz
@@ -118,8 +129,13 @@ struct SortedAxes {
 
 impl SortedAxes {
     fn new(r: DVec3) -> Self {
+        // Three compare-and-swaps (a library sort costs more than the rest of this).
         let mut index = [0, 1, 2];
-        index.sort_by(|&i, &j| r[j].total_cmp(&r[i]));
+        for (i, j) in [(0, 1), (1, 2), (0, 1)] {
+            if r[index[j]] > r[index[i]] {
+                index.swap(i, j);
+            }
+        }
         // An odd permutation of a right-handed frame is left-handed: negate the middle axis.
         let even = matches!(index, [0, 1, 2] | [1, 2, 0] | [2, 0, 1]);
         let sign = if even { [1.0; 3] } else { [1.0, -1.0, 1.0] };
@@ -223,7 +239,7 @@ impl Polhode {
 
     /// `G(φ)` of the module docs for `(sin φ, cos φ)`, normalized here.
     fn phase_integral(&self, sn: f64, cn: f64) -> f64 {
-        let norm = sn.hypot(cn);
+        let norm = norm2(sn, cn);
         integral_sn2_over(sn / norm, cn / norm, self.m1, self.nu)
     }
 
