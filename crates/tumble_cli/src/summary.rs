@@ -56,6 +56,8 @@ pub fn warning_line(warning: &StabilityWarning, names: &Names) -> String {
         StabilityWarning::StiffSpring { spring, .. } => spring,
         StabilityWarning::ExplicitGyroscopic { body, .. } => body,
         StabilityWarning::CoarsePosition { body, .. } => body,
+        StabilityWarning::InexactFreeRotation { body, .. } => body,
+        StabilityWarning::StiffRk4Rotation { body, .. } => body,
     };
     let text = warning.to_string();
     // `Display` starts with the entity ("spring 12v0: …"); say the scene's name instead.

@@ -23,6 +23,32 @@
 //!   (≈ 32/(Ω²Δt)): I = (1, 2, 3) at 20 rad/s and 60 Hz gives 4.8 s (measured: 3.5 s). A warning
 //!   is raised when `t*` is shorter than [`EXPLICIT_GYROSCOPIC_HORIZON`].
 //!
+//! One limit of the default method's accuracy (not its stability):
+//!
+//! - **Split free rotation.** `splitting` (and `splitting-xyz`) integrate the torque-free body as
+//!   an exact symmetric top `S` plus a residual rotation about axis `c` (`R = ½ (r_c − r_b) m_c²`,
+//!   `b, c` the axes with the closest reciprocal moments `r = 1/I`, `a` the odd one). Their Strang
+//!   composition errs where `S` and `R` do not commute: the residual rotation by
+//!   `h (r_c − r_b) m_c` swings `m_b` into `m_a` and back, and what is left per step is
+//!   `δm_a ≈ h² ω_a (r_c − r_b) m_b m_c`, a relative error in the odd axis's rate of
+//!   `e = Δt² |ω_b ω_c| |I_b − I_c| / I_a` per step. A thin asymmetric plate (`I_a` small, its
+//!   asymmetry `|I_b − I_c| ≤ I_a` by the triangle inequality) spun about a tilted axis is where
+//!   `e` is largest; the orientation error over `T` seconds then measures ≈ `0.4–0.7 e T / s`
+//!   rad (f32; plates and needles `I = (0.01, 1, 1.01)`, `(1e-4, 1, 1.0001)`, `(0.1, 1, 1.1)`,
+//!   `(0.3, 1, 1.3)` at 1–10 rad/s, 60 and 240 Hz). A warning naming `exact` (exact at any spin)
+//!   is raised when `e` exceeds [`FREE_ROTATION_ERROR_LIMIT`]: the run goes on (the motion stays
+//!   bounded, `|L|` exact), it is an accuracy limit like the one below.
+//!
+//! - **`rk4` at constant `L`** integrates `q̇ = ½ ω(q) q` with `ω(q) = R I⁻¹ Rᵀ L`. A trial
+//!   orientation off the true path by `δ` tilts `L` into the body's thinnest axis and spins it
+//!   at `|L| δ / I_min`: the equation is stiff with rate `|L|/I_min`, the spin the body would
+//!   have with all of `L` on that axis, however slowly it really turns. Explicit RK4 is accurate
+//!   only while `|L| Δt / I_min` is well inside its stable interval: measured over 10 s at 60 Hz,
+//!   0.2 → 5e-5 rad, 0.6 → 0.15 rad, 1.0 → 3 rad (box I = (1, 2, 3)); a rod I = (1e-4, 1, 1) has
+//!   `|L|Δt/I_min` = 110 already at 2 rad/s and is 0.3 rad off, and 2–3 rad at 18 rad/s
+//!   (`splitting`: 1e-5 to 2e-4 rad). A warning naming `splitting` and `exact` is raised above
+//!   [`RK4_STIFFNESS_LIMIT`].
+//!
 //! And one limit of the precision, not of the method:
 //!
 //! - **Positions far from the origin.** A stored coordinate `r` is rounded to the spacing of
@@ -54,6 +80,15 @@ pub const EXPLICIT_GYROSCOPIC_HORIZON: Real = 600.0;
 /// passes without a warning.
 pub const POSITION_RESOLUTION_LIMIT: Real = 1e-3;
 
+/// Relative error per step of the odd axis's rate under the split free rotation,
+/// `Δt² |ω_b ω_c| |I_b − I_c| / I_a` (module docs), above which the planner names `exact`: 1 %
+/// per step, an orientation drift of about 5e-3 rad/s. An ordinary box (I = (1, 2, 3)) reaches it
+/// at ≈ 6 rad/s about two axes at 60 Hz.
+pub const FREE_ROTATION_ERROR_LIMIT: Real = 1e-2;
+
+/// `|L| Δt / I_min` above which `rk4`'s constant-`L` rotation goes wrong (module docs).
+pub const RK4_STIFFNESS_LIMIT: Real = 0.5;
+
 /// A setting outside the selected integrator's stable region, or beyond what the precision can
 /// resolve.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -74,6 +109,25 @@ pub enum StabilityWarning {
         /// Predicted time for round-off to grow to order one (s).
         seconds: Real,
     },
+    /// A spin the split free rotation of `splitting` / `splitting-xyz` integrates with a large
+    /// error per step (not an instability: the motion stays bounded and `|L|` exact, but wrong);
+    /// `exact` integrates it exactly.
+    InexactFreeRotation {
+        /// The body.
+        body: Entity,
+        /// The integrator.
+        integrator: Integrator,
+        /// `Δt² |ω_b ω_c| |I_b − I_c| / I_a`, compared with [`FREE_ROTATION_ERROR_LIMIT`].
+        error_per_step: Real,
+    },
+    /// A body whose `rk4` rotation is stiff, `|L| Δt / I_min` above [`RK4_STIFFNESS_LIMIT`]
+    /// (module docs): the state stays finite, the orientation goes wrong.
+    StiffRk4Rotation {
+        /// The body.
+        body: Entity,
+        /// `|L| Δt / I_min`.
+        stiffness: Real,
+    },
     /// A body so far from the origin that rounding of its stored position eats a visible part
     /// of each step's motion (not an instability: the motion stays bounded, but wrong).
     CoarsePosition {
@@ -90,9 +144,14 @@ pub enum StabilityWarning {
 
 impl StabilityWarning {
     /// True for settings that make the integration diverge (stiff springs, explicit gyroscopic
-    /// blow-ups); false for a precision limit.
+    /// blow-ups); false for a limit of accuracy or precision.
     pub fn is_instability(&self) -> bool {
-        !matches!(self, StabilityWarning::CoarsePosition { .. })
+        !matches!(
+            self,
+            StabilityWarning::CoarsePosition { .. }
+                | StabilityWarning::InexactFreeRotation { .. }
+                | StabilityWarning::StiffRk4Rotation { .. }
+        )
     }
 }
 
@@ -113,6 +172,24 @@ impl std::fmt::Display for StabilityWarning {
                 f,
                 "rigid body {body}: integrator `{integrator}` amplifies its spin's round-off to \
                  order one in about {seconds:.1} s (explicit gyroscopic term); use `splitting`"
+            ),
+            StabilityWarning::InexactFreeRotation {
+                body,
+                integrator,
+                error_per_step,
+            } => write!(
+                f,
+                "rigid body {body}: integrator `{integrator}` splits its free rotation with a \
+                 relative error of {:.1} % per step in its spin (Δt²|ω_b ω_c||I_b − I_c|/I_a); \
+                 use `exact`, exact at any spin, or a smaller time step",
+                100.0 * error_per_step
+            ),
+            StabilityWarning::StiffRk4Rotation { body, stiffness } => write!(
+                f,
+                "rigid body {body}: integrator `rk4` is stiff for this body, |L|Δt/I_min = \
+                 {stiffness:.2} > {RK4_STIFFNESS_LIMIT} (its rotation at constant L reads any \
+                 tilt as a spin about the thinnest axis), so its orientation goes wrong; use \
+                 `splitting` or `exact`"
             ),
             StabilityWarning::CoarsePosition {
                 body,
@@ -150,6 +227,28 @@ fn nutation_factor(inertia: Vec3) -> Real {
             }
         })
         .fold(0.0, Real::max)
+}
+
+/// `Δt² |ω_b ω_c| |I_b − I_c| / I_a` of the split free rotation (module docs) for principal
+/// moments `inertia` and principal rates `omega`; `a` is the axis whose reciprocal moment is
+/// farthest from the other two (the pair `b, c` the split treats as a symmetric top). Zero for
+/// a body with a locked axis (its rates are held, see `exact`).
+pub fn split_rotation_error(inertia: Vec3, omega: Vec3, dt: Real) -> Real {
+    let i = inertia.to_array();
+    if i.iter().any(|&x| x <= 0.0) {
+        return 0.0;
+    }
+    let r = i.map(|x| 1.0 / x);
+    let w = omega.to_array();
+    // The odd axis: the one not in the closest pair of reciprocal moments.
+    let a = (0..3)
+        .min_by(|&x, &y| {
+            let gap = |k: usize| (r[(k + 1) % 3] - r[(k + 2) % 3]).abs();
+            gap(x).total_cmp(&gap(y))
+        })
+        .unwrap_or(0);
+    let (b, c) = ((a + 1) % 3, (a + 2) % 3);
+    dt * dt * (w[b] * w[c]).abs() * (i[b] - i[c]).abs() / i[a]
 }
 
 /// Checks the world's springs and spins against the selected integrator's stable region.
@@ -212,6 +311,44 @@ pub fn check_stability(world: &mut World) -> Vec<StabilityWarning> {
                     step_motion,
                     relative_error,
                 });
+            }
+        }
+    }
+    if matches!(
+        settings.integrator,
+        Integrator::Splitting | Integrator::SplittingXyz
+    ) {
+        // One substep's span: the split is applied once per stage.
+        let h = settings.dt() / settings.substeps.get() as Real;
+        let mut spins =
+            world.query_filtered::<(Entity, &MassProps, &Transform, &Velocity), With<RigidBody>>();
+        for (body, mass, transform, velocity) in spins.iter(world) {
+            let principal = transform.rotation * mass.principal_frame();
+            let omega = tumble_core::integrate::rotate_inv(principal, velocity.angular);
+            let error_per_step = split_rotation_error(mass.principal_inertia(), omega, h);
+            if error_per_step > FREE_ROTATION_ERROR_LIMIT {
+                warnings.push(StabilityWarning::InexactFreeRotation {
+                    body,
+                    integrator: settings.integrator,
+                    error_per_step,
+                });
+            }
+        }
+    }
+    if settings.integrator == Integrator::Rk4 {
+        let h = settings.dt() / settings.substeps.get() as Real;
+        let mut spins =
+            world.query_filtered::<(Entity, &MassProps, &Transform, &Velocity), With<RigidBody>>();
+        for (body, mass, transform, velocity) in spins.iter(world) {
+            let momentum = mass
+                .world_inertia_mul(transform.rotation, velocity.angular)
+                .length();
+            let thinnest = mass.principal_inertia().min_element();
+            if thinnest > 0.0 {
+                let stiffness = momentum * h / thinnest;
+                if stiffness > RK4_STIFFNESS_LIMIT {
+                    warnings.push(StabilityWarning::StiffRk4Rotation { body, stiffness });
+                }
             }
         }
     }
