@@ -8,6 +8,8 @@
 //!   body-step, measured in the same process;
 //! - **stability matrix** ([`stability`]): extreme scenes × integrator × setting: finite?
 //!   `max ||q| − 1|`? final/initial energy? and whether tumble's stability prediction warned;
+//! - **the thin asymmetric plate** ([`thin`]) at `|ω|Δt` = 0.1 … 3, every integrator, against
+//!   the closed-form top;
 //! - **energy over time** ([`energy`]) for long spins, each method and rapier;
 //! - **springs against rapier** ([`springs`], [`spring_output`]): the stiff chain
 //!   ([`tumble_rapier::presets::spring_chain`]) at several `ωΔt`, tumble's explicit and implicit spring steps against rapier's
@@ -25,4 +27,5 @@ pub mod run;
 pub mod spring_output;
 pub mod springs;
 pub mod stability;
+pub mod thin;
 pub mod workprec;

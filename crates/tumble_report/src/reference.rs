@@ -105,8 +105,7 @@ fn pendulum(point: DVec3, force: DVec3, inertia: f64, t: f64) -> DQuat {
     q
 }
 
-fn top(name: &'static str, description: &'static str, omega0: Vec3) -> Case {
-    let inertia = Vec3::new(1.0, 2.0, 3.0);
+fn top(name: &'static str, description: &'static str, inertia: Vec3, omega0: Vec3) -> Case {
     let exact_top = TorqueFreeTop::new(inertia.widen(), omega0.widen(), DQuat::IDENTITY)
         .expect("an asymmetric top with finite rates");
     Case {
@@ -140,17 +139,27 @@ pub fn cases() -> Vec<Case> {
         top(
             "top-largest",
             "torque-free top, I = (1, 2, 3), ω₀ = (0.1, 0.1, 3): stable spin near the largest axis",
+            Vec3::new(1.0, 2.0, 3.0),
             Vec3::new(0.1, 0.1, 3.0),
         ),
         top(
             "top-smallest",
             "torque-free top, ω₀ = (3, 0.1, 0.1): stable spin near the smallest axis",
+            Vec3::new(1.0, 2.0, 3.0),
             Vec3::new(3.0, 0.1, 0.1),
         ),
         top(
             "dzhanibekov",
             "torque-free top, ω₀ = (1, 5, 1): flips about the middle axis every 1.79 s",
+            Vec3::new(1.0, 2.0, 3.0),
             Vec3::new(1.0, 5.0, 1.0),
+        ),
+        top(
+            "thin-plate",
+            "torque-free thin asymmetric plate, I = (0.01, 1, 1.01), |ω₀| = 10 rad/s about a \
+             tilted axis (0.3, 1, 0.5)",
+            crate::thin::PLATE,
+            Vec3::new(0.3, 1.0, 0.5).normalize() * 10.0,
         ),
         Case {
             name: "projectile",

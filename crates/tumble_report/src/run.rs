@@ -103,6 +103,8 @@ pub fn run_report(options: &ReportOptions) -> Result<(), Box<dyn std::error::Err
     }
     bar.set_message("stability matrix");
     let cells = matrix(options.quick, || bar.inc(1));
+    bar.set_message("thin plate");
+    let thin_plate = crate::thin::table();
     bar.set_message("energy over time");
     let energy = traces(if options.quick { 30 } else { 120 });
     bar.set_message("springs against rapier");
@@ -115,6 +117,7 @@ pub fn run_report(options: &ReportOptions) -> Result<(), Box<dyn std::error::Err
         cells,
         energy,
         springs,
+        thin_plate,
     );
     let out: &Path = &options.out;
     create_directory(out)?;

@@ -220,6 +220,27 @@ fn thin_rod(integrator: Integrator, omega_dt: Real, steps: usize) -> Cell {
     )
 }
 
+/// The thin asymmetric plate ([`crate::thin::PLATE`]) spinning at `|ω|Δt` about a tilted axis.
+fn thin_plate(integrator: Integrator, omega_dt: Real, steps: usize) -> Cell {
+    let dt = 1.0 / 60.0;
+    let mut w = world(dt, integrator);
+    let mass =
+        MassProperties::new(Mass::new(1.0).expect("valid"), crate::thin::PLATE).expect("valid");
+    let axis = Vec3::new(0.3, 1.0, 0.5).normalize();
+    w.spawn((
+        RigidBody,
+        MassProps(mass),
+        Velocity::angular(axis * omega_dt / dt),
+    ));
+    run(
+        &mut w,
+        steps,
+        "thin-plate",
+        integrator,
+        format!("|ω|Δt = {omega_dt}"),
+    )
+}
+
 /// A mass on a stiff spring to a world anchor, √(k/m)Δt = `omega_dt`.
 fn stiff_spring(
     integrator: Integrator,
@@ -336,6 +357,9 @@ pub fn matrix(quick: bool, mut progress: impl FnMut()) -> Vec<Cell> {
     for &integrator in Integrator::ALL {
         for omega_dt in [0.1, 1.0, 5.0, 10.0] {
             cells.push(thin_rod(integrator, omega_dt, steps));
+        }
+        for omega_dt in crate::thin::OMEGA_DTS {
+            cells.push(thin_plate(integrator, omega_dt, steps));
         }
         for springs in [SpringSolver::Explicit, SpringSolver::Auto] {
             for omega_dt in [0.5, 1.0, 1.5, 2.0, 2.5, 10.0, 100.0] {

@@ -75,7 +75,8 @@ fn results_json_has_the_documented_shape() {
     let cells = matrix(true, || {}).into_iter().take(3).collect();
     let energy = tumble_report::energy::traces(2);
     let springs = tumble_report::springs::spring_runs(3, || {});
-    let results = Results::new(Machine::detect(true), points, cells, energy, springs);
+    let thin = tumble_report::thin::table();
+    let results = Results::new(Machine::detect(true), points, cells, energy, springs, thin);
     let json: serde_json::Value = serde_json::to_value(&results).unwrap();
     assert_eq!(json["schema"], 1);
     for key in ["cpu", "cores", "os", "tumble_version", "quick"] {
