@@ -52,6 +52,11 @@ fn yoshida4_is_fourth_order_with_springs_forces_at_points_and_torques() {
     for slope in s_slopes {
         assert!((slope - 2.0).abs() <= 0.2, "splitting slope {slope}: {s:?}");
     }
+    // `exact4` composes `exact`'s step the same way: fourth order on the whole motion too.
+    let (x, x_slopes) = order(Integrator::Exact4, &rates);
+    for slope in x_slopes {
+        assert!((slope - 4.0).abs() <= 0.3, "exact4 slope {slope}: {x:?}");
+    }
 }
 
 /// The bits of every body's state.
