@@ -47,6 +47,10 @@ const BUNDLED: &[(&str, &str)] = &[
     ),
     ("thin_rod", include_str!("../../../scenes/thin_rod.toml")),
     (
+        "thin_plate",
+        include_str!("../../../scenes/thin_plate.toml"),
+    ),
+    (
         "mass_ratio",
         include_str!("../../../scenes/mass_ratio.toml"),
     ),

@@ -131,6 +131,7 @@ fn scenes_lists_the_bundled_scenes_and_plan_prints_the_systems() {
         "dzhanibekov",
         "spring_chain",
         "thin_rod",
+        "thin_plate",
         "long_run",
         "stiff_chain",
         "cloth",

@@ -31,6 +31,7 @@ fn every_bundled_scene_has_exactly_the_systems_it_needs() {
         ("principal_spins", free),
         ("projectile", free),
         ("thin_rod", free),
+        ("thin_plate", free),
         // A force at a point on the top; springs between bodies (with the energy audit that
         // every spring network gets).
         (
