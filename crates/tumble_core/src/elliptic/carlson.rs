@@ -20,22 +20,33 @@ const MAX_DUPLICATIONS: usize = 200;
 /// `R_F(x, y, z) = ½ ∫₀^∞ dt / √((t+x)(t+y)(t+z))` for `x, y, z ≥ 0` with at most one of them
 /// zero.
 pub fn carlson_rf(mut x: f64, mut y: f64, mut z: f64) -> f64 {
+    // Each duplication shifts the three arguments by the same λ and divides them by 4, so their
+    // deviations from the mean shrink exactly as 4⁻ᵏ: the stopping test needs no division.
+    let mean0 = (x + y + z) * (1.0 / 3.0);
+    let spread = (mean0 - x)
+        .abs()
+        .max((mean0 - y).abs())
+        .max((mean0 - z).abs());
+    let (mut mean, mut shrink) = (mean0, 1.0);
     for _ in 0..MAX_DUPLICATIONS {
-        let mean = (x + y + z) / 3.0;
-        let (dx, dy, dz) = (1.0 - x / mean, 1.0 - y / mean, 1.0 - z / mean);
-        if dx.abs().max(dy.abs()).max(dz.abs()) < SERIES_SPREAD {
-            let e2 = dx * dy - dz * dz;
-            let e3 = dx * dy * dz;
-            return (1.0 - e2 / 10.0 + e3 / 14.0 + e2 * e2 / 24.0 - 3.0 * e2 * e3 / 44.0)
-                / mean.sqrt();
+        if shrink * spread < SERIES_SPREAD * mean {
+            break;
         }
         let (sx, sy, sz) = (x.sqrt(), y.sqrt(), z.sqrt());
         let lambda = sx * (sy + sz) + sy * sz;
         x = 0.25 * (x + lambda);
         y = 0.25 * (y + lambda);
         z = 0.25 * (z + lambda);
+        mean = 0.25 * (mean + lambda);
+        shrink *= 0.25;
     }
-    1.0 / ((x + y + z) / 3.0).sqrt()
+    let inv = 1.0 / mean;
+    // Deviations from the mean; they sum to zero.
+    let (dx, dy) = (1.0 - x * inv, 1.0 - y * inv);
+    let dz = -(dx + dy);
+    let e2 = dx * dy - dz * dz;
+    let e3 = dx * dy * dz;
+    (1.0 - e2 / 10.0 + e3 / 14.0 + e2 * e2 / 24.0 - 3.0 * e2 * e3 / 44.0) * inv.sqrt()
 }
 
 /// `R_C(1, 1 + e) = ½ ∫₀^∞ dt / ((t + 1 + e) √(t + 1))` for `e > −1`: `atan(√e)/√e` for `e > 0`,
@@ -64,38 +75,43 @@ pub fn carlson_rc1(e: f64) -> f64 {
 /// `A^{−3/2}(1 − 3E₂/14 + E₃/6 + 9E₂²/88 − 3E₄/22 − 9E₂E₃/52 + 3E₅/26)`.
 pub fn carlson_rj(mut x: f64, mut y: f64, mut z: f64, mut p: f64) -> f64 {
     let delta = (p - x) * (p - y) * (p - z);
+    let mean0 = (x + y + z + 2.0 * p) * 0.2;
+    let spread = (mean0 - x)
+        .abs()
+        .max((mean0 - y).abs())
+        .max((mean0 - z).abs())
+        .max((mean0 - p).abs());
     let mut sum = 0.0;
-    // 4^{−k} and 4^{−3k}.
-    let (mut scale, mut scale3) = (1.0, 1.0);
+    // 4^{−k} (the deviations from the mean shrink exactly so, see `carlson_rf`) and 4^{−3k}.
+    let (mut mean, mut shrink, mut shrink3) = (mean0, 1.0, 1.0);
     for _ in 0..MAX_DUPLICATIONS {
-        let mean = (x + y + z + 2.0 * p) / 5.0;
-        let (dx, dy, dz) = (1.0 - x / mean, 1.0 - y / mean, 1.0 - z / mean);
-        let dp = 1.0 - p / mean;
-        if dx.abs().max(dy.abs()).max(dz.abs()).max(dp.abs()) < SERIES_SPREAD {
-            let pp = -0.5 * (dx + dy + dz);
-            let e2 = dx * dy + dx * dz + dy * dz - 3.0 * pp * pp;
-            let e3 = dx * dy * dz + 2.0 * e2 * pp + 4.0 * pp * pp * pp;
-            let e4 = (2.0 * dx * dy * dz + e2 * pp + 3.0 * pp * pp * pp) * pp;
-            let e5 = dx * dy * dz * pp * pp;
-            let series = 1.0 - 3.0 * e2 / 14.0 + e3 / 6.0 + 9.0 * e2 * e2 / 88.0
-                - 3.0 * e4 / 22.0
-                - 9.0 * e2 * e3 / 52.0
-                + 3.0 * e5 / 26.0;
-            return scale * series / (mean * mean.sqrt()) + 6.0 * sum;
+        if shrink * spread < SERIES_SPREAD * mean {
+            break;
         }
         let (sx, sy, sz, sp) = (x.sqrt(), y.sqrt(), z.sqrt(), p.sqrt());
         let lambda = sx * (sy + sz) + sy * sz;
-        let d = (sp + sx) * (sp + sy) * (sp + sz);
-        sum += scale * carlson_rc1(scale3 * delta / (d * d)) / d;
+        let inv_d = 1.0 / ((sp + sx) * (sp + sy) * (sp + sz));
+        sum += shrink * carlson_rc1(shrink3 * delta * inv_d * inv_d) * inv_d;
         x = 0.25 * (x + lambda);
         y = 0.25 * (y + lambda);
         z = 0.25 * (z + lambda);
         p = 0.25 * (p + lambda);
-        scale *= 0.25;
-        scale3 *= 1.0 / 64.0;
+        mean = 0.25 * (mean + lambda);
+        shrink *= 0.25;
+        shrink3 *= 1.0 / 64.0;
     }
-    let mean = (x + y + z + 2.0 * p) / 5.0;
-    scale / (mean * mean.sqrt()) + 6.0 * sum
+    let inv = 1.0 / mean;
+    let (dx, dy, dz) = (1.0 - x * inv, 1.0 - y * inv, 1.0 - z * inv);
+    let pp = -0.5 * (dx + dy + dz);
+    let e2 = dx * dy + dx * dz + dy * dz - 3.0 * pp * pp;
+    let e3 = dx * dy * dz + 2.0 * e2 * pp + 4.0 * pp * pp * pp;
+    let e4 = (2.0 * dx * dy * dz + e2 * pp + 3.0 * pp * pp * pp) * pp;
+    let e5 = dx * dy * dz * pp * pp;
+    let series = 1.0 - 3.0 * e2 / 14.0 + e3 / 6.0 + 9.0 * e2 * e2 / 88.0
+        - 3.0 * e4 / 22.0
+        - 9.0 * e2 * e3 / 52.0
+        + 3.0 * e5 / 26.0;
+    shrink * series * inv * inv.sqrt() + 6.0 * sum
 }
 
 /// `∫₀^φ sin²θ / ((1 + ν sin²θ) √(1 − m sin²θ)) dθ` on `|φ| ≤ π/2`, from `sin φ`, `cos φ ≥ 0`,

@@ -56,12 +56,27 @@
 //! gyroscopic torque, so the body rates are constant and the body turns steadily about the
 //! fixed `ω` — that is the exact motion (it is also what every splitting tends to as `h → 0`).
 
+use std::f64::consts::FRAC_PI_2;
+
 use glam::{DQuat, DVec3};
 
+use super::sin_cos;
 use super::splitting::FreeBody;
 use crate::elliptic::{
     complete_k_complement, incomplete_f_sin_cos, integral_sn2_over, jacobi_sn_cn_dn_complement,
 };
+
+/// `atan x`: the series `x − x³/3 + x⁵/5 − x⁷/7` below `|x| = 10⁻³` (the first term left out,
+/// `x⁹/9`, is below `10⁻¹⁸ |x|`), the platform function above.
+#[inline]
+fn small_atan(x: f64) -> f64 {
+    if x.abs() < 1e-3 {
+        let x2 = x * x;
+        x * (1.0 - x2 * (1.0 / 3.0 - x2 * (1.0 / 5.0 - x2 / 7.0)))
+    } else {
+        x.atan()
+    }
+}
 
 /// `sign(x)` as `±1`, `+1` for `+0`.
 #[inline]
@@ -87,7 +102,7 @@ fn exp_body(v: DVec3) -> DQuat {
     if angle == 0.0 {
         return DQuat::IDENTITY;
     }
-    let (s, c) = (0.5 * angle).sin_cos();
+    let (s, c) = sin_cos(0.5 * angle);
     let axis = v * (s / angle);
     DQuat::from_xyzw(axis.x, axis.y, axis.z, c)
 }
@@ -246,6 +261,57 @@ impl Polhode {
     /// Advances the sorted momentum `s` by `h`: the new momentum and
     /// `∫ sn²/(1 + ν sn²) dτ` over the span.
     fn advance(&self, s: DVec3, h: f64) -> (DVec3, f64) {
+        self.advance_short(s, h)
+            .unwrap_or_else(|| self.advance_any(s, h))
+    }
+
+    /// [`advance`](Self::advance) by the addition theorems, for a phase advance `δ = λh` short
+    /// enough (see below); `None` otherwise.
+    ///
+    /// With `(sn, cn, dn)` at `τ₀` read off the momentum and at `δ` from the Landen
+    /// transformation, `τ₁ = τ₀ + δ` follows from Jacobi's addition theorem
+    /// (`sn(u + v) = (sn u cn v dn v + sn v cn u dn u)/(1 − m sn²u sn²v)` and its companions),
+    /// and the phase integral `J(u) = ∫₀^u sn²/(1 + ν sn²)` from the addition theorem of the third
+    /// kind (Jacobi's `Π(u, a)` at the imaginary `a` with `m sn²a = −ν`; the logarithm of a
+    /// ratio of conjugates is an angle):
+    ///
+    /// ```text
+    /// J(u + v) − J(u) = J(v) + atan2(C sn u sn v sn w, 1 + ν sn²w − ν sn u sn v cn w dn w) / C,
+    /// w = u + v,   C = √(ν (m + ν)(1 + ν)).
+    /// ```
+    ///
+    /// `J(v) = G(am v)` needs `|v| ≤ K`, which `|δ| < π/2 ≤ K` guarantees; and the angle is on the
+    /// principal branch when the correction is below `π/(2C)` in size: it is bounded by
+    /// `|δ|/(1 + ν)` (the integrand lies in `[0, 1/(1 + ν)]`), hence the second condition
+    /// `|δ| C/(1 + ν) < π/2`. This saves `F(φ₀)`, `K` and one `R_J` against
+    /// [`advance_any`](Self::advance_any).
+    fn advance_short(&self, s: DVec3, h: f64) -> Option<(DVec3, f64)> {
+        let delta = self.lambda * h;
+        let nu = self.nu;
+        let c = (nu * (self.m + nu) * (1.0 + nu)).sqrt();
+        if delta.abs() >= FRAC_PI_2 || delta.abs() * c >= FRAC_PI_2 * (1.0 + nu) {
+            return None;
+        }
+        let (sn0, cn0, dn0) = self.phase_of(s);
+        let (snd, cnd, dnd) = jacobi_sn_cn_dn_complement(delta, self.m, self.m1);
+        let product = sn0 * snd;
+        let denominator = 1.0 - self.m * product * product;
+        let sn = (sn0 * cnd * dnd + snd * cn0 * dn0) / denominator;
+        let cn = (cn0 * cnd - product * dn0 * dnd) / denominator;
+        let dn = (dn0 * dnd - self.m * product * cn0 * cnd) / denominator;
+        let mut integral = self.phase_integral(snd, cnd);
+        if c > 0.0 {
+            // The real part is positive under the conditions above: `atan` of the ratio, by its
+            // series where it is small (the usual case: the correction is O(δ³)).
+            let ratio = c * product * sn / (1.0 + nu * (sn * sn - product * cn * dn));
+            integral += small_atan(ratio) / c;
+        }
+        Some((self.momentum_at(sn, cn, dn), integral))
+    }
+
+    /// [`advance`](Self::advance) for any span: `τ₀ = F(φ₀ | m)`, `τ₁ = τ₀ + λh` reduced by
+    /// half-periods `2K`, and `J` from `G` at both ends plus `2G(π/2)` per half-period.
+    fn advance_any(&self, s: DVec3, h: f64) -> (DVec3, f64) {
         let (sn0, cn0, _) = self.phase_of(s);
         let tau0 = incomplete_f_sin_cos(sn0, cn0, self.m, self.m1);
         let tau1 = tau0 + self.lambda * h;
@@ -298,7 +364,7 @@ pub fn exact_free_flow(body: &mut FreeBody, r: DVec3, h: f64) {
 
     // Euler frame (a, b, c) = sorted (2, 3, 1).
     let euler = |s: DVec3| DVec3::new(s.y, s.z, s.x);
-    let (sin_half, cos_half) = (0.5 * delta_phi).sin_cos();
+    let (sin_half, cos_half) = sin_cos(0.5 * delta_phi);
     let spin = DQuat::from_xyzw(0.0, 0.0, sin_half, cos_half);
     let before = to_momentum_frame(euler(s0), magnitude);
     let after = to_momentum_frame(euler(s1), magnitude);

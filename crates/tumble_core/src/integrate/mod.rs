@@ -37,6 +37,8 @@ mod implicit_gyroscopic;
 mod lclamp;
 mod rk4;
 mod simd;
+/// `(sin x, cos x)` in IEEE arithmetic only, the same bits on every CPU path (see `simd`).
+pub(crate) use simd::sin_cos;
 mod splitting;
 mod stages;
 pub use stages::{StageSpan, Stages, TRIPLE_JUMP_LIMIT, TRIPLE_JUMP_SWING_MATCH};

@@ -199,8 +199,11 @@ fn keeps_the_world_momentum_and_the_energy() {
     }
     let drift = (body.q * body.m - world).length() / world.length();
     let energy_drift = (energy(body.m) - e0).abs() / e0;
+    // Nothing is conserved by construction but by the closed form: each flow rounds, a few ε
+    // (4 ε per flow bounds a drift that could even be biased).
+    let bound = 10_000.0 * 4.0 * f64::EPSILON;
     assert!(
-        drift < 1e-12 && energy_drift < 1e-12,
+        drift < bound && energy_drift < bound,
         "{drift:e} {energy_drift:e}"
     );
 }
@@ -216,4 +219,43 @@ fn a_locked_axis_holds_the_body_rates() {
     assert_eq!(body.m, m);
     let expected = DQuat::from_scaled_axis(omega_world * 1.3) * tilted();
     assert!(angle(body.q, expected) < 1e-14);
+}
+
+#[test]
+fn the_addition_theorems_agree_with_the_general_path() {
+    // Both polhode cases, near the separatrix, thin bodies, forward and backward spans.
+    let cases = [
+        (DVec3::new(1.0, 0.5, 1.0 / 3.0), DVec3::new(1.0, 10.0, 3.0)),
+        (DVec3::new(1.0, 0.5, 1.0 / 3.0), DVec3::new(4.0, 1.0, 0.5)),
+        (
+            DVec3::new(1.0, 0.5, 1.0 / 3.0),
+            DVec3::new(0.01, 20.0, 0.03),
+        ),
+        (
+            DVec3::new(100.0, 1.0, 1.0 / 1.01),
+            DVec3::new(0.06, 0.8, 0.5),
+        ),
+        (
+            DVec3::new(100.0, 1.0, 1.0 / 1.01),
+            DVec3::new(0.03, 1.0, 0.5),
+        ),
+    ];
+    let mut short_taken = 0;
+    for (r, m) in cases {
+        let polhode = super::Polhode::new(m, r);
+        for h in [1e-3, 0.01, 0.05, -0.02, 0.2] {
+            let Some((s_short, j_short)) = polhode.advance_short(m, h) else {
+                continue;
+            };
+            short_taken += 1;
+            let (s_any, j_any) = polhode.advance_any(m, h);
+            let ds = (s_short - s_any).length() / m.length();
+            let dj = (j_short - j_any).abs() / j_any.abs().max(1e-300);
+            assert!(
+                ds < 1e-13 && (dj < 1e-11 || (j_short - j_any).abs() < 1e-15),
+                "r = {r}, m = {m}, h = {h}: momentum {ds:e}, integral {j_short:e} vs {j_any:e}"
+            );
+        }
+    }
+    assert!(short_taken >= 15, "the short path ran {short_taken} times");
 }
