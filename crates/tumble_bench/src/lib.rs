@@ -105,6 +105,8 @@ pub struct BenchResults {
     pub schema: u32,
     /// Threads of the compute pool.
     pub pool_threads: usize,
+    /// The SIMD kernel path that ran (`avx512`, `avx2`, `portable`; `TUMBLE_KERNEL` forces one).
+    pub kernel_path: String,
     /// Copy bandwidth (read + write), GB/s, one thread and all pool threads.
     pub bandwidth_gb_s: [f64; 2],
     /// Bytes a body-step must move through memory in the ECS (read + write), for the floor.
@@ -223,6 +225,7 @@ pub fn run_bench(options: &BenchOptions, mut progress: impl FnMut(&str)) -> Benc
     let mut results = BenchResults {
         schema: 1,
         pool_threads: pool_threads(),
+        kernel_path: tumble_core::kernel_path().to_string(),
         bandwidth_gb_s: bandwidth,
         bytes_per_body_step: bytes_per_body_step(),
         rows,

@@ -155,9 +155,10 @@ pub fn markdown(results: &BenchResults) -> String {
     let floor = results.bytes_per_body_step as f64 / bw1;
     let _ = writeln!(
         s,
-        "Memory: {bw1:.1} GB/s copy on one thread, {bwn:.1} GB/s on {} threads; an ECS \
-         body-step moves {} bytes, so one thread cannot go below {floor:.1} ns per body-step.\n",
-        results.pool_threads, results.bytes_per_body_step
+        "Kernel path: `{}` (`TUMBLE_KERNEL=portable|avx2|avx512` forces one). Memory: {bw1:.1} \
+         GB/s copy on one thread, {bwn:.1} GB/s on {} threads; an ECS body-step moves {} bytes, \
+         so one thread cannot go below {floor:.1} ns per body-step.\n",
+        results.kernel_path, results.pool_threads, results.bytes_per_body_step
     );
     for integrator in crate::INTEGRATORS.map(|i| i.name()) {
         let _ = writeln!(s, "**{integrator}** — ns per body-step (median)\n");
@@ -337,9 +338,9 @@ pub fn readme_section(results: &BenchResults) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "Latest `tumble bench` ({} pool threads, {:.1} GB/s copy bandwidth), default integrator, \
-         ns per body-step:\n",
-        results.pool_threads, results.bandwidth_gb_s[0]
+        "Latest `tumble bench` ({} pool threads, {:.1} GB/s copy bandwidth, kernel path `{}`), \
+         default integrator, ns per body-step:\n",
+        results.pool_threads, results.bandwidth_gb_s[0], results.kernel_path
     );
     let _ = writeln!(
         s,

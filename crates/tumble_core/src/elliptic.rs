@@ -17,7 +17,10 @@
 //! `*_complement` variants therefore take `m` and `m₁` separately, so a caller that knows `m₁`
 //! to full relative accuracy (the torque-free top near its separatrix does) keeps it.
 
+mod arctan;
 mod carlson;
+
+pub(crate) use arctan::{atan, atan2};
 
 pub use carlson::{carlson_rc1, carlson_rf, carlson_rj, integral_sn2_over};
 
@@ -212,7 +215,7 @@ pub fn incomplete_f_sin_cos(sin_phi: f64, cos_phi: f64, m: f64, m1: f64) -> f64 
     if c == 0.0 && m1 == 0.0 {
         f64::INFINITY.copysign(s)
     } else if m == 0.0 {
-        s.atan2(c)
+        atan2(s, c)
     } else {
         s * carlson_rf(c * c, c * c + m1 * s * s, 1.0)
     }

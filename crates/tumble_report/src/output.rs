@@ -383,7 +383,7 @@ pub fn thin_plate_section(rows: &[crate::thin::ThinRow]) -> String {
     let mut rates: Vec<f64> = rows.iter().map(|r| r.omega_dt).collect();
     rates.dedup();
     for rate in rates {
-        let _ = write!(out, "| {rate} |");
+        let _ = write!(out, "| {rate:.1} |");
         for m in &order {
             let cell = rows
                 .iter()

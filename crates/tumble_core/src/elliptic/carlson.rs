@@ -49,7 +49,8 @@ pub fn carlson_rf(mut x: f64, mut y: f64, mut z: f64) -> f64 {
     (1.0 - e2 / 10.0 + e3 / 14.0 + e2 * e2 / 24.0 - 3.0 * e2 * e3 / 44.0) * inv.sqrt()
 }
 
-/// `R_C(1, 1 + e) = ½ ∫₀^∞ dt / ((t + 1 + e) √(t + 1))` for `e > −1`: `atan(√e)/√e` for `e > 0`,
+/// `R_C(1, 1 + e) = ½ ∫₀^∞ dt / ((t + 1 + e) √(t + 1))` for `e > −1`: `atan(√e)/√e` for `e > 0`
+/// (tumble's own `atan`, see `arctan`),
 /// `atanh(√−e)/√−e` for `e < 0`, and the alternating series `Σ (−e)ᵏ/(2k + 1)` for `|e|` below
 /// `10⁻³`, where the closed forms would divide a small difference by a small number.
 pub fn carlson_rc1(e: f64) -> f64 {
@@ -58,8 +59,9 @@ pub fn carlson_rc1(e: f64) -> f64 {
         1.0 - e * (1.0 / 3.0 - e * (1.0 / 5.0 - e * (1.0 / 7.0 - e * (1.0 / 9.0 - e / 11.0))))
     } else if e > 0.0 {
         let s = e.sqrt();
-        s.atan() / s
+        super::arctan::atan(s) / s
     } else {
+        // Only for `p` below an argument, never on the exact flow's path (its `p ≥ 1 ≥ x, y, z`).
         let s = (-e).sqrt();
         s.atanh() / s
     }

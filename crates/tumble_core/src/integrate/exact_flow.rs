@@ -67,14 +67,14 @@ use crate::elliptic::{
 };
 
 /// `atan x`: the series `x − x³/3 + x⁵/5 − x⁷/7` below `|x| = 10⁻³` (the first term left out,
-/// `x⁹/9`, is below `10⁻¹⁸ |x|`), the platform function above.
+/// `x⁹/9`, is below `10⁻¹⁸ |x|`), tumble's own `atan` above.
 #[inline]
 fn small_atan(x: f64) -> f64 {
     if x.abs() < 1e-3 {
         let x2 = x * x;
         x * (1.0 - x2 * (1.0 / 3.0 - x2 * (1.0 / 5.0 - x2 / 7.0)))
     } else {
-        x.atan()
+        crate::elliptic::atan(x)
     }
 }
 
