@@ -259,3 +259,26 @@ fn gen_many_writes_a_valid_scene() {
     assert!(big.status.success());
     assert!((big.stdout.len() as u64) < tumble_scene::MAX_SCENE_BYTES);
 }
+
+/// The bundled thin plate runs under `exact` without a word; under `splitting` it still runs,
+/// and the planner names `exact` on stderr.
+#[test]
+fn the_thin_plate_runs_exactly_and_splitting_is_told_to_use_exact() {
+    let out = tumble().args(["run", "thin_plate"]).output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(!stderr.contains("WARN"), "{stderr}");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("(exact)"), "{stdout}");
+
+    let out = tumble()
+        .args(["run", "thin_plate", "--integrator", "splitting"])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("body `plate`") && stderr.contains("use `exact`"),
+        "{stderr}"
+    );
+}
