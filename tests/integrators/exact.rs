@@ -174,8 +174,9 @@ fn point_load(state: &BodyState) -> Wrench {
     }
 }
 
-#[test]
-fn with_loads_exact4_is_fourth_order() {
+/// Observed orders of `integrator` under [`point_load`] over 1 s, from the errors at `rates`
+/// steps against `fine` steps of the same method.
+fn observed_orders(integrator: Integrator, rates: [u32; 3], fine: u32) -> Vec<f64> {
     let inertia = Vec3::new(1e-2, 0.05, 0.06);
     let mass = MassProperties::new(Mass::new(1.0).unwrap(), inertia).unwrap();
     let start = BodyState {
@@ -186,48 +187,32 @@ fn with_loads_exact4_is_fourth_order() {
         let dt = 1.0 / steps as Real;
         let mut state = start;
         for _ in 0..steps {
-            Integrator::Exact4.step_with(&mut state, &mass, dt, point_load);
+            integrator.step_with(&mut state, &mass, dt, point_load);
         }
         state
     };
-    // 12 … 48 steps: past the pre-asymptotic 8 (slope 4.4), errors (2e-2 … 8e-5) well above
-    // the f32 rounding of the 384-step reference (≈ 5e-6).
-    let fine = run(384);
-    let errors: Vec<f64> = [12, 24, 48]
+    let fine = run(fine);
+    let errors: Vec<f64> = rates
         .iter()
         .map(|&n| angle_between(run(n).rotation, fine.rotation))
         .collect();
     let orders: Vec<f64> = errors.windows(2).map(|e| (e[0] / e[1]).log2()).collect();
-    eprintln!("exact4: errors {errors:?}, orders {orders:?}");
-    for order in orders {
+    eprintln!("{integrator}: errors {errors:?}, orders {orders:?}");
+    orders
+}
+
+#[test]
+fn with_loads_exact4_is_fourth_order() {
+    // 12 … 48 steps: past the pre-asymptotic 8 (slope 4.4), errors (2e-2 … 8e-5) well above
+    // the f32 rounding of the 384-step reference (≈ 5e-6).
+    for order in observed_orders(Integrator::Exact4, [12, 24, 48], 384) {
         assert!((order - 4.0).abs() < 0.3, "observed order {order}");
     }
 }
 
 #[test]
 fn with_loads_it_is_second_order() {
-    let inertia = Vec3::new(1e-2, 0.05, 0.06);
-    let mass = MassProperties::new(Mass::new(1.0).unwrap(), inertia).unwrap();
-    let start = BodyState {
-        angular_velocity: Vec3::new(2.0, 1.0, -1.5),
-        ..Default::default()
-    };
-    let run = |steps: u32| {
-        let dt = 1.0 / steps as Real;
-        let mut state = start;
-        for _ in 0..steps {
-            Integrator::Exact.step_with(&mut state, &mass, dt, point_load);
-        }
-        state
-    };
-    let fine = run(2048);
-    let errors: Vec<f64> = [16, 32, 64]
-        .iter()
-        .map(|&n| angle_between(run(n).rotation, fine.rotation))
-        .collect();
-    let orders: Vec<f64> = errors.windows(2).map(|e| (e[0] / e[1]).log2()).collect();
-    eprintln!("errors {errors:?}, orders {orders:?}");
-    for order in orders {
+    for order in observed_orders(Integrator::Exact, [16, 32, 64], 2048) {
         assert!((order - 2.0).abs() < 0.3, "observed order {order}");
     }
 }

@@ -199,45 +199,55 @@ fn springs_world(dt: Real, integrator: Integrator, springs: SpringSolver) -> Wor
     w
 }
 
-/// Thin rod (I = (1e-4, 1, 1)) spinning at `|ω|Δt` about a tilted axis.
-fn thin_rod(integrator: Integrator, omega_dt: Real, steps: usize) -> Cell {
+/// One body of principal moments `inertia` spinning at `|ω|Δt = omega_dt` about `axis`, at 60 Hz.
+fn spinning(
+    integrator: Integrator,
+    scene: &str,
+    inertia: Vec3,
+    axis: Vec3,
+    omega_dt: Real,
+    steps: usize,
+) -> Cell {
     let dt = 1.0 / 60.0;
     let mut w = world(dt, integrator);
-    let mass = MassProperties::new(Mass::new(1.0).expect("valid"), Vec3::new(1e-4, 1.0, 1.0))
-        .expect("valid");
-    let axis = Vec3::new(0.3, 1.0, 0.2).normalize();
+    let mass = MassProperties::new(Mass::new(1.0).expect("valid"), inertia).expect("valid");
     w.spawn((
         RigidBody,
         MassProps(mass),
-        Velocity::angular(axis * omega_dt / dt),
+        Velocity::angular(axis.normalize() * omega_dt / dt),
     ));
     run(
         &mut w,
         steps,
-        "thin-rod",
+        scene,
         integrator,
         format!("|ω|Δt = {omega_dt}"),
     )
 }
 
+/// Thin rod (I = (1e-4, 1, 1)) spinning at `|ω|Δt` about a tilted axis.
+fn thin_rod(integrator: Integrator, omega_dt: Real, steps: usize) -> Cell {
+    let rod = Vec3::new(1e-4, 1.0, 1.0);
+    spinning(
+        integrator,
+        "thin-rod",
+        rod,
+        Vec3::new(0.3, 1.0, 0.2),
+        omega_dt,
+        steps,
+    )
+}
+
 /// The thin asymmetric plate ([`crate::thin::PLATE`]) spinning at `|ω|Δt` about a tilted axis.
 fn thin_plate(integrator: Integrator, omega_dt: Real, steps: usize) -> Cell {
-    let dt = 1.0 / 60.0;
-    let mut w = world(dt, integrator);
-    let mass =
-        MassProperties::new(Mass::new(1.0).expect("valid"), crate::thin::PLATE).expect("valid");
-    let axis = Vec3::new(0.3, 1.0, 0.5).normalize();
-    w.spawn((
-        RigidBody,
-        MassProps(mass),
-        Velocity::angular(axis * omega_dt / dt),
-    ));
-    run(
-        &mut w,
-        steps,
-        "thin-plate",
+    let axis = Vec3::new(0.3, 1.0, 0.5);
+    spinning(
         integrator,
-        format!("|ω|Δt = {omega_dt}"),
+        "thin-plate",
+        crate::thin::PLATE,
+        axis,
+        omega_dt,
+        steps,
     )
 }
 
