@@ -49,6 +49,13 @@
 //! `∫ = 2jG(π/2) + G(am(τ₁ − 2jK)) − G(am τ₀)`. Every piece is closed-form, so the flow is exact
 //! to round-off for any span `h` and any spin rate.
 //!
+//! **Short spans** (`|λh| < π/2` and a branch condition, the usual case) skip `τ₀`, `K` and one
+//! `R_J`: the momentum at `τ₀ + λh` comes from Jacobi's addition theorem and the integral from the
+//! addition theorem of the third kind (`Polhode::advance_short`). Every transcendental on the
+//! path is tumble's own (square roots are IEEE; sine, cosine and arctangent are written in IEEE
+//! arithmetic), so a flow gives the same bits on every platform, except exactly on the
+//! separatrix, whose `tanh`/`sech` are the platform's.
+//!
 //! **Degenerate bodies.** A steady spin (`ṁ = 0`: `m` along a principal axis, or in the plane of
 //! two equal moments, or a spherical body) rotates about its fixed axis by `h |r ∘ m|`. Two equal
 //! moments give `m = 0` above (`sn = sin`, the symmetric top's regular precession). A locked axis
