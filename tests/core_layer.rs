@@ -3,6 +3,7 @@
 
 mod core_layer {
     pub mod bad_input;
+    pub mod checksum;
     pub mod determinism;
     pub mod forces;
     // Shapes are built with parry's own vectors, which are tumble's except in an `f64` build

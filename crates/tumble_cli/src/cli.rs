@@ -126,4 +126,9 @@ pub struct RunArgs {
     /// Run even when tumble predicts the step unstable for this scene.
     #[arg(long)]
     pub allow_unstable: bool,
+    /// Print the world's checksum (`WorldChecksum`: 32 hex digits over everything the next step
+    /// depends on) at step 0, at every recorded step (`--every`) and after the last, with the
+    /// summary.
+    #[arg(long)]
+    pub checksum: bool,
 }

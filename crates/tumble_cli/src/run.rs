@@ -164,9 +164,16 @@ pub fn run(args: RunArgs) -> Result<(), Failure> {
     // file is being removed cannot cut that short.
     let guard = interrupt::Guard::poll();
     let bar = progress_bar(steps, built.bodies.len());
+    let mut checksums: Vec<(u64, WorldChecksum)> = Vec::new();
+    if args.checksum {
+        checksums.push((0, world_checksum(&built.world)));
+    }
     let mut on_step = |step: u64, world: &World| {
         if step.is_multiple_of(PROGRESS_EVERY) {
             bar.set_position(step);
+        }
+        if args.checksum && step.is_multiple_of(every.get()) {
+            checksums.push((step, world_checksum(world)));
         }
         reported = report_quarantines(world, &names, step, reported);
         if guard.interrupted() {
@@ -263,6 +270,14 @@ pub fn run(args: RunArgs) -> Result<(), Failure> {
         lines.push(format!(
             "rejected   {rejected} bodies (named above, on stderr)"
         ));
+    }
+    if args.checksum {
+        if checksums.last().is_none_or(|&(step, _)| step != steps) {
+            checksums.push((steps, world_checksum(&built.world)));
+        }
+        for (step, checksum) in &checksums {
+            lines.push(format!("checksum   step {step}: {checksum}"));
+        }
     }
     for line in lines {
         // A closed stdout (`| head`) must not turn a finished run into a panic.

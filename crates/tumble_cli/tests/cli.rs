@@ -282,3 +282,59 @@ fn the_thin_plate_runs_exactly_and_splitting_is_told_to_use_exact() {
         "{stderr}"
     );
 }
+
+/// `--checksum` prints the library's `world_checksum` at step 0, at every recorded step and at
+/// the end, the same on every run; with the trajectory on stdout it goes to stderr with the
+/// summary.
+#[test]
+fn checksum_prints_the_library_checksum_at_every_recorded_step() {
+    let run = || {
+        let out = tumble()
+            .args([
+                "run",
+                &scene_path("spring_chain"),
+                "--steps",
+                "25",
+                "--every",
+                "10",
+                "--checksum",
+            ])
+            .output()
+            .unwrap();
+        assert!(out.status.success());
+        String::from_utf8_lossy(&out.stdout)
+            .lines()
+            .filter(|l| l.starts_with("checksum"))
+            .map(str::to_owned)
+            .collect::<Vec<_>>()
+    };
+    let lines = run();
+    assert_eq!(lines, run(), "two runs, the same checksums");
+    let steps: Vec<&str> = lines
+        .iter()
+        .map(|l| l.split_whitespace().nth(2).unwrap())
+        .collect();
+    assert_eq!(steps, ["0:", "10:", "20:", "25:"]);
+    let scene = load_scene(std::path::Path::new(&scene_path("spring_chain"))).unwrap();
+    let mut built = scene.build();
+    for _ in 0..25 {
+        built.step();
+    }
+    let expected = world_checksum(&built.world).to_string();
+    assert!(lines[3].ends_with(&expected), "{} vs {expected}", lines[3]);
+    // With the CSV on stdout, the checksums go to stderr.
+    let out = tumble()
+        .args([
+            "run",
+            &scene_path("spring_chain"),
+            "--steps",
+            "5",
+            "--checksum",
+            "--out",
+            "-",
+        ])
+        .output()
+        .unwrap();
+    assert!(String::from_utf8_lossy(&out.stderr).contains("checksum   step 5: "));
+    assert!(!String::from_utf8_lossy(&out.stdout).contains("checksum"));
+}

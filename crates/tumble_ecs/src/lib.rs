@@ -13,6 +13,7 @@
 #![allow(clippy::type_complexity)]
 
 pub mod audit;
+pub mod checksum;
 pub mod components;
 pub mod damping;
 pub mod forces;
@@ -34,6 +35,7 @@ pub mod validate;
 /// Everything a game loop needs, in one import.
 pub mod prelude {
     pub use crate::audit::EnergyAudit;
+    pub use crate::checksum::{WorldChecksum, world_checksum};
     pub use crate::components::{
         Damping, ForceAccumulator, Gravity, GravityScale, Kinematic, MassProps, PhysicsSettings,
         RigidBody, Static, Transform, Velocity,

@@ -1,0 +1,235 @@
+//! [`WorldChecksum`]: one 128-bit number for everything the next step depends on, for lockstep
+//! and rollback netcode (a peer compares it frame by frame; GGRS asks for one per frame).
+//!
+//! It is the XXH3-128 hash (seed 0; the `xxhash-rust` crate, whose output is fixed by the
+//! XXH3 specification) of a byte stream laid out in a fixed order, every number by its IEEE
+//! bit pattern in little-endian order:
+//!
+//! 1. the tag `tumble-checksum-1`;
+//! 2. the step settings: `dt`, the integrator's and the spring step's names, the substeps, the
+//!    stage cursor, and gravity (a presence byte, then its vector);
+//! 3. every rigid body, in increasing `Entity::to_bits` order: the entity, `Transform`,
+//!    `Velocity`, `MassProps` (mass, principal moments and frame, centre of mass), then one
+//!    presence byte and the values for each of `ForceAccumulator`, `HeldLoad`, `GravityScale`,
+//!    `Damping`, and one byte each for `Static`, `Kinematic` and `Rejected`;
+//! 4. every force generator, by kind (`ConstantForce`, `ConstantTorque`, `Spring`), each kind
+//!    in increasing entity order, with all its fields.
+//!
+//! Equal worlds give equal checksums on every run, thread count and platform (no pointer, no
+//! iteration order, no `Hash` implementation of std enters it); a world built in `f32` and the
+//! same world in `f64` differ, as their bits do. Derived state the plan recomputes (the spring
+//! classification, scratch buffers) is left out.
+
+use bevy_ecs::prelude::*;
+use tumble_core::math::{Quat, Real, Vec3};
+use xxhash_rust::xxh3::Xxh3;
+
+use crate::components::{
+    Damping, ForceAccumulator, Gravity, GravityScale, HeldLoad, Kinematic, MassProps,
+    PhysicsSettings, RigidBody, Static, Transform, Velocity,
+};
+use crate::forces::{ConstantForce, ConstantTorque, Spring, SpringEnd};
+use crate::stages::StageCursor;
+use crate::validate::Rejected;
+
+/// The checksum of a world's step-affecting state (module docs): print it as 32 hex digits
+/// (`{}`), or take the number.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct WorldChecksum(pub u128);
+
+impl std::fmt::Display for WorldChecksum {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{:032x}", self.0)
+    }
+}
+
+/// The byte stream of the module docs, fed to XXH3.
+struct Stream(Xxh3);
+
+impl Stream {
+    fn bytes(&mut self, bytes: &[u8]) {
+        self.0.update(bytes);
+    }
+
+    fn real(&mut self, x: Real) {
+        self.bytes(&x.to_bits().to_le_bytes());
+    }
+
+    fn vec3(&mut self, v: Vec3) {
+        for x in v.to_array() {
+            self.real(x);
+        }
+    }
+
+    fn quat(&mut self, q: Quat) {
+        for x in q.to_array() {
+            self.real(x);
+        }
+    }
+
+    fn entity(&mut self, e: Entity) {
+        self.bytes(&e.to_bits().to_le_bytes());
+    }
+
+    fn flag(&mut self, present: bool) {
+        self.bytes(&[u8::from(present)]);
+    }
+
+    fn text(&mut self, s: &str) {
+        self.bytes(&(s.len() as u64).to_le_bytes());
+        self.bytes(s.as_bytes());
+    }
+}
+
+/// The checksum of `world` (see the module docs).
+pub fn world_checksum(world: &World) -> WorldChecksum {
+    let mut out = Stream(Xxh3::new());
+    out.text("tumble-checksum-1");
+    settings(world, &mut out);
+    bodies(world, &mut out);
+    generators(world, &mut out);
+    WorldChecksum(out.0.digest128())
+}
+
+fn settings(world: &World, out: &mut Stream) {
+    let settings = world.get_resource::<PhysicsSettings>();
+    out.flag(settings.is_some());
+    if let Some(s) = settings {
+        out.real(s.dt());
+        out.text(s.integrator.name());
+        out.text(s.springs.name());
+        out.bytes(&s.substeps.get().to_le_bytes());
+    }
+    let cursor = world
+        .get_resource::<StageCursor>()
+        .copied()
+        .unwrap_or_default();
+    out.bytes(&(cursor.index() as u64).to_le_bytes());
+    let gravity = world.get_resource::<Gravity>();
+    out.flag(gravity.is_some());
+    if let Some(g) = gravity {
+        out.vec3(g.0);
+    }
+}
+
+/// Sorted by entity bits, so that archetype and table order (which follow insertion history)
+/// do not enter the checksum.
+fn sorted<T>(mut items: Vec<(Entity, T)>) -> Vec<(Entity, T)> {
+    items.sort_unstable_by_key(|(e, _)| e.to_bits());
+    items
+}
+
+/// `(entity, item)` of every match of a read-only query, in increasing entity order; empty
+/// when a component of the query was never registered (no entity can have it).
+fn rows<D, F, T>(world: &World, item: impl Fn(D::Item<'_, '_>) -> (Entity, T)) -> Vec<(Entity, T)>
+where
+    D: bevy_ecs::query::ReadOnlyQueryData,
+    F: bevy_ecs::query::QueryFilter,
+{
+    let Some(mut query) = world.try_query_filtered::<D, F>() else {
+        return Vec::new();
+    };
+    sorted(query.iter(world).map(item).collect())
+}
+
+fn bodies(world: &World, out: &mut Stream) {
+    // The optional parts by entity lookup: a query naming a component no entity ever had finds
+    // nothing at all (`try_query` needs every component registered).
+    let rows = rows::<(Entity, &Transform, &Velocity, &MassProps), With<RigidBody>, _>(
+        world,
+        |(e, t, v, m)| {
+            let entity = world.entity(e);
+            (
+                e,
+                (
+                    *t,
+                    *v,
+                    *m,
+                    entity.get::<ForceAccumulator>().copied(),
+                    entity.get::<HeldLoad>().copied(),
+                    entity.get::<GravityScale>().copied(),
+                    entity.get::<Damping>().copied(),
+                    (
+                        entity.contains::<Static>(),
+                        entity.contains::<Kinematic>(),
+                        entity.contains::<Rejected>(),
+                    ),
+                ),
+            )
+        },
+    );
+    out.bytes(&(rows.len() as u64).to_le_bytes());
+    for (e, (t, v, m, acc, held, scale, damping, (fixed, kinematic, rejected))) in rows {
+        out.entity(e);
+        out.vec3(t.translation);
+        out.quat(t.rotation);
+        out.vec3(v.linear);
+        out.vec3(v.angular);
+        out.real(m.mass());
+        out.vec3(m.principal_inertia());
+        out.quat(m.principal_frame());
+        out.vec3(m.local_center_of_mass());
+        out.flag(acc.is_some());
+        if let Some(a) = acc {
+            out.vec3(a.force);
+            out.vec3(a.torque);
+        }
+        out.flag(held.is_some());
+        if let Some(h) = held {
+            out.vec3(h.force);
+            out.vec3(h.torque);
+        }
+        out.flag(scale.is_some());
+        if let Some(s) = scale {
+            out.real(s.0);
+        }
+        out.flag(damping.is_some());
+        if let Some(d) = damping {
+            out.real(d.linear);
+            out.real(d.angular);
+        }
+        out.flag(fixed);
+        out.flag(kinematic);
+        out.flag(rejected);
+    }
+}
+
+fn generators(world: &World, out: &mut Stream) {
+    let forces = rows::<(Entity, &ConstantForce), (), _>(world, |(e, f)| (e, *f));
+    out.bytes(&(forces.len() as u64).to_le_bytes());
+    for (e, f) in forces {
+        out.entity(e);
+        out.entity(f.body);
+        out.vec3(f.force);
+        out.flag(f.local_point.is_some());
+        out.vec3(f.local_point.unwrap_or(Vec3::ZERO));
+    }
+    let torques = rows::<(Entity, &ConstantTorque), (), _>(world, |(e, t)| (e, *t));
+    out.bytes(&(torques.len() as u64).to_le_bytes());
+    for (e, t) in torques {
+        out.entity(e);
+        out.entity(t.body);
+        out.vec3(t.torque);
+    }
+    let springs = rows::<(Entity, &Spring), (), _>(world, |(e, s)| (e, *s));
+    out.bytes(&(springs.len() as u64).to_le_bytes());
+    for (e, s) in springs {
+        out.entity(e);
+        out.entity(s.a);
+        out.vec3(s.anchor_a);
+        match s.b {
+            SpringEnd::World(point) => {
+                out.flag(false);
+                out.vec3(point);
+            }
+            SpringEnd::Body { body, anchor } => {
+                out.flag(true);
+                out.entity(body);
+                out.vec3(anchor);
+            }
+        }
+        out.real(s.stiffness);
+        out.real(s.damping);
+        out.real(s.rest_length);
+    }
+}

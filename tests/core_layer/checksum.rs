@@ -1,0 +1,208 @@
+//! `WorldChecksum`: the same for the same world on every run, thread count and kernel path,
+//! different for any change of a step-affecting bit, blind to storage order; and pinned for a
+//! reference scene under every integrator, so that a change of tumble's bits cannot go unnoticed.
+
+use tumble::bevy_ecs::prelude::*;
+use tumble::math::{DOUBLE_PRECISION, Quat, Real, Vec3};
+use tumble::prelude::*;
+
+use super::util::{mass_props, run, world_with};
+
+/// The reference scene: a chain of ten asymmetric bodies (a thin plate and a body with a locked
+/// axis among them) joined by springs at off-centre anchors, forces at body points, a torque,
+/// gravity with one body scaled, damping on one, at 60 Hz.
+fn reference_world(integrator: Integrator) -> World {
+    let mut world = world_with(1.0 / 60.0, integrator);
+    world.insert_resource(Gravity(Vec3::new(0.0, -9.81, 0.0)));
+    let mut bodies = Vec::new();
+    for i in 0..10u32 {
+        let f = i as Real;
+        let inertia = match i % 4 {
+            0 => [0.01, 1.0, 1.01],
+            1 => [0.3, 0.5, 0.7],
+            2 => [0.0, 0.4, 0.45],
+            _ => [0.2, 0.2, 0.35],
+        };
+        let body = world
+            .spawn((
+                RigidBody,
+                mass_props(1.0 + 0.1 * f, inertia),
+                Transform {
+                    translation: Vec3::new(f, 0.2 * f, 0.0),
+                    rotation: Quat::from_rotation_y(0.3 * f),
+                },
+                Velocity {
+                    linear: Vec3::new(0.0, 0.5, 0.1 * f),
+                    angular: Vec3::new(1.0, 2.0 - 0.2 * f, 0.5),
+                },
+            ))
+            .id();
+        bodies.push(body);
+    }
+    world.entity_mut(bodies[3]).insert(GravityScale(0.5));
+    world.entity_mut(bodies[5]).insert(Damping {
+        linear: 0.3,
+        angular: 0.2,
+    });
+    for pair in bodies.windows(2) {
+        world.spawn(Spring {
+            a: pair[0],
+            anchor_a: Vec3::new(0.2, 0.1, 0.0),
+            b: SpringEnd::Body {
+                body: pair[1],
+                anchor: Vec3::new(-0.2, 0.0, 0.1),
+            },
+            stiffness: 40.0,
+            damping: 0.1,
+            rest_length: 0.9,
+        });
+    }
+    world.spawn(ConstantForce {
+        body: bodies[7],
+        force: Vec3::new(0.0, 0.0, 2.0),
+        local_point: Some(Vec3::new(0.3, 0.0, 0.0)),
+    });
+    world.spawn(ConstantTorque {
+        body: bodies[2],
+        torque: Vec3::new(0.1, 0.0, -0.2),
+    });
+    world
+}
+
+fn checksum_after(integrator: Integrator, steps: usize) -> WorldChecksum {
+    let mut world = reference_world(integrator);
+    run(&mut world, steps);
+    world_checksum(&world)
+}
+
+#[test]
+fn equal_worlds_have_equal_checksums_and_any_changed_bit_shows() {
+    let mut a = reference_world(Integrator::Splitting);
+    let mut b = reference_world(Integrator::Splitting);
+    assert_eq!(world_checksum(&a), world_checksum(&b));
+    assert_eq!(
+        checksum_after(Integrator::Splitting, 30),
+        checksum_after(Integrator::Splitting, 30)
+    );
+    assert_ne!(
+        checksum_after(Integrator::Splitting, 30),
+        checksum_after(Integrator::Splitting, 31)
+    );
+    let before = world_checksum(&a);
+    // One ulp of one body's angular velocity.
+    let body = a
+        .query_filtered::<Entity, With<RigidBody>>()
+        .iter(&a)
+        .nth(4)
+        .unwrap();
+    let mut velocity = a.get_mut::<Velocity>(body).unwrap();
+    velocity.angular.x = Real::from_bits(velocity.angular.x.to_bits() + 1);
+    assert_ne!(world_checksum(&a), before);
+    // A resource: the integrator; gravity.
+    let c = reference_world(Integrator::Yoshida4);
+    assert_ne!(world_checksum(&c), before);
+    b.insert_resource(Gravity(Vec3::new(0.0, -9.8, 0.0)));
+    assert_ne!(world_checksum(&b), before);
+}
+
+#[test]
+fn storage_order_does_not_enter_the_checksum() {
+    let plain = reference_world(Integrator::Splitting);
+    let mut moved = reference_world(Integrator::Splitting);
+    // A marker added and removed moves the body to another table and back, to another row.
+    let body = moved
+        .query_filtered::<Entity, With<RigidBody>>()
+        .iter(&moved)
+        .next()
+        .unwrap();
+    #[derive(Component)]
+    struct Marker;
+    moved.entity_mut(body).insert(Marker);
+    moved.entity_mut(body).remove::<Marker>();
+    assert_eq!(world_checksum(&plain), world_checksum(&moved));
+}
+
+#[test]
+fn the_thread_count_does_not_change_the_checksum() {
+    for integrator in [Integrator::Splitting, Integrator::Exact] {
+        let checksums: Vec<WorldChecksum> = [Parallelism::SINGLE_THREAD, Parallelism::default()]
+            .into_iter()
+            .map(|parallelism| {
+                let mut world = reference_world(integrator);
+                world.insert_resource(parallelism);
+                run(&mut world, 60);
+                world_checksum(&world)
+            })
+            .collect();
+        assert_eq!(checksums[0], checksums[1], "{integrator}");
+    }
+}
+
+/// The reference scene after 120 steps (2 s) under every integrator, on every kernel path (CI
+/// runs this suite on the widest path and again with `TUMBLE_KERNEL=portable`).
+///
+/// **A failure here means tumble's results changed bits.** Users' recorded replays and lockstep
+/// peers on the old version no longer agree with the new one, so a change must be deliberate:
+/// say so in the change log, then re-pin by running
+/// `cargo test --test core_layer pinned -- --nocapture` (and with `--features tumble/f64`) and
+/// copying the printed table.
+#[test]
+fn pinned_checksums_of_the_reference_scene() {
+    let pinned: &[(&str, &str)] = if DOUBLE_PRECISION {
+        PINNED_F64
+    } else {
+        PINNED_F32
+    };
+    let measured: Vec<(String, String)> = Integrator::ALL
+        .iter()
+        .map(|&i| (i.name().to_owned(), checksum_after(i, 120).to_string()))
+        .collect();
+    for (name, checksum) in &measured {
+        println!("        (\"{name}\", \"{checksum}\"),");
+    }
+    for ((name, checksum), (pinned_name, pinned_checksum)) in measured.iter().zip(pinned) {
+        assert_eq!(name, pinned_name);
+        assert_eq!(
+            checksum, pinned_checksum,
+            "`{name}` changed its bits (see this test's docs before re-pinning)"
+        );
+    }
+    assert_eq!(
+        measured.len(),
+        pinned.len(),
+        "an integrator was added: pin it"
+    );
+}
+
+/// `f32` build (the default).
+const PINNED_F32: &[(&str, &str)] = &[
+    ("symplectic-euler", "a636b5f0afc75c797e54658852a4d414"),
+    (
+        "symplectic-euler-linear",
+        "ba8e3de0accd3f8ea72a3af0f5f4a216",
+    ),
+    ("lclamp", "8d38fcdd5afe04966fca0865b1834d78"),
+    ("implicit-gyroscopic", "3b52bf318deb11ac7a770d41526832ba"),
+    ("splitting", "1f78368c6edfc13106925f2b3a9694a5"),
+    ("splitting-xyz", "63fcd42da0020a33909db3d6adc3fa03"),
+    ("yoshida4", "42aa1b5ccc75f2d66ba4152c26ee96ed"),
+    ("rk4", "12c5bf9f4b0ff9fcb47375d2912938f8"),
+    ("exact", "c9baebd073b06b9ecffb4099b4346768"),
+    ("exact4", "181df44813dfd05195d19d99b7a8636e"),
+];
+/// `f64` build.
+const PINNED_F64: &[(&str, &str)] = &[
+    ("symplectic-euler", "d2ddba69d5fb5298108768181d9eb9e4"),
+    (
+        "symplectic-euler-linear",
+        "59898b4711fef275a1ad8df3b49e0430",
+    ),
+    ("lclamp", "6e1bff3ecb7f24b36a6b3e2713b8cdd4"),
+    ("implicit-gyroscopic", "98c3a384265e955d0a619173acfa8db7"),
+    ("splitting", "7f1db5400c6f82e7348ee526ee00184b"),
+    ("splitting-xyz", "a19f945aa496bce3e42fd112e8a4f680"),
+    ("yoshida4", "1810728fe5544054e1504159272a69a4"),
+    ("rk4", "a7491b2f0ab1c96c0efb5bf6183d7f4d"),
+    ("exact", "df4de84180d3e03a675881e2fc80fa5a"),
+    ("exact4", "5551a1cce4a6e166a934298ff5484c0c"),
+];
