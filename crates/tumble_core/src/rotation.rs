@@ -1,7 +1,7 @@
 //! Quaternion helpers: the exponential map and its linearization (internal to the integrators),
 //! and the angle between two orientations.
 
-use crate::math::{Quat, Real, Vec3, Widen};
+use crate::math::{Narrow, Quat, Real, Vec3, Widen};
 /// The unit quaternion of a rotation by the vector `θ` (axis `θ/|θ|`, angle `|θ|`):
 /// `exp(½ θ) = (sin(|θ|/2) θ/|θ|, cos(|θ|/2))`, exact for every angle.
 ///
@@ -15,7 +15,10 @@ pub(crate) fn exp_rotation(theta: Vec3) -> Quat {
         Quat::from_xyzw(xyz.x, xyz.y, xyz.z, 1.0 - angle2 / 8.0)
     } else {
         let angle = angle2.sqrt();
-        let (s, c) = (0.5 * angle).sin_cos();
+        // tumble's own sine and cosine (IEEE arithmetic only, in f64, rounded once): the same
+        // bits on every platform, where `f32::sin_cos` follows the platform's libm.
+        let (s, c) = crate::integrate::sin_cos((0.5 * angle).widen());
+        let (s, c) = (s.narrow(), c.narrow());
         let xyz = theta * (s / angle);
         Quat::from_xyzw(xyz.x, xyz.y, xyz.z, c)
     }

@@ -75,7 +75,8 @@ impl FreeBody {
     /// and the body momentum the opposite way, `m ← exp(−θ eₐ) m`, so `L = Q m` is unchanged.
     #[inline]
     pub fn rotate_about_axis(&mut self, axis: usize, angle: f64) {
-        let (s, c) = (0.5 * angle).sin_cos();
+        // tumble's own sine and cosine: the same bits on every platform.
+        let (s, c) = super::sin_cos(0.5 * angle);
         // cos θ and sin θ from the half angle: one sin_cos per rotation.
         let (cos, sin) = (c * c - s * s, 2.0 * s * c);
         let m = self.m;
