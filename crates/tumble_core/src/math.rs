@@ -19,7 +19,7 @@
 //! assert_eq!(length, 3.0);
 //! ```
 
-use glam::{DQuat, DVec3};
+use glam::{DMat3, DQuat, DVec3};
 
 #[cfg(not(feature = "f64"))]
 mod precision {
@@ -176,5 +176,29 @@ mod tests {
         assert_eq!(third, expected);
         assert!(Real::EPSILON.widen() > 1e-17);
         assert_eq!(DOUBLE_PRECISION, Real::EPSILON < 1e-10);
+    }
+}
+
+/// The axial vector of a 3×3 matrix `X`, `Tₖ = εₖₐᵦ Xₐᵦ`: `(X₂₃ − X₃₂, X₃₁ − X₁₃, X₁₂ − X₂₁)`
+/// (twice the axial vector of its antisymmetric part). For `X = Σ aᵢ Fᵢᵀ` it is `Σ aᵢ × Fᵢ`: the
+/// torque of forces `Fᵢ` at arms `aᵢ`.
+#[inline]
+pub fn axial_vector(x: DMat3) -> DVec3 {
+    DVec3::new(
+        x.z_axis.y - x.y_axis.z,
+        x.x_axis.z - x.z_axis.x,
+        x.y_axis.x - x.x_axis.y,
+    )
+}
+
+#[cfg(test)]
+mod axial_tests {
+    use glam::{DMat3, DVec3};
+
+    #[test]
+    fn axial_vector_of_an_outer_product_is_the_cross_product() {
+        let (a, f) = (DVec3::new(0.3, -1.2, 2.0), DVec3::new(-0.7, 0.4, 1.1));
+        let x = DMat3::from_cols(a * f.x, a * f.y, a * f.z);
+        assert!((super::axial_vector(x) - a.cross(f)).length() < 1e-15);
     }
 }

@@ -131,13 +131,8 @@ impl ImplicitBody {
 
     /// The torque `Σ (R aᵢ) × Fᵢ` of the recorded point forces with the body at `rotation`.
     pub(crate) fn point_torque(&self, rotation: tumble_core::math::Quat) -> Vec3 {
-        let x = DMat3::from_quat(rotation.widen()) * self.load_moment;
-        DVec3::new(
-            x.z_axis.y - x.y_axis.z,
-            x.x_axis.z - x.z_axis.x,
-            x.y_axis.x - x.x_axis.y,
-        )
-        .narrow()
+        tumble_core::math::axial_vector(DMat3::from_quat(rotation.widen()) * self.load_moment)
+            .narrow()
     }
 }
 

@@ -355,13 +355,7 @@ fn point_torque(s: &Start, half: DQuat) -> DVec3 {
     let turn = DMat3::from_quat(half);
     let arm = 0.5 * (turn + turn.transpose());
     let mid = s.r * turn;
-    let x = arm * s.moment * mid;
-    s.free
-        * DVec3::new(
-            x.z_axis.y - x.y_axis.z,
-            x.x_axis.z - x.z_axis.x,
-            x.y_axis.x - x.x_axis.y,
-        )
+    s.free * crate::math::axial_vector(arm * s.moment * mid)
 }
 
 /// normalized, half the angle about the same axis, without trigonometry.
