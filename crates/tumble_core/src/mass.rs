@@ -4,7 +4,7 @@
 //! expected (or the reverse).
 
 use crate::error::{InvalidInput, check_finite_vec3, check_unit_quat};
-use crate::math::{Quat, Real, Vec3, to_f64};
+use crate::math::{Quat, Real, Vec3, quat_mul, quat_normalize, quat_rotate, to_f64};
 
 /// Smallest accepted mass or nonzero principal moment: the smallest normal [`Real`]
 /// (`2⁻¹²⁶ ≈ 1.2e-38` in `f32`, `2⁻¹⁰²² ≈ 2.2e-308` in `f64`). Below it the reciprocal the
@@ -215,7 +215,7 @@ impl MassProperties {
     /// Sets the rotation `P` from the principal axes to body coordinates (unit quaternion).
     pub fn with_principal_frame(mut self, frame: Quat) -> Result<Self, InvalidInput> {
         check_unit_quat("principal frame", frame)?;
-        self.principal_frame = frame.normalize();
+        self.principal_frame = quat_normalize(frame);
         Ok(self)
     }
 
@@ -281,15 +281,21 @@ impl MassProperties {
     /// `body_rotation` is `R` (body → world).
     #[inline]
     pub fn world_inv_inertia_mul(&self, body_rotation: Quat, world: Vec3) -> Vec3 {
-        let frame = body_rotation * self.principal_frame;
-        frame * (self.inv_principal_inertia * (frame.inverse() * world))
+        let frame = quat_mul(body_rotation, self.principal_frame);
+        quat_rotate(
+            frame,
+            self.inv_principal_inertia * quat_rotate(frame.inverse(), world),
+        )
     }
 
     /// Applies the world inertia `(R P) I_b (R P)ᵀ` to a world vector (e.g. `L = I ω`).
     #[inline]
     pub fn world_inertia_mul(&self, body_rotation: Quat, world: Vec3) -> Vec3 {
-        let frame = body_rotation * self.principal_frame;
-        frame * (self.principal_inertia * (frame.inverse() * world))
+        let frame = quat_mul(body_rotation, self.principal_frame);
+        quat_rotate(
+            frame,
+            self.principal_inertia * quat_rotate(frame.inverse(), world),
+        )
     }
 }
 

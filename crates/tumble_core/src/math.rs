@@ -179,6 +179,26 @@ mod tests {
     }
 }
 
+/// `a b` (apply `b`, then `a`), computed in f64 and rounded once: the same bits whether glam
+/// runs its SIMD or its scalar `Quat` code (the `enhanced-determinism` feature), whose `f32`
+/// products sum in different orders. In `f64` it is glam's `DQuat` product, scalar either way.
+#[inline]
+pub fn quat_mul(a: Quat, b: Quat) -> Quat {
+    (a.widen() * b.widen()).narrow()
+}
+
+/// `q v` (the rotation of `v` by the unit quaternion `q`), as [`quat_mul`]: f64, one rounding.
+#[inline]
+pub fn quat_rotate(q: Quat, v: Vec3) -> Vec3 {
+    (q.widen() * v.widen()).narrow()
+}
+
+/// `q / |q|`, as [`quat_mul`]: f64, one rounding.
+#[inline]
+pub fn quat_normalize(q: Quat) -> Quat {
+    q.widen().normalize().narrow()
+}
+
 /// The axial vector of a 3×3 matrix `X`, `Tₖ = εₖₐᵦ Xₐᵦ`: `(X₂₃ − X₃₂, X₃₁ − X₁₃, X₁₂ − X₂₁)`
 /// (twice the axial vector of its antisymmetric part). For `X = Σ aᵢ Fᵢᵀ` it is `Σ aᵢ × Fᵢ`: the
 /// torque of forces `Fᵢ` at arms `aᵢ`.

@@ -1,7 +1,7 @@
 //! Quaternion helpers: the exponential map and its linearization (internal to the integrators),
 //! and the angle between two orientations.
 
-use crate::math::{Narrow, Quat, Real, Vec3, Widen};
+use crate::math::{Narrow, Quat, Real, Vec3, Widen, quat_mul, quat_normalize};
 /// The unit quaternion of a rotation by the vector `θ` (axis `θ/|θ|`, angle `|θ|`):
 /// `exp(½ θ) = (sin(|θ|/2) θ/|θ|, cos(|θ|/2))`, exact for every angle.
 ///
@@ -28,7 +28,7 @@ pub(crate) fn exp_rotation(theta: Vec3) -> Quat {
 /// `q ← exp(½ Δt ω) q`, then renormalizes to remove round-off.
 #[inline]
 pub(crate) fn rotate_exact(q: Quat, omega: Vec3, dt: Real) -> Quat {
-    (exp_rotation(omega * dt) * q).normalize()
+    quat_normalize(quat_mul(exp_rotation(omega * dt), q))
 }
 
 /// The linearized update `q ← normalize(q + ½ Δt (ω, 0) q)`: first-order, its error grows with
@@ -36,7 +36,7 @@ pub(crate) fn rotate_exact(q: Quat, omega: Vec3, dt: Real) -> Quat {
 #[inline]
 pub(crate) fn rotate_linearized(q: Quat, omega: Vec3, dt: Real) -> Quat {
     let w = Quat::from_xyzw(omega.x, omega.y, omega.z, 0.0);
-    (q + (w * q) * (0.5 * dt)).normalize()
+    quat_normalize(q + quat_mul(w, q) * (0.5 * dt))
 }
 
 /// Rotation angle between two orientations, in radians (0..π): the angle of `a* b`, computed as

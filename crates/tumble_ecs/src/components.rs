@@ -2,7 +2,7 @@
 
 use crate::stiff::SpringSolver;
 use bevy_ecs::prelude::*;
-use tumble_core::math::{Quat, Real, Vec3, Widen};
+use tumble_core::math::{Quat, Real, Vec3, Widen, quat_rotate};
 
 use std::num::NonZeroU32;
 use tumble_core::integrate::Stages;
@@ -87,13 +87,13 @@ impl Transform {
     /// World position of the centre of mass: `x = t + R c`.
     #[inline]
     pub fn center_of_mass(&self, mass: &MassProps) -> Vec3 {
-        self.translation + self.rotation * mass.local_center_of_mass()
+        self.translation + quat_rotate(self.rotation, mass.local_center_of_mass())
     }
 
     /// Maps a body-local point to world coordinates: `t + R p`.
     #[inline]
     pub fn transform_point(&self, local: Vec3) -> Vec3 {
-        self.translation + self.rotation * local
+        self.translation + quat_rotate(self.rotation, local)
     }
 }
 
@@ -409,7 +409,7 @@ impl Default for PhysicsSettings {
 #[inline]
 fn com_offset(rotation: Quat, mass: &MassProps) -> Option<Vec3> {
     let c = mass.local_center_of_mass();
-    (c != Vec3::ZERO).then(|| rotation * c)
+    (c != Vec3::ZERO).then(|| quat_rotate(rotation, c))
 }
 
 /// Kinetic energy `½ m |v|² + ½ ωᵀ I ω` (J) of a body, in `f64` (energy balances sum many

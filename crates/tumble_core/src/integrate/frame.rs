@@ -52,7 +52,7 @@ pub fn rotate_inv(q: Quat, v: Vec3) -> Vec3 {
 /// Orientation of the principal axes in the world: `Q = q P`.
 #[inline]
 pub fn principal_orientation(state: &BodyState, mass: &MassProperties) -> Quat {
-    state.rotation * mass.principal_frame()
+    crate::math::quat_mul(state.rotation, mass.principal_frame())
 }
 
 /// Removes the angular velocity about locked principal axes (zero moment ⇒ no rotation about

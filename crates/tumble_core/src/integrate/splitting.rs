@@ -158,7 +158,7 @@ pub fn rotate_freely(state: &mut BodyState, mass: &MassProperties, h: Real, flow
     flow(&mut body, r, h.widen());
     let q = body.q.normalize();
     state.angular_velocity = rotate64(q, r * body.m).narrow();
-    state.rotation = (q * frame.conjugate()).narrow().normalize();
+    state.rotation = crate::math::quat_normalize((q * frame.conjugate()).narrow());
 }
 
 /// Kick for `h`: `v += h F/m`, `L += h τ` (so `ω += h I⁻¹ τ` at the current pose).

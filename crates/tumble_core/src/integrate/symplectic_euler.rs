@@ -15,7 +15,7 @@
 
 use super::frame::clear_locked_axes;
 use crate::mass::MassProperties;
-use crate::math::{Real, Vec3};
+use crate::math::{Real, Vec3, quat_mul, quat_rotate};
 use crate::rotation::{rotate_exact, rotate_linearized};
 use crate::state::{BodyState, Wrench};
 
@@ -33,14 +33,14 @@ pub fn explicit_gyroscopic_kick(
     torque: Vec3,
     dt: Real,
 ) {
-    let frame = state.rotation * mass.principal_frame();
+    let frame = quat_mul(state.rotation, mass.principal_frame());
     let to_principal = frame.conjugate();
-    let mut rate = to_principal * torque;
+    let mut rate = quat_rotate(to_principal, torque);
     if !mass.is_spherical() {
-        let omega = to_principal * state.angular_velocity;
+        let omega = quat_rotate(to_principal, state.angular_velocity);
         rate -= omega.cross(mass.principal_inertia() * omega);
     }
-    state.angular_velocity += frame * (dt * mass.inv_principal_inertia() * rate);
+    state.angular_velocity += quat_rotate(frame, dt * mass.inv_principal_inertia() * rate);
 }
 
 #[inline]

@@ -5,13 +5,14 @@ use crate::error::UNIT_QUATERNION_TOLERANCE;
 use crate::mass::Mass;
 use crate::math::{Quat, Vec3, Widen};
 
-/// A ball spinning so fast that the linearized rotation update `q + ½Δt (ω, 0) q` overflows
-/// `|q|²`: `normalize` then scales by `1/√∞ = 0` and returns the zero quaternion, a finite
-/// state that is no rotation at all.
+/// A ball flying so fast from so far out that one step carries its position past the largest
+/// finite number: the step's result is not finite.
 fn overspun_ball() -> (BodyState, MassProperties) {
     let mass = MassProperties::new(Mass::new(1.0).unwrap(), Vec3::ONE).unwrap();
     let state = BodyState {
-        angular_velocity: Vec3::new(1.0, -0.5, 0.25) * (Real::MAX.sqrt() * 1e3),
+        position: Vec3::splat(Real::MAX),
+        linear_velocity: Vec3::splat(Real::MAX),
+        angular_velocity: Vec3::new(1.0, -0.5, 0.25),
         ..BodyState::default()
     };
     (state, mass)
@@ -28,17 +29,22 @@ fn calm_body(i: usize) -> BodyState {
 }
 
 #[test]
-fn the_overspun_ball_steps_to_a_finite_zero_quaternion() {
-    // The premise of the tests below: the old check (finite only) would commit this state.
+fn the_overspun_ball_steps_to_an_invalid_state_and_a_zero_quaternion_is_invalid() {
+    // The premise of the tests below: stepped without the check, the state is not valid.
     let (mut state, mass) = overspun_ball();
     Integrator::SymplecticEulerLinear.step(&mut state, &mass, &Wrench::ZERO, 1.0 / 60.0);
-    assert!(state.is_finite());
-    assert_eq!(state.rotation.length(), 0.0);
-    assert!(!state.is_valid());
+    assert!(!state.is_finite() && !state.is_valid());
+    // A finite state whose rotation is no rotation at all is invalid too (the linearized update
+    // used to produce one by overflowing `|q|²` in f32; its products are now formed in f64).
+    let zero = BodyState {
+        rotation: Quat::from_xyzw(0.0, 0.0, 0.0, 0.0),
+        ..BodyState::default()
+    };
+    assert!(zero.is_finite() && !zero.is_valid());
 }
 
 #[test]
-fn a_non_unit_rotation_after_a_step_is_a_divergence_on_the_scalar_path() {
+fn an_invalid_state_after_a_step_is_a_divergence_on_the_scalar_path() {
     let dt = 1.0 / 60.0;
     let (before, mass) = overspun_ball();
     let integrator = Integrator::SymplecticEulerLinear;
@@ -56,7 +62,7 @@ fn a_non_unit_rotation_after_a_step_is_a_divergence_on_the_scalar_path() {
 }
 
 #[test]
-fn a_non_unit_rotation_after_a_step_is_a_divergence_on_the_batched_path() {
+fn an_invalid_state_after_a_step_is_a_divergence_on_the_batched_path() {
     let dt = 1.0 / 60.0;
     let (overspun, ball) = overspun_ball();
     let integrator = Integrator::SymplecticEulerLinear;

@@ -624,9 +624,7 @@ impl ImplicitSpringSolver {
         self.starts.clear();
         for body in bodies {
             let m = &body.mass;
-            let q = (body.state.rotation * m.principal_frame())
-                .widen()
-                .normalize();
+            let q = (body.state.rotation.widen() * m.principal_frame().widen()).normalize();
             let inertia = m.principal_inertia().widen();
             let free = DVec3::select(inertia.cmpgt(DVec3::ZERO), DVec3::ONE, DVec3::ZERO);
             let omega = q.inverse() * body.state.angular_velocity.widen();
@@ -1070,7 +1068,7 @@ impl ImplicitSpringSolver {
             let rotation = (q1 * body.mass.principal_frame().widen().inverse()).normalize();
             let state = BodyState {
                 position: end.x.narrow(),
-                rotation: rotation.narrow().normalize(),
+                rotation: crate::math::quat_normalize(rotation.narrow()),
                 linear_velocity: end.v.narrow(),
                 angular_velocity: end.w.narrow(),
             };
