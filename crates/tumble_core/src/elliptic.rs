@@ -22,6 +22,24 @@ mod carlson;
 
 pub(crate) use arctan::{atan, atan2};
 
+/// `√(x² + y²)`, without the cost of `hypot` (more than `R_F`'s first duplication) where the
+/// squares cannot underflow or overflow.
+#[inline]
+pub(crate) fn norm2(x: f64, y: f64) -> f64 {
+    let sum = x * x + y * y;
+    if (1e-290..1e290).contains(&sum) {
+        sum.sqrt()
+    } else {
+        x.hypot(y)
+    }
+}
+
+/// `±1` by the sign bit, `+1` for `+0`.
+#[inline]
+pub(crate) fn sign(x: f64) -> f64 {
+    if x < 0.0 { -1.0 } else { 1.0 }
+}
+
 pub use carlson::{carlson_rc1, carlson_rf, carlson_rj, integral_sn2_over};
 
 use std::f64::consts::{FRAC_PI_2, PI};
@@ -200,14 +218,7 @@ pub fn incomplete_f_complement(phi: f64, m: f64, m1: f64) -> f64 {
 /// should use this form. A negative `cos φ` is treated as zero.
 pub fn incomplete_f_sin_cos(sin_phi: f64, cos_phi: f64, m: f64, m1: f64) -> f64 {
     let (m, m1) = (clamp_parameter(m), clamp_parameter(m1));
-    let sum = sin_phi * sin_phi + cos_phi * cos_phi;
-    // `hypot` only where the squares could underflow or overflow (it costs more than R_F's
-    // first duplication).
-    let r = if (1e-290..1e290).contains(&sum) {
-        sum.sqrt()
-    } else {
-        sin_phi.hypot(cos_phi)
-    };
+    let r = norm2(sin_phi, cos_phi);
     if r == 0.0 {
         return 0.0;
     }

@@ -71,7 +71,9 @@ use std::f64::consts::{FRAC_PI_3, TAU};
 use glam::{DMat3, DQuat, DVec3};
 
 use super::{ExactError, ORIENTATION_TOLERANCE};
-use crate::elliptic::{complete_k_complement, incomplete_f_sin_cos, jacobi_sn_cn_dn_complement};
+use crate::elliptic::{
+    complete_k_complement, incomplete_f_sin_cos, jacobi_sn_cn_dn_complement, sign,
+};
 
 /// 10-point Gauss–Legendre nodes on [−1, 1] (positive half) and their weights.
 const GL_NODES: [f64; 5] = [
@@ -158,11 +160,6 @@ pub struct TorqueFreeTop {
     q0: DQuat,
     motion: TopMotion,
     kind: Kind,
-}
-
-/// `±1` by the sign bit, `+1` for `+0`.
-fn sign(x: f64) -> f64 {
-    if x < 0.0 { -1.0 } else { 1.0 }
 }
 
 impl TorqueFreeTop {

@@ -71,6 +71,7 @@ use super::sin_cos;
 use super::splitting::FreeBody;
 use crate::elliptic::{
     complete_k_complement, incomplete_f_sin_cos, integral_sn2_over, jacobi_sn_cn_dn_complement,
+    norm2, sign,
 };
 
 /// `atan x`: the series `x − x³/3 + x⁵/5 − x⁷/7` below `|x| = 10⁻³` (the first term left out,
@@ -82,23 +83,6 @@ fn small_atan(x: f64) -> f64 {
         x * (1.0 - x2 * (1.0 / 3.0 - x2 * (1.0 / 5.0 - x2 / 7.0)))
     } else {
         crate::elliptic::atan(x)
-    }
-}
-
-/// `sign(x)` as `±1`, `+1` for `+0`.
-#[inline]
-fn sign(x: f64) -> f64 {
-    if x < 0.0 { -1.0 } else { 1.0 }
-}
-
-/// `√(x² + y²)`, without the cost of `hypot` where the squares cannot underflow or overflow.
-#[inline]
-fn norm2(x: f64, y: f64) -> f64 {
-    let sum = x * x + y * y;
-    if (1e-290..1e290).contains(&sum) {
-        sum.sqrt()
-    } else {
-        x.hypot(y)
     }
 }
 
