@@ -14,6 +14,7 @@ mod core_layer {
     pub mod momentum;
     pub mod precision;
     pub mod projectile;
+    pub mod rollback;
     pub mod schedule;
     pub mod spin;
     pub mod springs;

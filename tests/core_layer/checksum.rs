@@ -11,7 +11,7 @@ use super::util::{mass_props, run, world_with};
 /// The reference scene: a chain of ten asymmetric bodies (a thin plate and a body with a locked
 /// axis among them) joined by springs at off-centre anchors, forces at body points, a torque,
 /// gravity with one body scaled, damping on one, at 60 Hz.
-fn reference_world(integrator: Integrator) -> World {
+pub fn reference_world(integrator: Integrator) -> World {
     let mut world = world_with(1.0 / 60.0, integrator);
     world.insert_resource(Gravity(Vec3::new(0.0, -9.81, 0.0)));
     let mut bodies = Vec::new();

@@ -15,6 +15,7 @@ pub mod exact;
 pub mod measure;
 pub mod output;
 pub mod population;
+pub mod rollback;
 pub mod springs;
 
 use std::path::PathBuf;
@@ -121,6 +122,8 @@ pub struct BenchResults {
     pub springs: springs::SpringResults,
     /// The exact free flow against the default, ECS, one thread.
     pub exact: Vec<exact::ExactRow>,
+    /// Rollback snapshots: bytes per body, capture and restore time.
+    pub rollback: Vec<rollback::RollbackRow>,
     /// The targets of issue #7 and of the stiff-springs issue.
     pub targets: Vec<Target>,
 }
@@ -222,6 +225,16 @@ pub fn run_bench(options: &BenchOptions, mut progress: impl FnMut(&str)) -> Benc
         &[1_000, 100_000]
     };
     let exact = exact::run(exact_sizes, &effort, &mut progress);
+    let rollback_sizes: &[usize] = if options.quick {
+        &[1_000]
+    } else {
+        &[10_000, 100_000]
+    };
+    let rollback = rollback::run(
+        rollback_sizes,
+        if options.quick { 3 } else { 21 },
+        &mut progress,
+    );
     let mut results = BenchResults {
         schema: 1,
         pool_threads: pool_threads(),
@@ -233,6 +246,7 @@ pub fn run_bench(options: &BenchOptions, mut progress: impl FnMut(&str)) -> Benc
         unused_feature,
         springs,
         exact,
+        rollback,
         targets: Vec::new(),
     };
     results.targets = output::targets(&results);

@@ -203,7 +203,41 @@ pub fn markdown(results: &BenchResults) -> String {
     );
     s.push_str(&springs_markdown(&results.springs));
     s.push_str(&exact_markdown(&results.exact));
+    s.push_str(&rollback_markdown(&results.rollback));
     s.push_str(&targets_table(&results.targets));
+    s
+}
+
+/// Rollback snapshots: size and time next to a step and rapier's snapshot size.
+pub fn rollback_markdown(rows: &[crate::rollback::RollbackRow]) -> String {
+    let mut s = String::new();
+    if rows.is_empty() {
+        return s;
+    }
+    let _ = writeln!(
+        s,
+        "**rollback** snapshot of a loaded spring world (chains, gravity, a force at a point and \
+         damping on every body), `RollbackSnapshot::capture_into` and `restore`, medians\n"
+    );
+    let _ = writeln!(
+        s,
+        "| bodies | bytes / body | rapier bytes / body | capture | restore | one step | restore + 8 steps |"
+    );
+    let _ = writeln!(s, "|---:|---:|---:|---:|---:|---:|---:|");
+    for r in rows {
+        let _ = writeln!(
+            s,
+            "| {} | {:.0} | ≈ {:.0} (its #991) | {:.0} µs | {:.0} µs | {:.0} µs | {:.1} ms |",
+            r.bodies,
+            r.bytes_per_body,
+            crate::rollback::RAPIER_BYTES_PER_BODY,
+            r.capture_us,
+            r.restore_us,
+            r.step_us,
+            (r.restore_us + 8.0 * r.step_us) / 1000.0
+        );
+    }
+    s.push('\n');
     s
 }
 
@@ -365,6 +399,7 @@ pub fn readme_section(results: &BenchResults) -> String {
     s.push('\n');
     s.push_str(&springs_markdown(&results.springs));
     s.push_str(&exact_markdown(&results.exact));
+    s.push_str(&rollback_markdown(&results.rollback));
     s.push_str(&targets_table(&results.targets));
     s
 }

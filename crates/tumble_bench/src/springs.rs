@@ -87,6 +87,11 @@ impl SpringWorld {
         }
     }
 
+    /// The world (for the rollback measurements).
+    pub fn world_mut(&mut self) -> &mut bevy_ecs::world::World {
+        self.tumble.world_mut()
+    }
+
     /// True when every body is finite and none was quarantined.
     pub fn is_clean(&self) -> bool {
         (0..self.bodies).all(|i| self.tumble.state(i).is_finite() && !self.tumble.is_rejected(i))

@@ -220,6 +220,22 @@ pub struct SavedAccount {
     pub created: f64,
 }
 
+/// The audit's running accounts as a [`RollbackSnapshot`](crate::rollback::RollbackSnapshot)
+/// keeps them: the energy each spring group's integration has made up so far, which decides
+/// whether a later step quarantines the group. Opaque; in entity order.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct LedgerState {
+    accounts: Vec<(Entity, Account)>,
+    restored: bool,
+}
+
+impl LedgerState {
+    /// Bytes on the heap.
+    pub fn heap_bytes(&self) -> usize {
+        self.accounts.capacity() * std::mem::size_of::<(Entity, Account)>()
+    }
+}
+
 impl EnergyLedger {
     fn find(&mut self, mut i: usize) -> usize {
         while self.bodies[i].parent != i {
@@ -274,6 +290,22 @@ impl EnergyLedger {
             );
         }
         self.restored = true;
+    }
+
+    /// Copies the running accounts (by entity) into `into`, for a rollback snapshot.
+    pub(crate) fn save_state(&self, into: &mut LedgerState) {
+        into.accounts.clear();
+        into.accounts
+            .extend(self.accounts.iter().map(|(&k, &a)| (k, a)));
+        into.accounts.sort_unstable_by_key(|(k, _)| *k);
+        into.restored = self.restored;
+    }
+
+    /// Puts back the running accounts of `from` exactly (same keys: a rollback keeps entities).
+    pub(crate) fn load_state(&mut self, from: &LedgerState) {
+        self.accounts.clear();
+        self.accounts.extend(from.accounts.iter().copied());
+        self.restored = from.restored;
     }
 
     /// The group (root index) a link belongs to, if it touches an audited body.

@@ -20,6 +20,7 @@ pub mod forces;
 pub mod parallel;
 #[cfg(feature = "bevy_app")]
 pub mod plugin;
+pub mod rollback;
 pub mod runner;
 pub mod schedule;
 #[cfg(feature = "serde")]
@@ -42,6 +43,7 @@ pub mod prelude {
     };
     pub use crate::forces::{ConstantForce, ConstantTorque, Spring, SpringEnd};
     pub use crate::parallel::Parallelism;
+    pub use crate::rollback::{RollbackError, RollbackSnapshot};
     pub use crate::runner::{ForceSystems, PhysicsRunner};
     pub use crate::schedule::{PhysicsPlan, PhysicsSchedule, PhysicsSet, Stage};
     pub use crate::stability::{StabilityWarning, check_stability};

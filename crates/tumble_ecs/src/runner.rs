@@ -105,6 +105,11 @@ fn build(plan: &PhysicsPlan, world: &World) -> Schedule {
 /// assert_eq!(physics.plan().to_string(), "begin_stage → apply_gravity → integrate_with_forces");
 /// assert_eq!(physics.replans(), 1);
 /// ```
+///
+/// A `Resource`, so that a plugin can keep it in the world it steps (see `TumblePlugin`): it
+/// holds nothing a step depends on that the world does not (the plan and the schedule are
+/// derived from the world and re-derived when it changes).
+#[derive(Resource)]
 pub struct PhysicsRunner {
     plan: PhysicsPlan,
     schedule: Schedule,

@@ -24,8 +24,9 @@ pub enum StepperError {
     BadFrameTime(f64),
 }
 
-/// Fixed-step accumulator.
-#[derive(Debug, Clone, PartialEq)]
+/// Fixed-step accumulator. `Copy`: a game that rolls back saves it with its
+/// [`RollbackSnapshot`](crate::rollback::RollbackSnapshot) (it lives outside the world).
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FixedStepper {
     dt: f64,
     max_steps_per_frame: u32,
