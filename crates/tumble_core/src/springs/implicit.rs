@@ -260,15 +260,16 @@ pub struct ImplicitSpringSolver {
     rhs: Vec<f64>,
     blocks: Vec<Block>,
     preconditioner: Vec<Block>,
-    cayley: Vec<DQuat>,
+    /// Per body, `cay(hΩ̄)` as a matrix.
+    cayley: Vec<DMat3>,
     /// The spring ends on each body: body `i`'s are
     /// `ends_of[ends_start[i]..ends_start[i + 1]]`, as (spring, end).
     ends_of: Vec<(usize, usize)>,
     ends_start: Vec<usize>,
     /// Scratch of the counting sort.
     cursor: Vec<usize>,
-    /// Per body, the half rotation `S` (`S² = cay(hΩ̄)`).
-    half: Vec<DQuat>,
+    /// Per body, the half rotation `S` (`S² = cay(hΩ̄)`) as a matrix.
+    turn: Vec<DMat3>,
     /// Per body, the mid-step frame `Q₀ S` as a matrix.
     mid: Vec<DMat3>,
     /// Per body, `(1 − [hΩ̄/2]×)⁻¹`: the derivative of the Cayley rotation (see `evaluate`).
@@ -276,8 +277,6 @@ pub struct ImplicitSpringSolver {
     krylov: Krylov,
     /// The direct factorization of the Newton matrix (the preconditioner when it exists).
     lu: BlockLu,
-    /// Per spring, the Newton-matrix factors of its body ends (scratch of the factorization).
-    factors: Vec<[Option<EndFactors>; 2]>,
     /// True when `lu` holds a factorization of the current Newton matrix.
     factored: bool,
     /// True when `lu` holds the elimination order of the current group.
@@ -306,12 +305,11 @@ impl Default for ImplicitSpringSolver {
             ends_of: Vec::new(),
             ends_start: Vec::new(),
             cursor: Vec::new(),
-            half: Vec::new(),
+            turn: Vec::new(),
             mid: Vec::new(),
             cayley_derivative: Vec::new(),
             krylov: Krylov::default(),
             lu: BlockLu::default(),
-            factors: Vec::new(),
             factored: false,
             analyzed: false,
             saved: Vec::new(),
@@ -324,8 +322,12 @@ impl Default for ImplicitSpringSolver {
 const PIECE_TURN: f64 = 3.0;
 
 /// Relative size (kinetic-energy norm) of the previous Newton update above which an iteration
-/// refactors the Newton matrix; below it, the last factorization preconditions BiCGSTAB.
-const REFACTOR_ABOVE: f64 = 1e-3;
+/// refactors the Newton matrix; below it, the iteration is a chord step with the last
+/// factorization.
+const REFACTOR_ABOVE: f64 = 0.3;
+
+/// A chord step that shrinks the update by less than this factor is followed by a refactor.
+const CHORD_RATE: f64 = 0.25;
 
 /// Largest change of `h|Ω̄|` (rad) of any body in one Newton iteration.
 const MAX_TURN: f64 = 0.5;
@@ -490,16 +492,19 @@ impl ImplicitSpringSolver {
         let mut update = f64::INFINITY;
         let mut iterations = 0;
         let (mut previous_full, mut previous_step) = (f64::INFINITY, 0.0);
+        let mut previous_chord = None;
+        // Whether this iteration takes a fresh Newton matrix (and its factorization): always
+        // the first; afterwards only while the updates are large or the last chord step did not
+        // contract well. In between, a chord step reuses the last factorization as the matrix:
+        // near the solution the matrix barely changes from one iterate to the next, so the chord
+        // step contracts the error by about that change, for one evaluation and one triangular
+        // solve instead of an assembly and a factorization (five times the work).
+        let mut refactor = true;
         while iterations < self.max_newton {
             iterations += 1;
             stats.newton_iterations += 1;
-            // The body blocks follow the iterate (Krylov applies the exact Newton matrix). The
-            // factorization is rebuilt while the updates are large; near the solution the matrix
-            // barely changes between iterations, and the last factorization, as BiCGSTAB's
-            // preconditioner, solves the new one in a couple of iterations for far less work.
-            self.build_blocks(h);
-            let fresh = previous_full > REFACTOR_ABOVE;
-            if fresh {
+            if refactor {
+                self.build_blocks(h);
                 self.factor(h);
             }
             for (b, r) in self.rhs.iter_mut().zip(&self.residual) {
@@ -507,30 +512,27 @@ impl ImplicitSpringSolver {
             }
             let rhs = std::mem::take(&mut self.rhs);
             let mut delta = std::mem::take(&mut self.delta);
-            if fresh && self.factored {
-                // The factorization is of the exact Newton matrix: one direct solve.
+            if self.factored {
+                // A direct solve with the factorization: of the exact Newton matrix after a
+                // refactor, of a recent one in a chord step.
                 self.lu.solve(&rhs, &mut delta);
                 stats.linear_iterations += 1;
             } else {
+                // A singular pivot: BiCGSTAB on the exact Newton matrix (the body blocks
+                // follow the iterate) with block Jacobi.
+                if !refactor {
+                    self.build_blocks(h);
+                }
                 let mut krylov = std::mem::take(&mut self.krylov);
-                let mut lu = std::mem::take(&mut self.lu);
-                let factored = self.factored;
                 stats.linear_iterations += krylov.solve(
                     &rhs,
                     &mut delta,
                     1e-9,
                     400,
                     |u, out| self.apply_jacobian(h, u, out),
-                    |u, out| {
-                        if factored {
-                            lu.solve(u, out);
-                        } else {
-                            self.apply_preconditioner(u, out);
-                        }
-                    },
+                    |u, out| self.apply_preconditioner(u, out),
                 );
                 self.krylov = krylov;
-                self.lu = lu;
             }
             self.rhs = rhs;
             // Backtrack on the residual norm: a full Newton step can overshoot far from the
@@ -569,6 +571,16 @@ impl ImplicitSpringSolver {
             }
             let full = (self.kinetic_norm(&delta) / scale).sqrt();
             self.delta = delta;
+            let chord = !refactor && self.factored;
+            if chord && (!accepted || stagnating) {
+                // The stale matrix's step went nowhere: retake the iteration with a fresh one,
+                // linearized at the iterate (the last evaluation was of a rejected trial).
+                if !accepted {
+                    norm = self.evaluate(h);
+                }
+                refactor = true;
+                continue;
+            }
             if !accepted {
                 // No decrease at any step length: converged if the proposed update is already at
                 // the tolerance (the residual is at round-off), failed otherwise.
@@ -579,13 +591,21 @@ impl ImplicitSpringSolver {
             if update <= self.tolerance {
                 break;
             }
-            // Near the solution Newton's method contracts at a falling rate: with the rate
-            // θ = |δₖ|/|δₖ₋₁| of two full steps, the error left after δₖ is at most
-            // θ/(1 − θ)·|δₖ| (the tail of a geometric series), so the step is done once that is
-            // within the tolerance; it saves the last iteration, whose only use would be to
-            // show the update is small.
+            // Near the solution Newton's method contracts at a falling rate, a chord iteration
+            // at a steady one: with the rate θ = |δₖ|/|δₖ₋₁| of two full steps of the same kind,
+            // the error left after δₖ is at most θ/(1 − θ)·|δₖ| (the tail of a geometric
+            // series), so the step is done once that is within the tolerance; it saves the last
+            // iteration, whose only use would be to show the update is small. (A chord step
+            // after a Newton step is not measured by the Newton step's rate: it contracts by
+            // how much the matrix has aged, which the first chord step does not show yet.)
             let rate = full / previous_full;
-            if step == 1.0 && previous_step == 1.0 && rate < 0.5 {
+            let same_kind = previous_chord == Some(chord);
+            previous_chord = Some(chord);
+            refactor = !self.factored
+                || full > REFACTOR_ABOVE
+                || step < 1.0
+                || (chord && rate > CHORD_RATE);
+            if same_kind && step == 1.0 && previous_step == 1.0 && rate < 0.5 {
                 let left = rate / (1.0 - rate) * update;
                 if left <= self.tolerance {
                     update = left;
@@ -759,7 +779,7 @@ impl ImplicitSpringSolver {
     /// Jacobian) and returns its norm, scaled per body by `1/√m`, `1/√I`.
     fn evaluate(&mut self, h: f64) -> f64 {
         self.cayley.clear();
-        self.half.clear();
+        self.turn.clear();
         self.mid.clear();
         self.cayley_derivative.clear();
         for (i, s) in self.starts.iter().enumerate() {
@@ -767,10 +787,11 @@ impl ImplicitSpringSolver {
             let vbar = v3(&z[..3]);
             let wbar = s.free * v3(&z[3..]);
             let c = cayley(h * wbar);
-            self.cayley.push(c);
             let half = half_rotation(c);
-            self.half.push(half);
-            self.mid.push(DMat3::from_quat(s.q * half));
+            let turn = DMat3::from_quat(half);
+            self.turn.push(turn);
+            self.cayley.push(turn * turn);
+            self.mid.push(s.r * turn);
             // From (1 − [w/2]×) cay(w) a = (1 + [w/2]×) a: d(cay(w) a) = −(1 − [w/2]×)⁻¹ [b]× dw,
             // and (1 − [u]×)⁻¹ = 1 + ([u]× + [u]×²)/(1 + |u|²).
             let u = skew(0.5 * h * wbar);
@@ -782,7 +803,7 @@ impl ImplicitSpringSolver {
             // External torque in the principal frame at mid-step (symmetric in the two ends),
             // with the forces at body points taken like spring ends: arm (S a + Sᵀ a)/2 across
             // the mid-step force.
-            let torque = (s.q * half).inverse() * s.torque + point_torque(s, half);
+            let torque = self.mid[i].transpose() * s.torque + point_torque(s, half);
             let iw = s.inertia * wbar;
             let rot = iw - s.pi + 0.5 * h * wbar.cross(iw) - 0.5 * h * torque;
             // A locked axis has no equation of motion: its row pins Ω̄ to 0.
@@ -797,9 +818,9 @@ impl ImplicitSpringSolver {
                         let z = &self.z[6 * end.body..6 * end.body + 6];
                         let rotated = self.cayley[end.body] * end.local;
                         lin.b[e] = 0.5 * (end.local + rotated);
-                        let half = self.half[end.body];
-                        lin.arm[e] = 0.5 * (half * end.local + half.inverse() * end.local);
-                        p1[e] = s.x + h * v3(&z[..3]) + s.q * rotated;
+                        let turn = &self.turn[end.body];
+                        lin.arm[e] = 0.5 * (*turn * end.local + turn.transpose() * end.local);
+                        p1[e] = s.x + h * v3(&z[..3]) + s.r * rotated;
                     }
                     None => p1[e] = end.fixed,
                 }
@@ -848,15 +869,15 @@ impl ImplicitSpringSolver {
     /// `δθ` from `half_turn_jacobian`.
     fn turning_torque_jacobian(&self, h: f64, i: usize, w: DVec3) -> DMat3 {
         let s = &self.starts[i];
-        let half = half_rotation(cayley(h * w));
-        let to_mid = (s.q * half).inverse();
-        let turn = DMat3::from_quat(half);
+        // The half rotation and the mid-step frame of the iterate, from its evaluation.
+        let turn = self.turn[i];
+        let to_mid = self.mid[i].transpose();
         let mut by_theta = skew(to_mid * s.torque);
         for &(link, e) in &self.ends_of[self.ends_start[i]..self.ends_start[i + 1]] {
             let (end, lin) = (&self.links[link].ends[e], &self.lin[link]);
             let f = if e == 0 { lin.force } else { -lin.force };
             let y = skew(to_mid * f);
-            let (turned, back) = (half * end.local, half.inverse() * end.local);
+            let (turned, back) = (turn * end.local, turn.transpose() * end.local);
             let arm = 0.5 * (turned + back);
             by_theta += skew(arm) * y - 0.5 * y * (skew(back) - skew(turned) * turn);
         }
@@ -963,45 +984,9 @@ impl ImplicitSpringSolver {
     /// singular, block Jacobi instead (each body's diagonal block inverted, or its mass and
     /// inertia where that block is singular too).
     fn factor(&mut self, h: f64) {
-        let mut preconditioner = std::mem::take(&mut self.preconditioner);
-        preconditioner.clear();
-        preconditioner.extend_from_slice(&self.blocks);
-        // The springs' part ¼ GᵀKG of the Newton matrix, block by block: a body's own ends on
-        // its diagonal block, the coupling of the two ends of a spring between two bodies off it.
-        let len = self.starts.len();
-        let mut factors = std::mem::take(&mut self.factors);
-        factors.clear();
-        for (link, lin) in self.links.iter().zip(&self.lin) {
-            let k = 0.25 * lin.k;
-            let ends: [Option<EndFactors>; 2] = [0, 1].map(|e| {
-                let body = link.ends[e].body;
-                (body < len).then(|| self.end_factors(h, body, lin.b[e], lin.arm[e]))
-            });
-            for (e, end) in link.ends.iter().enumerate() {
-                let Some(fe) = &ends[e] else { continue };
-                add_block(&mut preconditioner[end.body], &coupling(h, k, fe, fe, 1.0));
-                // A spring with both ends on one body couples them on its diagonal block.
-                if let Some(ff) = &ends[1 - e]
-                    && link.ends[1 - e].body == end.body
-                {
-                    add_block(&mut preconditioner[end.body], &coupling(h, k, fe, ff, -1.0));
-                }
-            }
-            factors.push(ends);
-        }
         let mut lu = std::mem::take(&mut self.lu);
-        lu.reset(&preconditioner);
-        for ((link, lin), ends) in self.links.iter().zip(&self.lin).zip(&factors) {
-            let k = 0.25 * lin.k;
-            let [a, b] = link.ends;
-            if let [Some(fa), Some(fb)] = ends
-                && a.body != b.body
-            {
-                lu.add(a.body, b.body, &coupling(h, k, fa, fb, -1.0));
-                lu.add(b.body, a.body, &coupling(h, k, fb, fa, -1.0));
-            }
-        }
-        self.factors = factors;
+        lu.reset(&self.blocks);
+        self.assemble_springs(h, &mut lu);
         if !self.analyzed {
             // The pattern is the group's graph, the same for every Newton iteration of a solve.
             lu.analyze();
@@ -1009,13 +994,20 @@ impl ImplicitSpringSolver {
         }
         self.factored = lu.factor().is_ok();
         self.lu = lu;
-        // Block Jacobi only where the direct factorization failed (a singular pivot).
-        for (s, block) in self
-            .starts
-            .iter()
-            .zip(preconditioner.iter_mut())
-            .filter(|_| !self.factored)
-        {
+        if self.factored {
+            return;
+        }
+        // Block Jacobi where the direct factorization failed (a singular pivot): each body's
+        // diagonal block inverted, or its mass and inertia where that block is singular too.
+        let mut diagonal = DiagonalBlocks {
+            blocks: std::mem::take(&mut self.preconditioner),
+            off_diagonal: [[0.0; 6]; 6],
+        };
+        diagonal.blocks.clear();
+        diagonal.blocks.extend_from_slice(&self.blocks);
+        self.assemble_springs(h, &mut diagonal);
+        let mut preconditioner = diagonal.blocks;
+        for (s, block) in self.starts.iter().zip(preconditioner.iter_mut()) {
             *block = invert(block).unwrap_or_else(|| {
                 let mut d = [[0.0; 6]; 6];
                 for (a, row) in d.iter_mut().enumerate() {
@@ -1025,6 +1017,52 @@ impl ImplicitSpringSolver {
             });
         }
         self.preconditioner = preconditioner;
+    }
+
+    /// Adds the springs' part `¼ GᵀKG` of the Newton matrix into `blocks`: a body's own ends (and both ends of a spring with both on one body) on its
+    /// diagonal block `(i, i)`, the coupling of the two ends of a spring between two bodies off
+    /// it. Per spring the products `K G_f` and `E_e K` are formed once per end and shared by
+    /// the blocks (see [`add_coupling`]).
+    fn assemble_springs(&self, h: f64, blocks: &mut impl BlockSink) {
+        let len = self.starts.len();
+        for (link, lin) in self.links.iter().zip(&self.lin) {
+            let k = 0.25 * lin.k;
+            // Each end's factors, and `K G_turn`, `E_turn K`, as separate locals (not gathered
+            // in a struct, which the compiler would copy around by `memcpy`).
+            let [a, b] = [link.ends[0].body, link.ends[1].body];
+            let (a_in, b_in) = (a < len, b < len);
+            let factors = |on: bool, body: usize, e: usize| {
+                if on {
+                    self.end_factors(h, body, lin.b[e], lin.arm[e])
+                } else {
+                    EndFactors::default()
+                }
+            };
+            let (fa, fb) = (factors(a_in, a, 0), factors(b_in, b, 1));
+            let (k_turn_a, k_turn_b) = (k * fa.move_by_turn, k * fb.move_by_turn);
+            let (torque_k_a, torque_k_b) = (fa.torque_of_force * k, fb.torque_of_force * k);
+            let end_a = EndProducts {
+                torque: &fa.torque_of_force,
+                torque_k: &torque_k_a,
+                k_turn: &k_turn_a,
+            };
+            let end_b = EndProducts {
+                torque: &fb.torque_of_force,
+                torque_k: &torque_k_b,
+                k_turn: &k_turn_b,
+            };
+            if a_in {
+                add_coupling(blocks.block(a, a), h, k, &end_a, &end_a, 1.0);
+            }
+            if b_in {
+                add_coupling(blocks.block(b, b), h, k, &end_b, &end_b, 1.0);
+            }
+            if a_in && b_in {
+                // (A spring with both ends on one body couples them on its diagonal block.)
+                add_coupling(blocks.block(a, b), h, k, &end_a, &end_b, -1.0);
+                add_coupling(blocks.block(b, a), h, k, &end_b, &end_a, -1.0);
+            }
+        }
     }
 
     /// The two 3×3 factors of a spring end's blocks of the Newton matrix (see [`coupling`]) on
@@ -1231,40 +1269,71 @@ fn anchor_at(poses: &[Pose], end: &End) -> DVec3 {
 }
 
 /// A spring end's factors of the Newton matrix, see `ImplicitSpringSolver::end_factors`.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, Default)]
 struct EndFactors {
     move_by_turn: DMat3,
     torque_of_force: DMat3,
 }
 
-/// The block `sign · Eₑᵀ K G_f` of the Newton matrix that spring end `e` receives from end `f`
-/// (`K` = ¼ of the spring's stiffness matrix): `G_f = [h 1, G_turn]` maps the update of end `f`'s
-/// body to its anchor's motion, `Eₑᵀ = [h 1; E_turn]` maps a world force at end `e` to its body's
-/// generalized force.
-fn coupling(h: f64, k: DMat3, e: &EndFactors, f: &EndFactors, sign: f64) -> Block {
-    let k = sign * k;
-    let k_turn = k * f.move_by_turn;
-    let torque_k = e.torque_of_force * k;
+/// Adds the block `sign · Eₑᵀ K G_f` of the Newton matrix that spring end `e` receives from end
+/// `f` to `block` (`K` = ¼ of the spring's stiffness matrix): `G_f = [h 1, G_turn,f]` maps the
+/// update of end `f`'s body to its anchor's motion, `Eₑᵀ = [h 1; E_turn,e]` maps a world force at
+/// end `e` to its body's generalized force. The 3×3 parts are `h² K`, `h K G_turn,f`,
+/// `h E_turn,e K` and `E_turn,e (K G_turn,f)`; each end's `K G_turn` and `E_turn K` are formed
+/// once and shared by the blocks of its spring.
+fn add_coupling(block: &mut Block, h: f64, k: DMat3, e: &EndProducts, f: &EndProducts, sign: f64) {
     let parts = [
-        [(h * h) * k, h * k_turn],
-        [h * torque_k, torque_k * f.move_by_turn],
+        [(sign * h * h) * k, (sign * h) * *f.k_turn],
+        [(sign * h) * *e.torque_k, sign * (*e.torque * *f.k_turn)],
     ];
-    let mut block = [[0.0; 6]; 6];
     for (r, row) in block.iter_mut().enumerate() {
         for (c, x) in row.iter_mut().enumerate() {
-            *x = parts[r / 3][c / 3].col(c % 3)[r % 3];
+            *x += parts[r / 3][c / 3].col(c % 3)[r % 3];
         }
     }
-    block
 }
 
-/// `a += b` for 6×6 blocks.
-fn add_block(a: &mut Block, b: &Block) {
-    for (x, y) in a.iter_mut().zip(b) {
-        for (u, v) in x.iter_mut().zip(y) {
-            *u += v;
+/// Where the assembly of the Newton matrix adds its blocks.
+trait BlockSink {
+    /// The block of row body `i` and column body `j`.
+    fn block(&mut self, i: usize, j: usize) -> &mut Block;
+}
+
+impl BlockSink for BlockLu {
+    fn block(&mut self, i: usize, j: usize) -> &mut Block {
+        if i == j {
+            self.diagonal_mut(i)
+        } else {
+            self.entry(i, j)
         }
     }
+}
+
+/// The diagonal blocks alone (block Jacobi): the coupling blocks are dropped.
+struct DiagonalBlocks {
+    blocks: Vec<Block>,
+    off_diagonal: Block,
+}
+
+impl BlockSink for DiagonalBlocks {
+    fn block(&mut self, i: usize, j: usize) -> &mut Block {
+        if i == j {
+            &mut self.blocks[i]
+        } else {
+            &mut self.off_diagonal
+        }
+    }
+}
+
+/// A spring end's products for the assembly of the Newton matrix, by reference (see
+/// `assemble_springs`).
+struct EndProducts<'a> {
+    /// `E_turn`.
+    torque: &'a DMat3,
+    /// `E_turn K`.
+    torque_k: &'a DMat3,
+    /// `K G_turn`.
+    k_turn: &'a DMat3,
 }
 
 fn skew(v: DVec3) -> DMat3 {

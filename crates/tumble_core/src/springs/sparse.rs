@@ -99,21 +99,35 @@ impl BlockLu {
     }
 
     /// Adds `block` to the off-diagonal entry `(i, j)`, `i ≠ j`, and makes `(j, i)` present.
+    #[cfg(test)]
     pub(crate) fn add(&mut self, i: usize, j: usize, block: &Block) {
-        let row = &mut self.rows[i];
-        match row.iter_mut().find(|(c, _)| *c == j) {
-            Some((_, b)) => {
-                for (x, y) in b.iter_mut().zip(block) {
-                    for (u, v) in x.iter_mut().zip(y) {
-                        *u += v;
-                    }
-                }
+        for (x, y) in self.entry(i, j).iter_mut().zip(block) {
+            for (u, v) in x.iter_mut().zip(y) {
+                *u += v;
             }
-            None => row.push((j, *block)),
         }
+    }
+
+    /// The diagonal block of body `i`, to add to before [`factor`](Self::factor).
+    pub(crate) fn diagonal_mut(&mut self, i: usize) -> &mut Block {
+        &mut self.diagonal[i]
+    }
+
+    /// The block `(i, j)` (`i ≠ j`), zero when first named, to add to before
+    /// [`factor`](Self::factor); `(j, i)` enters the pattern too, which stays symmetric.
+    pub(crate) fn entry(&mut self, i: usize, j: usize) -> &mut Block {
         if !self.rows[j].iter().any(|(c, _)| *c == i) {
             self.rows[j].push((i, [[0.0; 6]; 6]));
         }
+        let row = &mut self.rows[i];
+        let at = match row.iter().position(|(c, _)| *c == j) {
+            Some(at) => at,
+            None => {
+                row.push((j, [[0.0; 6]; 6]));
+                row.len() - 1
+            }
+        };
+        &mut row[at].1
     }
 
     /// Chooses the elimination order from the present pattern (call after the `add`s; the
