@@ -69,32 +69,59 @@ fn clamp_parameter(m: f64) -> f64 {
 /// the separatrix, `m → 1`), unlike the angle form `φₙ₋₁ = (φₙ + asin(…))/2`, whose `asin` near 1
 /// loses half the digits.
 fn landen_sn_cn_dn(u: f64, m: f64, m1: f64) -> (f64, f64, f64) {
-    // r = √mₙ₊₁ and 1 − r for each level.
-    let mut r = [0.0; MAX_LEVELS];
-    let mut one_minus_r = [0.0; MAX_LEVELS];
-    let (mut mn, mut m1n, mut v) = (m, m1, u);
-    let mut levels = 0;
-    while mn >= 1e-18 && levels < MAX_LEVELS {
-        let kp = m1n.sqrt();
-        r[levels] = (1.0 - kp) / (1.0 + kp);
-        one_minus_r[levels] = 2.0 * kp / (1.0 + kp);
-        mn = r[levels] * r[levels];
-        m1n = 4.0 * kp / ((1.0 + kp) * (1.0 + kp));
-        v *= 0.5 * (1.0 + kp);
-        levels += 1;
+    let descent = LandenDescent::new(u, m, m1);
+    let (s, c) = sin_cos(descent.v);
+    descent.ascend(s, c)
+}
+
+/// The descending half of [`landen_sn_cn_dn`]: the levels' `r = √mₙ₊₁` and `1 − r`, and the
+/// argument `v` at the bottom. Split from the ascent so that two bodies' chains can be
+/// interleaved ([`jacobi_sn_cn_dn_complement_pair`]).
+struct LandenDescent {
+    r: [f64; MAX_LEVELS],
+    one_minus_r: [f64; MAX_LEVELS],
+    levels: usize,
+    v: f64,
+}
+
+impl LandenDescent {
+    #[inline(always)]
+    fn new(u: f64, m: f64, m1: f64) -> Self {
+        // Filled in place: tables built apart and moved in would be copied.
+        let mut descent = Self {
+            r: [0.0; MAX_LEVELS],
+            one_minus_r: [0.0; MAX_LEVELS],
+            levels: 0,
+            v: u,
+        };
+        let (mut mn, mut m1n) = (m, m1);
+        while mn >= 1e-18 && descent.levels < MAX_LEVELS {
+            let (kp, level) = (m1n.sqrt(), descent.levels);
+            descent.r[level] = (1.0 - kp) / (1.0 + kp);
+            descent.one_minus_r[level] = 2.0 * kp / (1.0 + kp);
+            mn = descent.r[level] * descent.r[level];
+            m1n = 4.0 * kp / ((1.0 + kp) * (1.0 + kp));
+            descent.v *= 0.5 * (1.0 + kp);
+            descent.levels += 1;
+        }
+        descent
     }
-    let (mut s, mut c) = sin_cos(v);
-    let mut d = 1.0;
-    for level in (0..levels).rev() {
-        let (rk, one_minus) = (r[level], one_minus_r[level]);
-        let denom = 1.0 + rk * s * s;
-        (s, c, d) = (
-            (1.0 + rk) * s / denom,
-            c * d / denom,
-            (one_minus + rk * c * c) / denom,
-        );
+
+    /// `(sn, cn, dn)` from `(sin v, cos v)` at the bottom.
+    #[inline(always)]
+    fn ascend(&self, mut s: f64, mut c: f64) -> (f64, f64, f64) {
+        let mut d = 1.0;
+        for level in (0..self.levels).rev() {
+            let (rk, one_minus) = (self.r[level], self.one_minus_r[level]);
+            let denom = 1.0 + rk * s * s;
+            (s, c, d) = (
+                (1.0 + rk) * s / denom,
+                c * d / denom,
+                (one_minus + rk * c * c) / denom,
+            );
+        }
+        (s, c, d)
     }
-    (s, c, d)
 }
 
 /// Jacobi amplitude `am(u | m)`, the continuous, increasing solution of `dφ/du = √(1 − m sin²φ)`
@@ -149,6 +176,27 @@ pub fn jacobi_sn_cn_dn_complement(u: f64, m: f64, m1: f64) -> (f64, f64, f64) {
         return (u.tanh(), sech, sech);
     }
     landen_sn_cn_dn(u, m, m1)
+}
+
+/// [`jacobi_sn_cn_dn_complement`] for two independent arguments at once, the same bits as two
+/// calls. Each body's Landen chain (a square root and a division per level, then the sine, then a
+/// division per level) is one long dependency; running the two chains stage by stage puts both
+/// in the processor's window, so each fills the other's latency.
+pub(crate) fn jacobi_sn_cn_dn_complement_pair(
+    u: [f64; 2],
+    m: [f64; 2],
+    m1: [f64; 2],
+) -> [(f64, f64, f64); 2] {
+    let (m, m1) = (m.map(clamp_parameter), m1.map(clamp_parameter));
+    if m.contains(&0.0) || m1.contains(&0.0) {
+        return [0, 1].map(|i| jacobi_sn_cn_dn_complement(u[i], m[i], m1[i]));
+    }
+    // Plain bindings rather than arrays of descents: those would be copied level tables.
+    let a = LandenDescent::new(u[0], m[0], m1[0]);
+    let b = LandenDescent::new(u[1], m[1], m1[1]);
+    let (sa, ca) = sin_cos(a.v);
+    let (sb, cb) = sin_cos(b.v);
+    [a.ascend(sa, ca), b.ascend(sb, cb)]
 }
 
 /// Arithmetic–geometric mean of `a ≥ b ≥ 0`.

@@ -15,6 +15,7 @@ use std::borrow::Borrow;
 
 use super::Integrator;
 use super::simd::{Kernel, LANES};
+use super::exact_flow::{rotate_exactly, rotate_exactly_pair};
 use super::splitting::{drift_kick_drift_translation, free_rotation_span};
 use super::symmetric_kernel::{
     LaneInputs, SymmetricInput, rotate_symmetric_lanes, rotate_symmetric_one,
@@ -255,6 +256,50 @@ fn batched(
     pending.flush(bodies);
 }
 
+/// The `exact` batch: each body's drift–kick–drift translation, then its free rotation, two
+/// bodies at a time ([`rotate_exactly_pair`]: their long dependency chains overlap), or stepped
+/// whole by `alone` when it is spherical or its translation cannot run first (a whole step
+/// under a torque).
+#[inline(always)]
+fn paired(
+    phase: StepPhase,
+    bodies: &mut impl BodyBatch,
+    dt: Real,
+    mut alone: impl FnMut(&mut BodyState, &MassProperties, &Wrench),
+) {
+    let h = free_rotation_span(phase, dt);
+    let mut next = BodyState::ZEROED;
+    // A translated body waiting for a partner.
+    let mut waiting: Option<(usize, BodyState)> = None;
+    for i in 0..bodies.len() {
+        bodies.prefetch(i + PREFETCH_AHEAD);
+        let Some(wrench) = bodies.read(i, &mut next) else {
+            continue;
+        };
+        let mass = bodies.mass(i);
+        if mass.is_spherical() || !drift_kick_drift_translation(phase, &mut next, mass, &wrench, dt)
+        {
+            let mut single = next;
+            alone(&mut single, mass, &wrench);
+            commit(bodies, i, &single);
+            continue;
+        }
+        match waiting.take() {
+            None => waiting = Some((i, next)),
+            Some((j, mut first)) => {
+                let mut second = next;
+                rotate_exactly_pair([&mut first, &mut second], [bodies.mass(j), mass], h);
+                commit(bodies, j, &first);
+                commit(bodies, i, &second);
+            }
+        }
+    }
+    if let Some((j, mut last)) = waiting {
+        rotate_exactly(&mut last, bodies.mass(j), h);
+        commit(bodies, j, &last);
+    }
+}
+
 /// Plain arrays as a [`BodyBatch`]; divergent indices are collected in order of discovery.
 struct Slices<'a, M> {
     states: &'a mut [BodyState],
@@ -337,6 +382,13 @@ impl Integrator {
         let alone = |s: &mut BodyState, m: &MassProperties, w: &Wrench| {
             self.stage(phase, s, m, w, h);
         };
+        if self == Integrator::Exact || self == Integrator::Exact4 {
+            return match phase {
+                StepPhase::Whole => paired(StepPhase::Whole, bodies, h, alone),
+                StepPhase::Begin => paired(StepPhase::Begin, bodies, h, alone),
+                StepPhase::Finish => paired(StepPhase::Finish, bodies, h, alone),
+            };
+        }
         if !self.rotates_on_symmetric_kernel() {
             return each_alone(bodies, alone);
         }

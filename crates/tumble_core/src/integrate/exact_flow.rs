@@ -68,10 +68,13 @@ use std::f64::consts::FRAC_PI_2;
 use glam::{DQuat, DVec3};
 
 use super::sin_cos;
-use super::splitting::FreeBody;
+use super::splitting::{FreeBody, FreeState, rotate_freely};
+use crate::mass::MassProperties;
+use crate::math::{Real, Widen};
+use crate::state::BodyState;
 use crate::elliptic::{
     complete_k_complement, incomplete_f_sin_cos, integral_sn2_over, jacobi_sn_cn_dn_complement,
-    norm2, sign,
+    jacobi_sn_cn_dn_complement_pair, norm2, sign,
 };
 
 /// `atan x`: the series `x − x³/3 + x⁵/5 − x⁷/7` below `|x| = 10⁻³` (the first term left out,
@@ -182,6 +185,15 @@ struct Polhode {
     nu: f64,
 }
 
+/// [`Polhode::advance_short`] up to the elliptic functions of the phase advance `δ = λh`.
+struct ShortStart {
+    delta: f64,
+    /// `C = √(ν (m + ν)(1 + ν))`.
+    c: f64,
+    /// `(sn, cn, dn)` at the start.
+    phase: (f64, f64, f64),
+}
+
 impl Polhode {
     /// The motion through the sorted momentum `s` with sorted reciprocal moments `r`, not a
     /// steady spin (`P > 0` and `R > 0`).
@@ -277,14 +289,33 @@ impl Polhode {
     /// `|δ| C/(1 + ν) < π/2`. This saves `F(φ₀)`, `K` and one `R_J` against
     /// [`advance_any`](Self::advance_any).
     fn advance_short(&self, s: DVec3, h: f64) -> Option<(DVec3, f64)> {
+        let start = self.short_start(s, h)?;
+        let (snd, cnd, dnd) = jacobi_sn_cn_dn_complement(start.delta, self.m, self.m1);
+        Some(self.short_end(&start, snd, cnd, dnd))
+    }
+
+    /// The part of [`advance_short`](Self::advance_short) before `(sn, cn, dn)` of `δ`: `None`
+    /// when the span is not short.
+    #[inline(always)]
+    fn short_start(&self, s: DVec3, h: f64) -> Option<ShortStart> {
         let delta = self.lambda * h;
         let nu = self.nu;
         let c = (nu * (self.m + nu) * (1.0 + nu)).sqrt();
         if delta.abs() >= FRAC_PI_2 || delta.abs() * c >= FRAC_PI_2 * (1.0 + nu) {
             return None;
         }
-        let (sn0, cn0, dn0) = self.phase_of(s);
-        let (snd, cnd, dnd) = jacobi_sn_cn_dn_complement(delta, self.m, self.m1);
+        Some(ShortStart {
+            delta,
+            c,
+            phase: self.phase_of(s),
+        })
+    }
+
+    /// The part of [`advance_short`](Self::advance_short) after `(sn, cn, dn)` of `δ`.
+    #[inline(always)]
+    fn short_end(&self, start: &ShortStart, snd: f64, cnd: f64, dnd: f64) -> (DVec3, f64) {
+        let (nu, c) = (self.nu, start.c);
+        let (sn0, cn0, dn0) = start.phase;
         let product = sn0 * snd;
         let denominator = 1.0 - self.m * product * product;
         let sn = (sn0 * cnd * dnd + snd * cn0 * dn0) / denominator;
@@ -297,7 +328,7 @@ impl Polhode {
             let ratio = c * product * sn / (1.0 + nu * (sn * sn - product * cn * dn));
             integral += small_atan(ratio) / c;
         }
-        Some((self.momentum_at(sn, cn, dn), integral))
+        (self.momentum_at(sn, cn, dn), integral)
     }
 
     /// [`advance`](Self::advance) for any span: `τ₀ = F(φ₀ | m)`, `τ₁ = τ₀ + λh` reduced by
@@ -331,40 +362,136 @@ impl Polhode {
     }
 }
 
+/// True when the body momentum `m` does not move under the reciprocal moments `r`: `ṁ = m × (r ∘
+/// m) = 0` (principal-axis spins, spheres, the plane of two equal moments), or a locked axis
+/// (the constraint holds the body rates).
+#[inline(always)]
+fn is_steady(m: DVec3, r: DVec3) -> bool {
+    m.cross(r * m) == DVec3::ZERO || r.min_element() == 0.0
+}
+
+/// A steady body's flow: a rotation about its fixed axis by `h |r ∘ m|`.
+#[inline(always)]
+fn steady_flow(body: &mut FreeBody, r: DVec3, h: f64) {
+    body.q = (body.q * exp_body(h * (r * body.m))).normalize();
+}
+
+/// A moving body in the sorted frame, before its momentum advances.
+struct Moving {
+    axes: SortedAxes,
+    /// Sorted reciprocal moments.
+    rs: DVec3,
+    /// Sorted momentum at the start.
+    s0: DVec3,
+    polhode: Polhode,
+}
+
+impl Moving {
+    #[inline(always)]
+    fn new(m: DVec3, r: DVec3) -> Self {
+        let axes = SortedAxes::new(r);
+        let (rs, s0) = (axes.to_sorted(r).abs(), axes.to_sorted(m));
+        Self {
+            axes,
+            rs,
+            s0,
+            polhode: Polhode::new(s0, rs),
+        }
+    }
+
+    /// Writes the flow's end into `body`, from the sorted momentum `s1` at the end and the
+    /// phase integral over the span `h`.
+    #[inline(always)]
+    fn finish(&self, body: &mut FreeBody, s1: DVec3, integral: f64, h: f64) {
+        let (rs, s0, polhode) = (self.rs, self.s0, &self.polhode);
+        let magnitude = s0.length();
+        let d23 = rs.y - rs.z;
+        let delta_phi =
+            magnitude * rs.z * h + magnitude * d23 * polhode.kappa / polhode.lambda * integral;
+
+        // Euler frame (a, b, c) = sorted (2, 3, 1).
+        let euler = |s: DVec3| DVec3::new(s.y, s.z, s.x);
+        let (sin_half, cos_half) = sin_cos(0.5 * delta_phi);
+        let spin = DQuat::from_xyzw(0.0, 0.0, sin_half, cos_half);
+        let before = to_momentum_frame(euler(s0), magnitude);
+        let after = to_momentum_frame(euler(s1), magnitude);
+        let turn = before.conjugate() * spin * after;
+        // The turn's axis from Euler-frame to principal components: (a, b, c) → sorted (y, z, x).
+        let axis = self.axes.to_principal(DVec3::new(turn.z, turn.x, turn.y));
+        let turn = DQuat::from_xyzw(axis.x, axis.y, axis.z, turn.w);
+        body.q = (body.q * turn).normalize();
+        body.m = self.axes.to_principal(s1);
+    }
+}
+
 /// The exact torque-free flow over `h` of the principal orientation `Q` and body momentum `m` of
 /// `body`, given the reciprocal principal moments `r` (`0` on a locked axis); see the module docs.
 /// `L = Q m` is unchanged, and so are `E` and `|m|`, to round-off.
 pub fn exact_free_flow(body: &mut FreeBody, r: DVec3, h: f64) {
-    let m = body.m;
-    let omega = r * m;
-    // Steady: ṁ = m × (r ∘ m) = 0 (principal-axis spins, spheres, the plane of two equal
-    // moments), or a locked axis (the constraint holds the body rates).
-    let steady = m.cross(omega) == DVec3::ZERO || r.min_element() == 0.0;
-    if steady {
-        body.q = (body.q * exp_body(h * omega)).normalize();
+    if is_steady(body.m, r) {
+        return steady_flow(body, r, h);
+    }
+    let moving = Moving::new(body.m, r);
+    let (s1, integral) = moving.polhode.advance(moving.s0, h);
+    moving.finish(body, s1, integral, h);
+}
+
+/// [`exact_free_flow`] of two bodies over the same `h`, the same bits as two calls: the two
+/// flows run stage by stage, so that the processor overlaps their long dependency chains
+/// (square roots, divisions, the Landen levels; see
+/// [`jacobi_sn_cn_dn_complement_pair`]). Bodies off the common path (steady, or a span that is
+/// not short) take it one by one.
+pub fn exact_free_flow_pair(bodies: [&mut FreeBody; 2], r: [DVec3; 2], h: f64) {
+    let [a, b] = bodies;
+    if is_steady(a.m, r[0]) || is_steady(b.m, r[1]) {
+        exact_free_flow(a, r[0], h);
+        exact_free_flow(b, r[1], h);
         return;
     }
-    let axes = SortedAxes::new(r);
-    let (rs, s0) = (axes.to_sorted(r).abs(), axes.to_sorted(m));
-    let polhode = Polhode::new(s0, rs);
-    let (s1, integral) = polhode.advance(s0, h);
-    let magnitude = s0.length();
-    let d23 = rs.y - rs.z;
-    let delta_phi =
-        magnitude * rs.z * h + magnitude * d23 * polhode.kappa / polhode.lambda * integral;
+    let moving = [Moving::new(a.m, r[0]), Moving::new(b.m, r[1])];
+    let (Some(start_a), Some(start_b)) = (
+        moving[0].polhode.short_start(moving[0].s0, h),
+        moving[1].polhode.short_start(moving[1].s0, h),
+    ) else {
+        for (body, moving) in [a, b].into_iter().zip(&moving) {
+            let (s1, integral) = moving.polhode.advance(moving.s0, h);
+            moving.finish(body, s1, integral, h);
+        }
+        return;
+    };
+    let [pa, pb] = [&moving[0].polhode, &moving[1].polhode];
+    let [(sa, ca, da), (sb, cb, db)] = jacobi_sn_cn_dn_complement_pair(
+        [start_a.delta, start_b.delta],
+        [pa.m, pb.m],
+        [pa.m1, pb.m1],
+    );
+    let (s1a, integral_a) = pa.short_end(&start_a, sa, ca, da);
+    let (s1b, integral_b) = pb.short_end(&start_b, sb, cb, db);
+    moving[0].finish(a, s1a, integral_a, h);
+    moving[1].finish(b, s1b, integral_b, h);
+}
 
-    // Euler frame (a, b, c) = sorted (2, 3, 1).
-    let euler = |s: DVec3| DVec3::new(s.y, s.z, s.x);
-    let (sin_half, cos_half) = sin_cos(0.5 * delta_phi);
-    let spin = DQuat::from_xyzw(0.0, 0.0, sin_half, cos_half);
-    let before = to_momentum_frame(euler(s0), magnitude);
-    let after = to_momentum_frame(euler(s1), magnitude);
-    let turn = before.conjugate() * spin * after;
-    // The turn's axis from Euler-frame to principal components: (a, b, c) → sorted (y, z, x).
-    let axis = axes.to_principal(DVec3::new(turn.z, turn.x, turn.y));
-    let turn = DQuat::from_xyzw(axis.x, axis.y, axis.z, turn.w);
-    body.q = (body.q * turn).normalize();
-    body.m = axes.to_principal(s1);
+/// The free rotation of `exact` over `h`: [`rotate_freely`] with [`exact_free_flow`].
+#[inline]
+pub(crate) fn rotate_exactly(state: &mut BodyState, mass: &MassProperties, h: Real) {
+    rotate_freely(state, mass, h, exact_free_flow);
+}
+
+/// The exact free rotation over `h` of two non-spherical bodies ([`rotate_freely`] with
+/// [`exact_free_flow`] for each), through [`exact_free_flow_pair`]: the same bits as one by one.
+#[inline]
+pub(crate) fn rotate_exactly_pair(
+    states: [&mut BodyState; 2],
+    masses: [&MassProperties; 2],
+    h: Real,
+) {
+    let [a, b] = states;
+    let mut free = [FreeState::new(a, masses[0]), FreeState::new(b, masses[1])];
+    let r = [free[0].r, free[1].r];
+    let [fa, fb] = &mut free;
+    exact_free_flow_pair([&mut fa.body, &mut fb.body], r, h.widen());
+    fa.write(a);
+    fb.write(b);
 }
 
 #[cfg(test)]

@@ -58,7 +58,7 @@ use crate::state::{BodyState, Wrench};
 
 // The public surface is the `Integrator` enum, the batch interface, the kernel path and the two
 // frame rotations the tests and reports measure with; each method's functions are internal.
-use exact_flow::exact_free_flow;
+use exact_flow::rotate_exactly;
 pub use frame::{rotate, rotate_inv};
 use implicit_gyroscopic::implicit_gyroscopic;
 use lclamp::lclamp;
@@ -205,9 +205,7 @@ impl Integrator {
     fn free_rotation(self) -> Rotation {
         match self {
             Integrator::Rk4 => |s, m, h| rotate_freely(s, m, h, rk4_free_flow),
-            Integrator::Exact | Integrator::Exact4 => {
-                |s, m, h| rotate_freely(s, m, h, exact_free_flow)
-            }
+            Integrator::Exact | Integrator::Exact4 => rotate_exactly,
             Integrator::SplittingXyz => |s, m, h| rotate_freely(s, m, h, strang_free_flow),
             _ => rotate_symmetric,
         }

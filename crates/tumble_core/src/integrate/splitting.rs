@@ -143,22 +143,45 @@ pub fn rotate_freely(state: &mut BodyState, mass: &MassProperties, h: Real, flow
         state.rotation = rotate_exact(state.rotation, state.angular_velocity, h);
         return;
     }
-    let frame = mass.principal_frame().widen();
-    let q = state.rotation.widen() * frame;
-    let inertia = mass.principal_inertia().widen();
-    let r = DVec3::new(
-        reciprocal(inertia.x),
-        reciprocal(inertia.y),
-        reciprocal(inertia.z),
-    );
-    let mut body = FreeBody {
-        q,
-        m: inertia * rotate64(q.conjugate(), state.angular_velocity.widen()),
-    };
-    flow(&mut body, r, h.widen());
-    let q = body.q.normalize();
-    state.angular_velocity = rotate64(q, r * body.m).narrow();
-    state.rotation = crate::math::quat_normalize((q * frame.conjugate()).narrow());
+    let mut free = FreeState::new(state, mass);
+    flow(&mut free.body, free.r, h.widen());
+    free.write(state);
+}
+
+/// A non-spherical body's state as a free flow advances it: the [`FreeBody`], its reciprocal
+/// principal moments and its principal frame (see [`rotate_freely`]).
+pub(crate) struct FreeState {
+    pub(crate) body: FreeBody,
+    pub(crate) r: DVec3,
+    frame: DQuat,
+}
+
+impl FreeState {
+    /// The free body of `state`.
+    #[inline(always)]
+    pub(crate) fn new(state: &BodyState, mass: &MassProperties) -> Self {
+        let frame = mass.principal_frame().widen();
+        let q = state.rotation.widen() * frame;
+        let inertia = mass.principal_inertia().widen();
+        let r = DVec3::new(
+            reciprocal(inertia.x),
+            reciprocal(inertia.y),
+            reciprocal(inertia.z),
+        );
+        let body = FreeBody {
+            q,
+            m: inertia * rotate64(q.conjugate(), state.angular_velocity.widen()),
+        };
+        Self { body, r, frame }
+    }
+
+    /// Writes the flowed body back into `state`, rounded to the engine's precision.
+    #[inline(always)]
+    pub(crate) fn write(&self, state: &mut BodyState) {
+        let q = self.body.q.normalize();
+        state.angular_velocity = rotate64(q, self.r * self.body.m).narrow();
+        state.rotation = crate::math::quat_normalize((q * self.frame.conjugate()).narrow());
+    }
 }
 
 /// Kick for `h`: `v += h F/m`, `L += h τ` (so `ω += h I⁻¹ τ` at the current pose).
