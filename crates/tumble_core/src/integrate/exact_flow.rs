@@ -376,6 +376,12 @@ fn steady_flow(body: &mut FreeBody, r: DVec3, h: f64) {
     body.q = (body.q * exp_body(h * (r * body.m))).normalize();
 }
 
+/// Sorted components → the Euler frame `(a, b, c)` = sorted `(2, 3, 1)`.
+#[inline(always)]
+fn euler(s: DVec3) -> DVec3 {
+    DVec3::new(s.y, s.z, s.x)
+}
+
 /// A moving body in the sorted frame, before its momentum advances.
 struct Moving {
     axes: SortedAxes,
@@ -383,6 +389,10 @@ struct Moving {
     rs: DVec3,
     /// Sorted momentum at the start.
     s0: DVec3,
+    /// `|m|`.
+    magnitude: f64,
+    /// The momentum frame at the start, `B(m₀)` of the module docs.
+    before: DQuat,
     polhode: Polhode,
 }
 
@@ -391,10 +401,15 @@ impl Moving {
     fn new(m: DVec3, r: DVec3) -> Self {
         let axes = SortedAxes::new(r);
         let (rs, s0) = (axes.to_sorted(r).abs(), axes.to_sorted(m));
+        let magnitude = s0.length();
         Self {
             axes,
             rs,
             s0,
+            magnitude,
+            // Not needed before the end, but independent of the flow: here it overlaps the flow's
+            // long chain instead of lengthening the end's.
+            before: to_momentum_frame(euler(s0), magnitude),
             polhode: Polhode::new(s0, rs),
         }
     }
@@ -403,19 +418,14 @@ impl Moving {
     /// phase integral over the span `h`.
     #[inline(always)]
     fn finish(&self, body: &mut FreeBody, s1: DVec3, integral: f64, h: f64) {
-        let (rs, s0, polhode) = (self.rs, self.s0, &self.polhode);
-        let magnitude = s0.length();
+        let (rs, magnitude, polhode) = (self.rs, self.magnitude, &self.polhode);
         let d23 = rs.y - rs.z;
         let delta_phi =
             magnitude * rs.z * h + magnitude * d23 * polhode.kappa / polhode.lambda * integral;
-
-        // Euler frame (a, b, c) = sorted (2, 3, 1).
-        let euler = |s: DVec3| DVec3::new(s.y, s.z, s.x);
         let (sin_half, cos_half) = sin_cos(0.5 * delta_phi);
         let spin = DQuat::from_xyzw(0.0, 0.0, sin_half, cos_half);
-        let before = to_momentum_frame(euler(s0), magnitude);
         let after = to_momentum_frame(euler(s1), magnitude);
-        let turn = before.conjugate() * spin * after;
+        let turn = self.before.conjugate() * spin * after;
         // The turn's axis from Euler-frame to principal components: (a, b, c) → sorted (y, z, x).
         let axis = self.axes.to_principal(DVec3::new(turn.z, turn.x, turn.y));
         let turn = DQuat::from_xyzw(axis.x, axis.y, axis.z, turn.w);
