@@ -14,8 +14,8 @@ use crate::math::{Quat, Real, Vec3};
 use std::borrow::Borrow;
 
 use super::Integrator;
-use super::simd::{Kernel, LANES};
 use super::exact_flow::{rotate_exactly, rotate_exactly_pair};
+use super::simd::{Kernel, LANES};
 use super::splitting::{drift_kick_drift_translation, free_rotation_span};
 use super::symmetric_kernel::{
     LaneInputs, SymmetricInput, rotate_symmetric_lanes, rotate_symmetric_one,
@@ -409,7 +409,13 @@ impl Integrator {
         if let [c] = self.composition() {
             return self.stage_batch(StepPhase::Whole, bodies, c * dt);
         }
-        each_alone(bodies, |s, m, w| self.step(s, m, w, dt));
+        let alone = |s: &mut BodyState, m: &MassProperties, w: &Wrench| self.step(s, m, w, dt);
+        if self == Integrator::Exact4 {
+            // Without torque its composed step is the translation of a whole stage over `dt`
+            // and one exact rotation over `dt` (see `Integrator::step`): a whole stage's work.
+            return paired(StepPhase::Whole, bodies, dt, alone);
+        }
+        each_alone(bodies, alone);
     }
 
     /// Runs [`stage_batch`](Self::stage_batch) over plain arrays; returns the diverged indices

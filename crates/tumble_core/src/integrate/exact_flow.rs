@@ -69,13 +69,13 @@ use glam::{DQuat, DVec3};
 
 use super::sin_cos;
 use super::splitting::{FreeBody, FreeState, rotate_freely};
-use crate::mass::MassProperties;
-use crate::math::{Real, Widen};
-use crate::state::BodyState;
 use crate::elliptic::{
     complete_k_complement, incomplete_f_sin_cos, integral_sn2_over, jacobi_sn_cn_dn_complement,
     jacobi_sn_cn_dn_complement_pair, norm2, sign,
 };
+use crate::mass::MassProperties;
+use crate::math::{Real, Widen};
+use crate::state::BodyState;
 
 /// `atan x`: the series `x − x³/3 + x⁵/5 − x⁷/7` below `|x| = 10⁻³` (the first term left out,
 /// `x⁹/9`, is below `10⁻¹⁸ |x|`), tumble's own `atan` above.
