@@ -6,7 +6,9 @@
 //! rotations of up to eight non-spherical bodies are computed together in SIMD lanes by the
 //! kernel of `symmetric_kernel`, on the [`kernel_path`](super::kernel_path) (and so for each
 //! stage of `yoshida4`, a composition of `splitting` steps); the translation,
-//! the kicks and spherical bodies stay scalar. Every other method steps body by body. Either way each body's result is bit-identical
+//! the kicks and spherical bodies stay scalar. `exact` and `exact4` rotate two bodies at a time,
+//! in scalar code run stage by stage so that their long dependency chains overlap. Every other
+//! method steps body by body. Either way each body's result is bit-identical
 //! to [`Integrator::try_step`] and the stage functions on that body alone, whatever the batch, its order or
 //! the thread that runs it.
 
@@ -382,7 +384,7 @@ impl Integrator {
         let alone = |s: &mut BodyState, m: &MassProperties, w: &Wrench| {
             self.stage(phase, s, m, w, h);
         };
-        if self == Integrator::Exact || self == Integrator::Exact4 {
+        if self.is_exact_torque_free() {
             return match phase {
                 StepPhase::Whole => paired(StepPhase::Whole, bodies, h, alone),
                 StepPhase::Begin => paired(StepPhase::Begin, bodies, h, alone),
