@@ -268,7 +268,8 @@ pub fn markdown(results: &Results, plots: &[String]) -> String {
         out,
         "## Headline: error at Δt = 1/60 s\n\nOrientation error (rad) for the tops, position \
          error (m, or orientation where larger) for the others, at each scene's horizon; \
-         ns/body-step is the median over scenes.\n"
+         ns/body-step is the median over scenes, each timed through the ECS (the batched \
+         systems users run, 64 copies of the scene per world).\n"
     );
     out.push_str(&headline_table(&results.work_precision));
     let _ = writeln!(
