@@ -196,17 +196,17 @@ const PINNED_F32: &[(&str, &str)] = &[
 ];
 /// `f64` build (with or without `enhanced-determinism`).
 const PINNED_F64: &[(&str, &str)] = &[
-    ("symplectic-euler", "64d12025f93c0f0d1b1220f7d5cd61ce"),
+    ("symplectic-euler", "d586e8092b90f976189b0b2867c03317"),
     (
         "symplectic-euler-linear",
-        "b832e4699fdddfb4a5d6147139a6fdec",
+        "3be8d0dfdc8ece9e992fb4f3c3757fc3",
     ),
-    ("lclamp", "16ec2f50ca2bcd3412da232f2c387b91"),
-    ("implicit-gyroscopic", "c8d0479838a2e9ad34ddc2a55496f5e9"),
-    ("splitting", "c6ee3ec396f76c60bd16bcbca874c807"),
-    ("splitting-xyz", "8b5eb83cea5b707f4d428dca8cd61c7e"),
+    ("lclamp", "23a4deef6aaa4bb9e3e87b2c7f92aee0"),
+    ("implicit-gyroscopic", "ccf835346065b14500f1125168b7e1d2"),
+    ("splitting", "e9dea2bdb3962308aadf82252890d9bc"),
+    ("splitting-xyz", "6f016ffb8cb56fab17320850b1c2ebea"),
     ("yoshida4", "1810728fe5544054e1504159272a69a4"),
-    ("rk4", "bffaaeff073326ce8acd3db55cc918dc"),
-    ("exact", "e56d3bdb4f06492e957e1d434d9b53f3"),
+    ("rk4", "9bc8eafc089fc03c33d4ccce8d1829e0"),
+    ("exact", "f80a11da387fdf854f7f601485262e09"),
     ("exact4", "5551a1cce4a6e166a934298ff5484c0c"),
 ];

@@ -264,7 +264,7 @@ fn damped_spring_never_gains_energy() {
 /// following it; at ωΔt = 0.1 and ζ = 2 it is +1.7 %).
 #[test]
 fn damped_spring_loses_energy_at_the_physical_rate() {
-    use tumble::core::exact::DampedSpring;
+    use tumble_reference::exact::DampedSpring;
     let (m, k) = (1.0_f64, 40.0_f64);
     let omega = (k / m).sqrt();
     for omega_dt in [0.1, 0.25, 0.5] {

@@ -7,9 +7,9 @@
 //! must be within ±0.3 of the nominal order. `exact` has no truncation error: its error must stay
 //! at the round-off floor at every step.
 
-use tumble::core::reference::free_body;
 use tumble::core::rotation::angle_between;
 use tumble::math::{Quat, Real, Vec3, Widen, to_f64};
+use tumble_reference::rk4::free_body;
 
 use tumble::prelude::*;
 

@@ -3,7 +3,7 @@
 //! Damping is a flow of its own split symmetrically around the conservative step,
 //! `D(Δt/2) ∘ step ∘ D(Δt/2)`, so the drift–kick–drift `splitting` stays second order. Measured
 //! here against independent f64 solutions: the damped oscillator's closed form
-//! ([`tumble::core::exact::damped_spring`]) and, for a net of asymmetric bodies with off-centre
+//! ([`tumble_reference::exact::damped_spring`]) and, for a net of asymmetric bodies with off-centre
 //! anchors, a tiny-step RK4 of the same equations of motion written out below.
 //!
 //! The observed order is the least-squares slope of log(error) against log(Δt) over a sweep at
@@ -13,10 +13,10 @@
 
 use glam::{DQuat, DVec3};
 use tumble::bevy_ecs::prelude::*;
-use tumble::core::exact::DampedSpring;
 use tumble::core::rotation::angle_between;
 use tumble::math::{Quat, Real, Vec3, Widen, to_f64};
 use tumble::prelude::*;
+use tumble_reference::exact::DampedSpring;
 
 /// Least-squares slope of log(error) against log(Δt).
 fn observed_order(errors: &[(f64, f64)]) -> f64 {

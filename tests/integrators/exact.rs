@@ -10,12 +10,12 @@
 //! `|ω|Δt = 3`; 2ε at `|ω|Δt = 0.1`). The targets (f64:
 //! 1e-5 rad and 1e-6 in energy and |L| over 10 s; f32: 1e-3 rad) are asserted as well.
 
-use tumble::core::exact::TorqueFreeTop;
-use tumble::core::reference::free_body;
 use tumble::core::rotation::angle_between;
 use tumble::glam::{DQuat, DVec3};
 use tumble::math::{DOUBLE_PRECISION, Real, Vec3, Widen, to_f64};
 use tumble::prelude::*;
+use tumble_reference::exact::TorqueFreeTop;
+use tumble_reference::rk4::free_body;
 
 use super::harness::torque_free;
 

@@ -4,10 +4,10 @@
 //! times; ω₀ = (0.01, 10, 0.01), within 5e-7 of the separatrix, flips 44 times. Near the
 //! separatrix the count is decided by round-off; in f32 we accept 44 ± 2 as the issue states.
 
-use tumble::core::exact::TorqueFreeTop;
 use tumble::glam::DQuat;
 use tumble::math::{Real, Vec3, Widen, to_f64};
 use tumble::prelude::*;
+use tumble_reference::exact::TorqueFreeTop;
 
 use super::harness::torque_free;
 

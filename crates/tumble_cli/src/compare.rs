@@ -1,7 +1,6 @@
 //! `tumble compare`: the scene in tumble and in rapier 0.36, side by side.
 
 use glam::DQuat;
-use tumble_core::exact::TorqueFreeTop;
 use tumble_core::math::{Narrow, Quat, Real, Vec3, Widen, to_f64};
 use tumble_core::{BodyState, Integrator};
 use tumble_ecs::prelude::SpringSolver;
@@ -9,6 +8,7 @@ use tumble_rapier::{
     Comparison, ComparisonBody, ComparisonOptions, ComparisonScene, ComparisonSpring,
     ComparisonSpringEnd, Load, RapierSprings, compare,
 };
+use tumble_reference::exact::TorqueFreeTop;
 use tumble_scene::text::terminal_safe;
 use tumble_scene::{ForceDef, Scene};
 

@@ -34,9 +34,9 @@ pub(crate) fn norm2(x: f64, y: f64) -> f64 {
     }
 }
 
-/// `±1` by the sign bit, `+1` for `+0`.
+/// `−1` for a negative `x`, `+1` otherwise (`+1` for `±0`).
 #[inline]
-pub(crate) fn sign(x: f64) -> f64 {
+pub fn sign(x: f64) -> f64 {
     if x < 0.0 { -1.0 } else { 1.0 }
 }
 

@@ -1,9 +1,11 @@
 //! # tumble_core
 //!
-//! The ECS-free math of tumble: rigid-body state, mass properties, integrators, invariants and
-//! analytic reference solutions. Everything here is a plain function on plain data, so every
-//! integrator can be tested and benchmarked without an ECS, and the ECS layer (`tumble_ecs`) is a
-//! thin loop over queries that calls these functions.
+//! The ECS-free math of tumble, what a step runs: rigid-body state, mass properties,
+//! integrators (with the elliptic functions of the exact free flow), the implicit spring solve
+//! and invariants. (What tumble is measured against lives in `tumble_reference`.) Everything
+//! here is a plain function on plain data, so every integrator can be tested and benchmarked
+//! without an ECS, and the ECS layer (`tumble_ecs`) is a thin loop over queries that calls
+//! these functions.
 //!
 //! Conventions:
 //! - `BodyState::position` is the world position of the **centre of mass**.
@@ -15,13 +17,11 @@
 pub mod damping;
 pub mod elliptic;
 pub mod error;
-pub mod exact;
 pub mod integrate;
 pub mod invariants;
 pub mod mass;
 pub mod math;
 pub mod prefetch;
-pub mod reference;
 pub mod rotation;
 #[cfg(feature = "serde")]
 mod serde_impls;

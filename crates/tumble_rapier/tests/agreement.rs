@@ -3,9 +3,9 @@
 
 use glam::DQuat;
 use tumble_core::math::{Narrow, Quat, Real, Vec3, Widen, to_f64};
-use tumble_core::reference::free_body;
 use tumble_core::{BodyState, Integrator, Mass, MassProperties};
 use tumble_rapier::{ComparisonBody, ComparisonOptions, ComparisonScene, Load, compare};
+use tumble_reference::rk4::free_body;
 
 /// Round-off unit of the comparison: rapier runs in f32 whatever tumble's precision.
 const RAPIER_EPS: Real = f32::EPSILON as Real;

@@ -1,9 +1,9 @@
 //! Reference scenes with exact solutions (f64).
 
 use glam::{DQuat, DVec3};
-use tumble_core::exact::TorqueFreeTop;
 use tumble_core::math::{Quat, Real, Vec3, Widen, to_f64};
 use tumble_core::{BodyState, Mass, MassProperties, Wrench};
+use tumble_reference::exact::TorqueFreeTop;
 
 /// The load of a reference scene, evaluated at the state where the integrator samples it.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -95,12 +95,9 @@ fn pendulum(point: DVec3, force: DVec3, inertia: f64, t: f64) -> DQuat {
     let h = t / steps as f64;
     let (mut q, mut l) = (DQuat::IDENTITY, DVec3::ZERO);
     for _ in 0..steps {
-        let (a1, b1) = f(q, l);
-        let (a2, b2) = f(q + a1 * (h / 2.0), l + b1 * (h / 2.0));
-        let (a3, b3) = f(q + a2 * (h / 2.0), l + b2 * (h / 2.0));
-        let (a4, b4) = f(q + a3 * h, l + b3 * h);
-        q = (q + (a1 + a2 * 2.0 + a3 * 2.0 + a4) * (h / 6.0)).normalize();
-        l += (b1 + b2 * 2.0 + b3 * 2.0 + b4) * (h / 6.0);
+        let (next, dl) = tumble_reference::rk4::step(q, l, h, f);
+        q = next;
+        l += dl;
     }
     q
 }

@@ -1,5 +1,5 @@
 //! The thin asymmetric plate at every spin rate: each integrator's orientation, energy and `|L|`
-//! error over 10 s at 60 Hz, against the closed-form top ([`tumble_core::exact::TorqueFreeTop`]).
+//! error over 10 s at 60 Hz, against the closed-form top ([`tumble_reference::exact::TorqueFreeTop`]).
 //!
 //! The plate `I = (0.01, 1, 1.01)` is as thin and as asymmetric as a rigid body can be (the
 //! triangle inequality bounds `I₃ − I₂` by `I₁`); it spins about an axis tilted from all three
@@ -7,10 +7,10 @@
 
 use glam::{DQuat, DVec3};
 use serde::Serialize;
-use tumble_core::exact::TorqueFreeTop;
 use tumble_core::math::{Real, Vec3, Widen, to_f64};
 use tumble_core::rotation::angle_between;
 use tumble_core::{BodyState, Integrator, Mass, MassProperties, Wrench};
+use tumble_reference::exact::TorqueFreeTop;
 
 use crate::reference::to_quat;
 

@@ -323,8 +323,15 @@ const PIECE_TURN: f64 = 3.0;
 
 /// Relative size (kinetic-energy norm) of the previous Newton update above which an iteration
 /// refactors the Newton matrix; below it, the iteration is a chord step with the last
-/// factorization.
+/// factorization. A chord step converges linearly and stops at the tolerance, where Newton's
+/// quadratic step overshoots it by orders: in `f32` that costs nothing (storing the state moves
+/// the energy by ~1e-7 per step, ten times the tolerance), in `f64` it would be the largest
+/// error of the step, so there every iteration refactors.
+#[cfg(not(feature = "f64"))]
 const REFACTOR_ABOVE: f64 = 0.3;
+/// See the `f32` constant: in `f64` every iteration is a Newton step.
+#[cfg(feature = "f64")]
+const REFACTOR_ABOVE: f64 = 0.0;
 
 /// A chord step that shrinks the update by less than this factor is followed by a refactor.
 const CHORD_RATE: f64 = 0.25;

@@ -1,12 +1,12 @@
-//! The exact flow against the closed-form top of `crate::exact` (an independent derivation:
+//! The exact flow against the closed-form top of `tumble_reference::exact` (an independent derivation:
 //! Euler angles about the largest or smallest axis by case, the phase by Gauss–Legendre
 //! quadrature, checked there against RK4 at h = 1e-4), in f64.
 
 use glam::{DQuat, DVec3};
 
 use super::exact_free_flow;
-use crate::exact::TorqueFreeTop;
 use crate::integrate::splitting::FreeBody;
+use tumble_reference::exact::TorqueFreeTop;
 
 /// Angle of `a* b`, in radians, from its sine and cosine halves (`acos` of a dot product near 1
 /// would floor at `2√ε ≈ 3e-8`).
@@ -22,19 +22,19 @@ fn reciprocal(i: DVec3) -> DVec3 {
 /// Orientation and body rates of the reference at time `t`.
 type Reference = Box<dyn Fn(f64) -> (DQuat, DVec3)>;
 
-/// The closed-form top (`crate::exact`).
+/// The closed-form top (`tumble_reference::exact`).
 fn closed_form(inertia: DVec3, omega0: DVec3, q0: DQuat) -> Reference {
     let top = TorqueFreeTop::new(inertia, omega0, q0).unwrap();
     Box::new(move |t| (top.orientation(t), top.body_angular_velocity(t)))
 }
 
-/// Classic RK4 at h = 1e-4 (`crate::reference`), from `q0`: its own error is `≈ h⁴|ω|⁵t`, below
+/// Classic RK4 at h = 1e-4 (`tumble_reference::rk4`), from `q0`: its own error is `≈ h⁴|ω|⁵t`, below
 /// 1e-10 for the rates used with it. It stands in where the closed form's phase quadrature is
 /// the harder problem: a thin body circling its largest axis, whose `φ̇` about that axis peaks
 /// at `M/I₁` (the exact flow takes the smallest axis, where `φ̇` stays within `[M/I₃, M/I₂]`).
 fn runge_kutta(inertia: DVec3, omega0: DVec3, q0: DQuat, h: f64, steps: usize) -> Reference {
     let times: Vec<f64> = (1..=steps).map(|k| k as f64 * h).collect();
-    let path = crate::reference::free_body(inertia, omega0, &times);
+    let path = tumble_reference::rk4::free_body(inertia, omega0, &times);
     Box::new(move |t| {
         let k = (t / h).round() as usize - 1;
         (q0 * path[k].0, path[k].1)

@@ -15,16 +15,16 @@ pub mod top;
 
 use thiserror::Error;
 
-pub use crate::elliptic;
-pub use crate::elliptic::{complete_k, incomplete_f, jacobi_amplitude, jacobi_sn_cn_dn};
 pub use linear::{
     DampedSpring, DampingRegime, HarmonicSpring, damped_spring, harmonic_spring, projectile,
 };
 pub use top::{TopMotion, TorqueFreeTop};
+pub use tumble_core::elliptic;
+pub use tumble_core::elliptic::{complete_k, incomplete_f, jacobi_amplitude, jacobi_sn_cn_dn};
 
 /// Largest accepted `||q₀| − 1|` of an initial orientation; it is renormalized on input.
 ///
-/// Same as the crate-wide [`crate::UNIT_QUATERNION_TOLERANCE`], so any state the engine
+/// Same as the crate-wide [`tumble_core::UNIT_QUATERNION_TOLERANCE`], so any state the engine
 /// accepts can seed a reference.
 pub const ORIENTATION_TOLERANCE: f64 = 1e-4;
 
@@ -55,13 +55,13 @@ pub enum ExactError {
 
 #[cfg(test)]
 mod tolerance_tests {
-    use crate::math::Narrow;
+    use tumble_core::math::Narrow;
 
     #[test]
     fn orientation_tolerance_is_the_engine_tolerance() {
         assert_eq!(
             super::ORIENTATION_TOLERANCE.narrow(),
-            crate::UNIT_QUATERNION_TOLERANCE
+            tumble_core::UNIT_QUATERNION_TOLERANCE
         );
     }
 }

@@ -71,7 +71,7 @@ use std::f64::consts::{FRAC_PI_3, TAU};
 use glam::{DMat3, DQuat, DVec3};
 
 use super::{ExactError, ORIENTATION_TOLERANCE};
-use crate::elliptic::{
+use tumble_core::elliptic::{
     complete_k_complement, incomplete_f_sin_cos, jacobi_sn_cn_dn_complement, sign,
 };
 
@@ -531,15 +531,12 @@ mod tests {
                     (target - t) / steps as f64
                 };
                 for _ in 0..steps {
-                    let (a1, b1) = rate(q, l);
-                    let (a2, b2) = rate(q + a1 * (h / 2.0), l + b1 * (h / 2.0));
-                    let (a3, b3) = rate(q + a2 * (h / 2.0), l + b2 * (h / 2.0));
-                    let (a4, b4) = rate(q + a3 * h, l + b3 * h);
-                    q = (q + (a1 + a2 * 2.0 + a3 * 2.0 + a4) * (h / 6.0)).normalize();
+                    let (next, dl) = crate::rk4::step(q, l, h, rate);
+                    q = next;
                     // Compensated (Kahan) update of L_b: near the separatrix the motion depends
                     // on M² − 2EI₂, a small difference of large invariants, so plain round-off
                     // of 1e-16 per step would random-walk it far beyond the truncation error.
-                    let delta = (b1 + b2 * 2.0 + b3 * 2.0 + b4) * (h / 6.0) - carry;
+                    let delta = dl - carry;
                     let sum = l + delta;
                     carry = (sum - l) - delta;
                     l = sum;
