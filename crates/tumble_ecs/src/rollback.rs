@@ -221,8 +221,8 @@ impl RollbackSnapshot {
         snapshot
     }
 
-    /// Captures `world` into `self`, reusing its buffers (no allocation once they are large
-    /// enough).
+    /// Captures `world` into `self`, reusing its record buffers (the body and generator
+    /// queries are still built afresh on each call, a few small allocations).
     pub fn capture_into(&mut self, world: &mut World) {
         self.settings = world
             .get_resource::<PhysicsSettings>()
