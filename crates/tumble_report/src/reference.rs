@@ -2,7 +2,7 @@
 
 use glam::{DQuat, DVec3};
 use tumble_core::math::{Quat, Real, Vec3, Widen, to_f64};
-use tumble_core::{BodyState, Mass, MassProperties, Wrench};
+use tumble_core::{BodyState, Mass, MassProperties};
 use tumble_reference::exact::TorqueFreeTop;
 
 /// The load of a reference scene, evaluated at the state where the integrator samples it.
@@ -24,25 +24,6 @@ pub enum Load {
 }
 
 impl Load {
-    /// The load on a body in `state`.
-    pub fn wrench(&self, state: &BodyState, mass: &MassProperties) -> Wrench {
-        match *self {
-            Load::Free => Wrench::ZERO,
-            Load::Gravity(g) => Wrench {
-                force: mass.mass() * g,
-                torque: Vec3::ZERO,
-            },
-            Load::Spring(k) => Wrench {
-                force: -k * state.position,
-                torque: Vec3::ZERO,
-            },
-            Load::ForceAtPoint { force, point } => Wrench {
-                force,
-                torque: (state.rotation * point).cross(force),
-            },
-        }
-    }
-
     /// Potential energy (J), so that kinetic + potential is conserved.
     pub fn potential(&self, state: &BodyState, mass: &MassProperties) -> f64 {
         let x = state.position.widen();

@@ -1026,10 +1026,11 @@ impl ImplicitSpringSolver {
         self.preconditioner = preconditioner;
     }
 
-    /// Adds the springs' part `¼ GᵀKG` of the Newton matrix into `blocks`: a body's own ends (and both ends of a spring with both on one body) on its
-    /// diagonal block `(i, i)`, the coupling of the two ends of a spring between two bodies off
-    /// it. Per spring the products `K G_f` and `E_e K` are formed once per end and shared by
-    /// the blocks (see [`add_coupling`]).
+    /// Adds the springs' part `¼ GᵀKG` of the Newton matrix into `blocks`: a body's own ends
+    /// (and both ends of a spring with both on one body) on its diagonal block `(i, i)`, the
+    /// coupling of the two ends of a spring between two bodies off it. Per spring the products
+    /// `K G_f` and `E_e K` are formed once per end and shared by the blocks (see
+    /// [`add_coupling`]).
     fn assemble_springs(&self, h: f64, blocks: &mut impl BlockSink) {
         let len = self.starts.len();
         for (link, lin) in self.links.iter().zip(&self.lin) {
@@ -1072,7 +1073,7 @@ impl ImplicitSpringSolver {
         }
     }
 
-    /// The two 3×3 factors of a spring end's blocks of the Newton matrix (see [`coupling`]) on
+    /// The two 3×3 factors of a spring end's blocks of the Newton matrix (see [`add_coupling`]) on
     /// body `i`, with mean anchor `b` and lever arm `arm` (see [`Linearized`]):
     /// `G_turn = −h R C [b]× F`, how the body's turn moves the anchor (see `end_jacobian`), and
     /// `E_turn = h F [arm]× Mᵀ`, the torque of a world force at the anchor (see
