@@ -30,15 +30,20 @@ pub enum GenKind {
     /// Many tumbling bodies under gravity, on a grid.
     #[command(allow_negative_numbers = true)]
     Many {
-        /// Number of bodies (1 to 200000: the generated file must stay loadable).
+        /// Number of bodies: 1 to 200000 in TOML, 1 to 10000000 in JSON (the generated file
+        /// must stay loadable).
         #[arg(long, default_value_t = 100_000, allow_hyphen_values = true)]
         n: i64,
         /// Steps (1 to 1000000000, as `run` accepts).
         #[arg(long, default_value_t = 600, allow_hyphen_values = true)]
         steps: i64,
-        /// Output file, `-` for stdout (default: stdout).
+        /// Output file, `-` for stdout (default: stdout). A name ending in `.json` gets JSON,
+        /// the format for large scenes (read as a stream); any other, TOML.
         #[arg(long)]
         out: Option<PathBuf>,
+        /// `toml` or `json` (default: by the extension of `--out`, else `toml`).
+        #[arg(long, value_parser = ["toml", "json"])]
+        format: Option<String>,
     },
 }
 
@@ -117,6 +122,11 @@ pub struct RunArgs {
     /// Record every K-th step (step 0 is always recorded).
     #[arg(long, default_value_t = 1, allow_hyphen_values = true)]
     pub every: i64,
+    /// Record only these bodies: a comma-separated list of names or patterns (`*` any run of
+    /// characters, `?` one character, `[abc]` one of a class), e.g. `--bodies 'b1,b2?,b9*'`.
+    /// Rows keep the order of the scene file; a pattern that matches no body is an error.
+    #[arg(long)]
+    pub bodies: Option<OsString>,
     /// Print the planned systems and exit.
     #[arg(long)]
     pub plan: bool,

@@ -6,37 +6,58 @@ use std::path::Path;
 
 use tumble_scene::output::{OutputError, OutputFile};
 use tumble_scene::text::path_for_terminal;
-use tumble_scene::{MAX_SCENE_BYTES, MAX_STEPS};
+use tumble_scene::{
+    BodyDef, MAX_JSON_SCENE_BYTES, MAX_SCENE_BYTES, MAX_STEPS, SceneSyntax, WorldDef,
+};
 
 use crate::exit::{self, Failure};
 use crate::interrupt;
 
-/// Most bodies `gen many` writes: [`RECORD_BYTES_BOUND`] × this, plus the header, stays under
-/// [`MAX_SCENE_BYTES`], so the file loads.
+/// Most bodies `gen many` writes in TOML: [`RECORD_BYTES_BOUND`] × this, plus the header,
+/// stays under [`MAX_SCENE_BYTES`], so the file loads.
 pub const MAX_BODIES: i64 = 200_000;
 
-/// A bound on the bytes of one body's record in [`many_bodies`]: 128 bytes of fixed text,
-/// the name (`b` and 6 digits), three grid coordinates of at most 3 digits (the grid side is
-/// ≤ 59 at [`MAX_BODIES`]), and 7 numbers of at most 25 characters each (`f64` `Display` of a
+/// Most bodies `gen many` writes in JSON: [`JSON_RECORD_BYTES_BOUND`] × this, plus the
+/// header, stays under [`MAX_JSON_SCENE_BYTES`].
+pub const MAX_JSON_BODIES: i64 = 10_000_000;
+
+/// A bound on the bytes of one body's record in TOML: 128 bytes of fixed text, the name (`b`
+/// and up to 8 digits), three grid coordinates of at most 4 digits (the grid side is ≤ 216 at
+/// [`MAX_JSON_BODIES`]), and 7 numbers of at most 25 characters each (`f64` `Display` of a
 /// value in (0, 6) is at most 17 significant digits, the point, and a few leading zeros).
-const RECORD_BYTES_BOUND: u64 = 128 + 7 + 3 * 3 + 7 * 25;
+const RECORD_BYTES_BOUND: u64 = 128 + 9 + 3 * 4 + 7 * 25;
+
+/// The same bound for a JSON record: 180 bytes of keys, brackets, the default rotation, gravity
+/// scale and zeros (156 bytes besides the name and the 9 numbers), the name, and 9
+/// numbers of at most 24 characters (`ryu`'s shortest `f64`, exponent included).
+const JSON_RECORD_BYTES_BOUND: u64 = 180 + 9 + 9 * 24;
 
 const _: () = assert!(MAX_BODIES as u64 * RECORD_BYTES_BOUND + 256 <= MAX_SCENE_BYTES);
+const _: () =
+    assert!(MAX_JSON_BODIES as u64 * JSON_RECORD_BYTES_BOUND + 256 <= MAX_JSON_SCENE_BYTES);
 
-/// `n` and `steps` as `gen many` accepts them.
-pub fn check_many(n: i64, steps: i64) -> Result<(u64, u64), Failure> {
-    if !(1..=MAX_BODIES).contains(&n) {
-        let why = if n > MAX_BODIES {
-            format!(
-                " (more would not fit in a scene file of {} MiB)",
-                MAX_SCENE_BYTES >> 20
-            )
-        } else {
-            String::new()
+/// `n` and `steps` as `gen many` accepts them for a file in `syntax`.
+pub fn check_many(n: i64, steps: i64, syntax: SceneSyntax) -> Result<(u64, u64), Failure> {
+    let (most, limit) = match syntax {
+        SceneSyntax::Toml => (MAX_BODIES, MAX_SCENE_BYTES),
+        SceneSyntax::Json => (MAX_JSON_BODIES, MAX_JSON_SCENE_BYTES),
+    };
+    if !(1..=most).contains(&n) {
+        let why = match syntax {
+            _ if n <= most => String::new(),
+            SceneSyntax::Toml => format!(
+                " (more would not fit in a TOML scene file of {} MiB; write JSON, e.g. --out \
+                 many.json, for up to {MAX_JSON_BODIES})",
+                limit >> 20
+            ),
+            SceneSyntax::Json => format!(
+                " (more would not fit in a JSON scene file of {} GiB)",
+                limit >> 30
+            ),
         };
         return Err(Failure::new(
             exit::ERROR,
-            format!("--n: expected 1 to {MAX_BODIES} bodies, got {n}{why}"),
+            format!("--n: expected 1 to {most} bodies, got {n}{why}"),
         ));
     }
     if !(1..=MAX_STEPS as i64).contains(&steps) {
@@ -48,76 +69,183 @@ pub fn check_many(n: i64, steps: i64) -> Result<(u64, u64), Failure> {
     Ok((n as u64, steps as u64))
 }
 
-/// A scene of `n` asymmetric bodies on a cubic grid, each with its own spin, under gravity;
-/// `None` when interrupted.
-pub fn many_bodies(n: u64, steps: u64, guard: &interrupt::Guard) -> Option<String> {
+/// Body `i` of `n` of the generated scene: asymmetric, on a cubic grid of spacing 2 m, each with
+/// its own mass, inertia, fall speed and spin.
+fn many_body(i: u64, n: u64) -> BodyDef {
     let side = (n as f64).cbrt().ceil().max(1.0) as u64;
+    let (x, y, z) = (i % side, (i / side) % side, i / (side * side));
+    let f = i as f64 / n.max(1) as f64;
+    BodyDef {
+        name: format!("b{i}"),
+        mass: Some(1.0 + f),
+        inertia: Some([1.0, 2.0 + f, 3.0 + f]),
+        shape: None,
+        density: None,
+        position: [2.0 * x as f64, 2.0 * y as f64, 2.0 * z as f64],
+        rotation: [0.0, 0.0, 0.0, 1.0],
+        linear_velocity: [0.0, 5.0 * f, 0.0],
+        angular_velocity: [0.3 + f, 1.0 - f, 0.3],
+        gravity_scale: 1.0,
+        linear_damping: 0.0,
+        angular_damping: 0.0,
+    }
+}
+
+/// The generated scene's world: 60 Hz steps under gravity.
+fn many_world(steps: u64) -> WorldDef {
+    WorldDef {
+        dt: 0.016666668,
+        steps,
+        integrator: None,
+        springs: None,
+        substeps: None,
+        gravity: Some([0.0, -9.81, 0.0]),
+    }
+}
+
+/// A scene of `n` bodies ([`many_body`]) in TOML; `None` when interrupted.
+pub fn many_bodies(n: u64, steps: u64, guard: &interrupt::Guard) -> Option<String> {
+    let w = many_world(steps);
+    let [gx, gy, gz] = w.gravity.unwrap_or_default();
     let mut text = format!(
-        "name = \"many-{n}\"\n[world]\ndt = 0.016666668\nsteps = {steps}\ngravity = [0.0, -9.81, 0.0]\n"
+        "name = \"many-{n}\"\n[world]\ndt = {}\nsteps = {steps}\ngravity = [{gx:?}, {gy:?}, {gz:?}]\n",
+        w.dt
     );
     for i in 0..n {
         if i.is_multiple_of(4096) && guard.interrupted() {
             return None;
         }
-        let (x, y, z) = (i % side, (i / side) % side, i / (side * side));
-        let f = i as f64 / n.max(1) as f64;
+        let b = many_body(i, n);
+        let (Some(mass), Some(inertia)) = (b.mass, b.inertia) else {
+            unreachable!("generated bodies have a mass and an inertia")
+        };
+        let [px, py, pz] = b.position;
+        let [wx, wy, wz] = b.angular_velocity;
         let _ = write!(
             text,
-            "[[bodies]]\nname = \"b{i}\"\nmass = {}\ninertia = [1.0, {}, {}]\nposition = [{}, {}, {}]\nlinear_velocity = [0.0, {}, 0.0]\nangular_velocity = [{}, {}, 0.3]\n",
-            1.0 + f,
-            2.0 + f,
-            3.0 + f,
-            2 * x,
-            2 * y,
-            2 * z,
-            5.0 * f,
-            0.3 + f,
-            1.0 - f
+            "[[bodies]]\nname = \"{}\"\nmass = {mass}\ninertia = [{:?}, {}, {}]\nposition = [{px}, {py}, {pz}]\nlinear_velocity = [0.0, {}, 0.0]\nangular_velocity = [{wx}, {wy}, {wz}]\n",
+            b.name, inertia[0], inertia[1], inertia[2], b.linear_velocity[1]
         );
     }
     Some(text)
 }
 
-/// `tumble gen many`: the scene to `out` (a file, or stdout for `None` and `-`).
-pub fn run(n: i64, steps: i64, out: Option<&Path>) -> Result<(), Failure> {
-    let (n, steps) = check_many(n, steps)?;
+/// Writes the scene of `n` bodies ([`many_body`]) as JSON to `out`, one body per line (so that
+/// an error in a hand-edited copy names a useful line), without holding the text. Fails with
+/// [`std::io::ErrorKind::Interrupted`] when interrupted.
+pub fn write_many_json(
+    n: u64,
+    steps: u64,
+    guard: &interrupt::Guard,
+    out: impl std::io::Write,
+) -> std::io::Result<()> {
+    let mut w = std::io::BufWriter::with_capacity(1 << 16, out);
+    write!(w, "{{\"name\":\"many-{n}\",\"world\":")?;
+    serde_json::to_writer(&mut w, &many_world(steps))?;
+    write!(w, ",\"bodies\":[")?;
+    for i in 0..n {
+        if i.is_multiple_of(4096) && guard.interrupted() {
+            return Err(std::io::ErrorKind::Interrupted.into());
+        }
+        w.write_all(if i == 0 { b"\n" } else { b",\n" })?;
+        serde_json::to_writer(&mut w, &many_body(i, n))?;
+    }
+    w.write_all(b"\n]}\n")?;
+    w.flush()
+}
+
+/// `tumble gen many`: the scene to `out` (a file, or stdout for `None` and `-`), in `format`
+/// (default: JSON for a file name ending in `.json`, else TOML).
+pub fn run(
+    n: i64,
+    steps: i64,
+    out: Option<&Path>,
+    format: Option<SceneSyntax>,
+) -> Result<(), Failure> {
+    let file_out = out.filter(|p| !crate::is_stdout(p));
+    let syntax = match (format, file_out) {
+        (Some(format), Some(path)) if SceneSyntax::of(path) != format => {
+            return Err(Failure::new(
+                exit::ERROR,
+                format!(
+                    "--format {}: {} is read as {} (scene files are read by their extension: \
+                     .json is JSON, anything else TOML)",
+                    syntax_name(format),
+                    path_for_terminal(path),
+                    syntax_name(SceneSyntax::of(path))
+                ),
+            ));
+        }
+        (Some(format), _) => format,
+        (None, Some(path)) => SceneSyntax::of(path),
+        (None, None) => SceneSyntax::Toml,
+    };
+    let (n, steps) = check_many(n, steps, syntax)?;
     // Polling starts first so that it ends last, after the temporary file is removed.
     let guard = interrupt::Guard::poll();
     // The output is checked (and its temporary file made) before the work.
-    let file = match out {
-        Some(path) if !crate::is_stdout(path) => Some(OutputFile::create(path, &[])?),
-        _ => None,
+    let mut file = match file_out {
+        Some(path) => Some(OutputFile::create(path, &[])?),
+        None => None,
     };
-    let text = many_bodies(n, steps, &guard).ok_or_else(|| {
-        let unchanged = out
-            .filter(|p| !crate::is_stdout(p))
+    let interrupted = || {
+        let unchanged = file_out
             .map(|p| format!("; {} was not written", path_for_terminal(p)))
             .unwrap_or_default();
         Failure::new(exit::INTERRUPTED, format!("interrupted{unchanged}"))
-    })?;
-    // Cannot happen below the caps; checked so that a change of the generator cannot slip by.
-    if text.len() as u64 > MAX_SCENE_BYTES {
-        return Err(Failure::new(
-            exit::ERROR,
-            format!(
-                "the generated scene is {} bytes, over the {MAX_SCENE_BYTES} bytes `run` reads",
-                text.len()
-            ),
-        ));
-    }
+    };
+    let written = match syntax {
+        SceneSyntax::Json => {
+            let result = match file.as_mut() {
+                Some(file) => write_many_json(n, steps, &guard, file),
+                None => write_many_json(n, steps, &guard, std::io::stdout().lock()),
+            };
+            match result {
+                Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {
+                    return Err(interrupted());
+                }
+                other => other,
+            }
+        }
+        SceneSyntax::Toml => {
+            let text = many_bodies(n, steps, &guard).ok_or_else(interrupted)?;
+            // Cannot happen below the caps; checked so that a change of the generator cannot
+            // slip by.
+            if text.len() as u64 > MAX_SCENE_BYTES {
+                return Err(Failure::new(
+                    exit::ERROR,
+                    format!(
+                        "the generated scene is {} bytes, over the {MAX_SCENE_BYTES} bytes `run` \
+                         reads",
+                        text.len()
+                    ),
+                ));
+            }
+            match file.as_mut() {
+                Some(file) => file.write_all(text.as_bytes()),
+                None => {
+                    let mut stdout = std::io::stdout().lock();
+                    stdout
+                        .write_all(text.as_bytes())
+                        .and_then(|()| stdout.flush())
+                }
+            }
+        }
+    };
     match file {
-        Some(mut file) => {
-            file.write_all(text.as_bytes())
-                .map_err(|e| OutputError::io(file.path(), e))?;
+        Some(file) => {
+            written.map_err(|e| OutputError::io(file.path(), e))?;
             file.commit()?;
         }
-        None => {
-            let mut stdout = std::io::stdout().lock();
-            stdout
-                .write_all(text.as_bytes())
-                .and_then(|()| stdout.flush())
-                .map_err(|e| format!("standard output: {e}"))?;
-        }
+        None => written.map_err(|e| format!("standard output: {e}"))?,
     }
     Ok(())
+}
+
+/// `toml` or `json`, as `--format` spells it.
+pub fn syntax_name(syntax: SceneSyntax) -> &'static str {
+    match syntax {
+        SceneSyntax::Toml => "toml",
+        SceneSyntax::Json => "json",
+    }
 }

@@ -18,7 +18,7 @@ use std::process::ExitCode;
 use clap::Parser;
 use clap::error::ErrorKind;
 use tumble_scene::text::terminal_safe;
-use tumble_scene::{Scene, read_scene_text};
+use tumble_scene::{Scene, load_scene};
 
 use crate::cli::{Cli, Command, GenKind};
 use crate::exit::Failure;
@@ -149,31 +149,26 @@ fn utf8(flag: &str, value: OsString) -> Result<String, Failure> {
     })
 }
 
-/// A scene's text, the name its errors use, and its path when it was read from a file.
+/// A checked scene, and its path when it was read from a file.
 pub struct Loaded {
-    /// The name in error messages.
-    pub file: String,
-    /// The TOML text.
-    pub text: String,
+    /// The scene.
+    pub scene: Scene,
     /// The file it was read from (`None` for a bundled scene).
     pub path: Option<PathBuf>,
 }
 
-/// A bundled scene by name, or a scene file.
+/// A bundled scene by name, or a scene file (TOML, or JSON by its `.json` extension).
 pub fn load(scene: &Path) -> Result<Loaded, Failure> {
     if let Some(name) = scene.to_str()
         && let Some((_, text)) = BUNDLED.iter().find(|(bundled, _)| *bundled == name)
     {
         return Ok(Loaded {
-            file: format!("scenes/{name}.toml"),
-            text: (*text).to_owned(),
+            scene: Scene::parse(&format!("scenes/{name}.toml"), text)?,
             path: None,
         });
     }
-    let text = read_scene_text(scene)?;
     Ok(Loaded {
-        file: scene.display().to_string(),
-        text,
+        scene: load_scene(scene)?,
         path: Some(scene.to_owned()),
     })
 }
@@ -186,15 +181,28 @@ pub fn is_stdout(path: &Path) -> bool {
 fn dispatch(cli: Cli) -> Result<(), Failure> {
     match cli.command {
         Command::Gen {
-            kind: GenKind::Many { n, steps, out },
-        } => generate::run(n, steps, out.as_deref()),
+            kind:
+                GenKind::Many {
+                    n,
+                    steps,
+                    out,
+                    format,
+                },
+        } => {
+            let format = format.map(|f| match f.as_str() {
+                "json" => tumble_scene::SceneSyntax::Json,
+                _ => tumble_scene::SceneSyntax::Toml,
+            });
+            generate::run(n, steps, out.as_deref(), format)
+        }
         Command::Scenes => {
             for (name, text) in BUNDLED {
                 let first = text.lines().find(|l| l.starts_with("name")).unwrap_or("");
                 println!("{name:<16} {first}");
             }
             println!(
-                "{:<16} generated: tumble gen many --n 100000 --out many.toml",
+                "{:<16} generated: tumble gen many --n 100000 --out many.toml (or --n 1000000 \
+                 --out many.json)",
                 "many"
             );
             Ok(())
@@ -213,8 +221,7 @@ fn dispatch(cli: Cli) -> Result<(), Failure> {
                 utf8("--rapier-springs", rapier_springs)?.parse().map_err(
                     |e: tumble_rapier::UnknownRapierSprings| format!("--rapier-springs: {e}"),
                 )?;
-            let loaded = load(&scene)?;
-            let scene = Scene::parse(&loaded.file, &loaded.text)?;
+            let scene = load(&scene)?.scene;
             let integrator = match integrator {
                 Some(name) => {
                     name.parse()

@@ -13,7 +13,7 @@ use tumble_ecs::prelude::*;
 use tumble_scene::output::{OutputError, OutputFile};
 use tumble_scene::text::{path_for_terminal, terminal_safe};
 use tumble_scene::{
-    BuiltScene, MAX_STEPS, MAX_SUBSTEPS, Scene, SceneError, TrajectoryError, csv_text_cell,
+    BuiltScene, MAX_STEPS, MAX_SUBSTEPS, Recording, SceneError, TrajectoryError, csv_text_cell,
 };
 
 use crate::cli::RunArgs;
@@ -114,25 +114,30 @@ pub fn run(args: RunArgs) -> Result<(), Failure> {
         }
         other => other.map(|n| n as u64),
     };
+    let patterns = args
+        .bodies
+        .map(|v| crate::utf8("--bodies", v))
+        .transpose()?
+        .map(|list| body_patterns(&list))
+        .transpose()?;
     let loaded = crate::load(&args.scene)?;
-    let mut scene = Scene::parse(&loaded.file, &loaded.text)?;
+    let mut scene = loaded.scene;
     if steps.is_some()
         || args.dt.is_some()
         || integrator.is_some()
         || springs.is_some()
         || substeps.is_some()
     {
-        // Overrides are applied to the file model, then validated like the file itself.
-        let mut model = scene.file().clone();
-        model.world.steps = steps.unwrap_or(model.world.steps);
-        model.world.dt = args.dt.unwrap_or(model.world.dt);
+        // Overrides are applied to the world settings, then validated like the file's.
+        let mut world = scene.file().world.clone();
+        world.steps = steps.unwrap_or(world.steps);
+        world.dt = args.dt.unwrap_or(world.dt);
         let overridden = integrator.is_some();
-        model.world.integrator = integrator.or(model.world.integrator);
+        world.integrator = integrator.or(world.integrator);
         let springs_overridden = springs.is_some();
-        model.world.springs = springs.or(model.world.springs);
-        model.world.substeps = substeps.or(model.world.substeps);
-        let text = tumble_scene::to_toml_string(&model)?;
-        scene = Scene::parse(&loaded.file, &text).map_err(|e| {
+        world.springs = springs.or(world.springs);
+        world.substeps = substeps.or(world.substeps);
+        scene = scene.with_world(world).map_err(|e| {
             override_error(
                 e,
                 args.dt,
@@ -143,7 +148,9 @@ pub fn run(args: RunArgs) -> Result<(), Failure> {
             )
         })?;
     }
-    let mut built = scene.build();
+    let steps = scene.steps();
+    let scene_name = terminal_safe(scene.name()).into_owned();
+    let mut built = scene.into_built();
     if args.plan {
         println!("{}", PhysicsPlan::for_world(&mut built.world));
         if let Some(line) = stages_line(&built.world) {
@@ -151,9 +158,14 @@ pub fn run(args: RunArgs) -> Result<(), Failure> {
         }
         return Ok(());
     }
+    let record = Recording {
+        every,
+        bodies: patterns
+            .map(|p| select_bodies(&p, &built.bodies))
+            .transpose()?,
+    };
     let names = Names::new(&mut built.world, &built.bodies);
     stability_gate(&mut built, &names, args.allow_unstable)?;
-    let steps = scene.steps();
     let to_stdout = args.out.as_deref().is_some_and(crate::is_stdout);
 
     let conserved = summary::conserved(&mut built.world);
@@ -168,6 +180,7 @@ pub fn run(args: RunArgs) -> Result<(), Failure> {
     if args.checksum {
         checksums.push((0, world_checksum(&built.world)));
     }
+    let mut written = None;
     let mut on_step = |step: u64, world: &World| {
         if step.is_multiple_of(PROGRESS_EVERY) {
             bar.set_position(step);
@@ -195,24 +208,28 @@ pub fn run(args: RunArgs) -> Result<(), Failure> {
     match args.out.as_deref() {
         Some(_) if to_stdout => {
             let stdout = std::io::stdout().lock();
-            tumble_scene::write_trajectory(&mut built, steps, every, stdout, &mut on_step)
-                .map_err(|e| match e {
-                    TrajectoryError::Stopped { step } => interrupted(step, None),
-                    e => Failure::new(exit::ERROR, format!("standard output: {e}")),
-                })?;
+            written = Some(
+                tumble_scene::write_trajectory(&mut built, steps, &record, stdout, &mut on_step)
+                    .map_err(|e| match e {
+                        TrajectoryError::Stopped { step } => interrupted(step, None),
+                        e => Failure::new(exit::ERROR, format!("standard output: {e}")),
+                    })?,
+            );
         }
         Some(path) => {
             let inputs: Vec<&Path> = loaded.path.as_deref().into_iter().collect();
             let mut file = OutputFile::create(path, &inputs)?;
             if !args.force {
-                check_free_space(&file, &built, steps, every)?;
+                check_free_space(&file, &built, steps, &record)?;
             }
-            tumble_scene::write_trajectory(&mut built, steps, every, &mut file, &mut on_step)
-                .map_err(|e| match e {
-                    TrajectoryError::Stopped { step } => interrupted(step, Some(path)),
-                    TrajectoryError::Io(e) => OutputError::io(path, e).into(),
-                    e => Failure::from(e),
-                })?;
+            written = Some(
+                tumble_scene::write_trajectory(&mut built, steps, &record, &mut file, &mut on_step)
+                    .map_err(|e| match e {
+                        TrajectoryError::Stopped { step } => interrupted(step, Some(path)),
+                        TrajectoryError::Io(e) => OutputError::io(path, e).into(),
+                        e => Failure::from(e),
+                    })?,
+            );
             file.commit()?;
         }
         None => {
@@ -244,7 +261,7 @@ pub fn run(args: RunArgs) -> Result<(), Failure> {
         Box::new(std::io::stdout().lock())
     };
     let mut lines = vec![
-        format!("scene      {}", terminal_safe(scene.name())),
+        format!("scene      {scene_name}"),
         format!("bodies     {}", built.bodies.len()),
         format!("steps      {steps} × {dt} s ({integrator})"),
         format!(
@@ -266,6 +283,14 @@ pub fn run(args: RunArgs) -> Result<(), Failure> {
         None => format!("|L|        {momentum} (about the origin)"),
         Some(why) => format!("|L|        {momentum} (about the origin; not conserved: {why})"),
     });
+    if let Some(written) = written {
+        lines.push(format!(
+            "trajectory {} rows, {:.1} MB, written at {:.0} MB/s",
+            written.rows,
+            written.bytes as f64 / 1e6,
+            written.megabytes_per_second()
+        ));
+    }
     if rejected > 0 {
         lines.push(format!(
             "rejected   {rejected} bodies (named above, on stderr)"
@@ -313,15 +338,77 @@ fn progress_bar(steps: u64, bodies: usize) -> ProgressBar {
     bar
 }
 
+/// The comma-separated patterns of `--bodies`, each checked.
+fn body_patterns(list: &str) -> Result<Vec<(String, glob::Pattern)>, Failure> {
+    list.split(',')
+        .map(|item| {
+            let item = item.trim();
+            if item.is_empty() {
+                return Err(Failure::new(
+                    exit::ERROR,
+                    format!(
+                        "--bodies: an empty name in `{}`; expected names or patterns separated \
+                         by commas",
+                        terminal_safe(list)
+                    ),
+                ));
+            }
+            glob::Pattern::new(item)
+                .map(|p| (item.to_owned(), p))
+                .map_err(|e| {
+                    Failure::new(
+                        exit::ERROR,
+                        format!("--bodies: `{}` is not a pattern: {e}", terminal_safe(item)),
+                    )
+                })
+        })
+        .collect()
+}
+
+/// Indices of the bodies that match any of `patterns`, in file order; a pattern that matches
+/// none is an error (a typo must not give an empty trajectory).
+fn select_bodies(
+    patterns: &[(String, glob::Pattern)],
+    bodies: &[(String, Entity)],
+) -> Result<Vec<usize>, Failure> {
+    let mut used = vec![false; patterns.len()];
+    let mut selected = Vec::new();
+    for (i, (name, _)) in bodies.iter().enumerate() {
+        let mut hit = false;
+        for ((_, pattern), used) in patterns.iter().zip(&mut used) {
+            if pattern.matches(name) {
+                *used = true;
+                hit = true;
+            }
+        }
+        if hit {
+            selected.push(i);
+        }
+    }
+    if let Some(((item, _), _)) = patterns.iter().zip(&used).find(|(_, used)| !**used) {
+        return Err(Failure::new(
+            exit::ERROR,
+            format!(
+                "--bodies: `{}` matches no body of the scene",
+                terminal_safe(item)
+            ),
+        ));
+    }
+    Ok(selected)
+}
+
 /// The estimated CSV size: `(rows, bytes per row)`, the row size a bound for the usual
 /// magnitudes (see [`VALUE_BYTES`]).
-pub fn csv_estimate(built: &BuiltScene, steps: u64, every: NonZeroU64) -> (u64, u64) {
-    let recorded = steps / every.get() + 1;
-    let rows = recorded.saturating_mul(built.bodies.len() as u64);
-    let name = built
-        .bodies
+pub fn csv_estimate(built: &BuiltScene, steps: u64, record: &Recording) -> (u64, u64) {
+    let recorded = steps / record.every.get() + 1;
+    let bodies: Vec<&String> = match &record.bodies {
+        None => built.bodies.iter().map(|(n, _)| n).collect(),
+        Some(indices) => indices.iter().map(|&i| &built.bodies[i].0).collect(),
+    };
+    let rows = recorded.saturating_mul(bodies.len() as u64);
+    let name = bodies
         .iter()
-        .map(|(n, _)| csv_text_cell(n).len() as u64)
+        .map(|n| csv_text_cell(n).len() as u64)
         .max()
         .unwrap_or(0);
     let dt = built
@@ -340,9 +427,9 @@ fn check_free_space(
     file: &OutputFile,
     built: &BuiltScene,
     steps: u64,
-    every: NonZeroU64,
+    record: &Recording,
 ) -> Result<(), Failure> {
-    let (rows, row) = csv_estimate(built, steps, every);
+    let (rows, row) = csv_estimate(built, steps, record);
     let bytes = rows.saturating_mul(row).saturating_add(CSV_HEADER_BYTES);
     let dir = match file.target().parent() {
         Some(dir) if !dir.as_os_str().is_empty() => dir,

@@ -2,8 +2,6 @@
 //! planning-time warnings and quarantined bodies, each naming bodies and forces as the scene file
 //! does.
 
-use std::collections::HashMap;
-
 use bevy_ecs::prelude::*;
 use glam::DVec3;
 use tumble_core::math::{Vec3, Widen};
@@ -13,17 +11,39 @@ use tumble_scene::text::terminal_safe;
 
 /// Names of a built scene's entities: bodies by their `name`, force generators as
 /// `forces[i] (kind)` in file order.
-pub struct Names(HashMap<Entity, String>);
+///
+/// Compact for a million bodies (about 20 bytes a body): the names are kept in one string and
+/// looked up by a binary search over the entities, and a message is formatted only when one is
+/// printed.
+pub struct Names {
+    /// `(entity, start, end)` of each body's name in `text`, sorted by entity.
+    bodies: Vec<(Entity, u32, u32)>,
+    /// Every body name, one after the other.
+    text: String,
+    /// `(entity, name)` of each force generator, sorted by entity.
+    forces: Vec<(Entity, String)>,
+}
 
 impl Names {
     /// Names for `world`, whose bodies are `bodies` (`(name, entity)` in file order). Force
     /// generators were spawned in file order after the bodies, so their entity order is the
     /// file order.
     pub fn new(world: &mut World, bodies: &[(String, Entity)]) -> Self {
-        let mut names: HashMap<Entity, String> = bodies
-            .iter()
-            .map(|(name, e)| (*e, format!("body `{}`", terminal_safe(name))))
-            .collect();
+        let mut text = String::with_capacity(bodies.iter().map(|(name, _)| name.len()).sum());
+        let mut spans = Vec::with_capacity(bodies.len());
+        for (name, e) in bodies {
+            // Scene names are at most a few hundred bytes; a library world of more than 4 GB
+            // of names gets the last ones by entity id.
+            let Ok(start) = u32::try_from(text.len()) else {
+                break;
+            };
+            text.push_str(name);
+            let Ok(end) = u32::try_from(text.len()) else {
+                break;
+            };
+            spans.push((*e, start, end));
+        }
+        spans.sort_unstable_by_key(|&(e, _, _)| e);
         let mut forces: Vec<(Entity, &'static str)> = world
             .query::<(Entity, Has<Spring>, Has<ConstantForce>, Has<ConstantTorque>)>()
             .iter(world)
@@ -35,18 +55,32 @@ impl Names {
             })
             .collect();
         forces.sort_by_key(|(e, _)| e.index());
-        for (i, (e, kind)) in forces.into_iter().enumerate() {
-            names.insert(e, format!("forces[{i}] ({kind})"));
+        let mut forces: Vec<(Entity, String)> = forces
+            .into_iter()
+            .enumerate()
+            .map(|(i, (e, kind))| (e, format!("forces[{i}] ({kind})")))
+            .collect();
+        forces.sort_unstable_by_key(|(e, _)| *e);
+        Self {
+            bodies: spans,
+            text,
+            forces,
         }
-        Self(names)
     }
 
     /// The name of `entity`, or its id when it is not part of the scene.
     pub fn of(&self, entity: Entity) -> String {
-        self.0
-            .get(&entity)
-            .cloned()
-            .unwrap_or_else(|| format!("entity {entity}"))
+        if let Ok(i) = self.bodies.binary_search_by_key(&entity, |&(e, _, _)| e) {
+            let (_, start, end) = self.bodies[i];
+            return format!(
+                "body `{}`",
+                terminal_safe(&self.text[start as usize..end as usize])
+            );
+        }
+        match self.forces.binary_search_by_key(&entity, |(e, _)| *e) {
+            Ok(i) => self.forces[i].1.clone(),
+            Err(_) => format!("entity {entity}"),
+        }
     }
 }
 

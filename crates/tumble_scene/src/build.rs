@@ -13,9 +13,10 @@ use tumble_core::{Density, Integrator, Mass, MassProperties};
 use tumble_ecs::prelude::*;
 
 use crate::error::{SaveError, SceneError};
-use crate::format::{BodyDef, ForceDef, SceneFile, ShapeDef};
+use crate::format::{BodyDef, ForceDef, SceneFile, ShapeDef, WorldDef};
+use crate::json::JsonSource;
 use crate::text::{is_unsafe_char, terminal_safe};
-use crate::validate::Checker;
+use crate::validate::{Checker, Locate, NoText, TomlText};
 use tumble_core::error::compact;
 
 /// A scene that passed every check: it builds a world without failing.
@@ -30,7 +31,6 @@ pub struct Scene {
     settings: PhysicsSettings,
     steps: u64,
     gravity: Option<Vec3>,
-    bodies: Vec<ValidBody>,
     forces: Vec<ValidForce>,
 }
 
@@ -53,7 +53,6 @@ pub struct SceneBody {
 
 #[derive(Debug, Clone, PartialEq)]
 struct ValidBody {
-    name: String,
     mass: MassProperties,
     transform: Transform,
     velocity: Velocity,
@@ -96,6 +95,26 @@ pub struct BuiltScene {
     pub bodies: Vec<(String, Entity)>,
 }
 
+/// The syntax of a scene file.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SceneSyntax {
+    /// TOML (`DESIGN.md`'s format; the default).
+    Toml,
+    /// JSON with the same schema: for large scenes, read as a stream (see
+    /// [`load_scene`](crate::load_scene)).
+    Json,
+}
+
+impl SceneSyntax {
+    /// JSON for a path ending in `.json` (any case), TOML otherwise.
+    pub fn of(path: &std::path::Path) -> Self {
+        match path.extension() {
+            Some(ext) if ext.eq_ignore_ascii_case("json") => Self::Json,
+            _ => Self::Toml,
+        }
+    }
+}
+
 /// Largest accepted step count.
 pub const MAX_STEPS: u64 = 1_000_000_000;
 
@@ -134,90 +153,67 @@ impl Scene {
                 .unwrap_or_else(|| "toml".to_owned());
             SceneError::at(file, line, field, message)
         })?;
-        Self::validate(file, text, parsed)
+        Self::validate(file, &TomlText(text), parsed)
     }
 
-    fn validate(file: &str, text: &str, parsed: SceneFile) -> Result<Self, SceneError> {
-        let ck = Checker { file, text };
-        let w = parsed.world.clone();
-        let dt = ck.scalar("world", None, "dt", w.dt)?;
-        if w.dt <= 0.0 {
-            return Err(ck.error(
-                "world",
-                None,
-                "dt",
-                format!("expected a time step > 0, got {}", compact(w.dt)),
-            ));
+    /// Parses and validates scene text in JSON (the schema of the TOML files, e.g.
+    /// `{"name": …, "world": {…}, "bodies": [{…}], "forces": [{"type": "spring", …}]}`);
+    /// `file` names it in errors.
+    pub fn parse_json(file: &str, text: &str) -> Result<Self, SceneError> {
+        let source = JsonSource::Text(text.as_bytes());
+        let parsed = crate::json::parse(file, text.as_bytes(), source)?;
+        Self::validate(file, &source, parsed)
+    }
+
+    /// Parses and validates scene text in the given syntax (see [`SceneSyntax::of`]).
+    pub fn parse_as(syntax: SceneSyntax, file: &str, text: &str) -> Result<Self, SceneError> {
+        match syntax {
+            SceneSyntax::Toml => Self::parse(file, text),
+            SceneSyntax::Json => Self::parse_json(file, text),
         }
-        if dt == 0.0 {
-            // Positive in the file, zero in the engine: the step underflows the precision.
-            return Err(ck.error(
-                "world",
-                None,
-                "dt",
-                format!(
-                    "{} rounds to 0 in {REAL_NAME}; expected a step ≥ {:.1e} s",
-                    compact(w.dt),
-                    Real::from_bits(1)
-                ),
-            ));
-        }
-        if w.steps == 0 || w.steps > MAX_STEPS {
-            return Err(ck.error(
-                "world",
-                None,
-                "steps",
-                format!("expected 1 to {MAX_STEPS} steps, got {}", w.steps),
-            ));
-        }
-        let integrator = match &w.integrator {
-            None => Integrator::default(),
-            Some(name) => {
-                name.parse()
-                    .map_err(|e: tumble_core::integrate::UnknownIntegrator| {
-                        ck.error("world", None, "integrator", e.to_string())
-                    })?
-            }
+    }
+
+    /// Parses and validates JSON read from `input` as a stream, without holding its text;
+    /// `source` is read again only to locate an error.
+    pub(crate) fn read_json(
+        file: &str,
+        input: impl std::io::Read,
+        source: JsonSource<'_>,
+    ) -> Result<Self, SceneError> {
+        let parsed = crate::json::parse(file, input, source)?;
+        Self::validate(file, &source, parsed)
+    }
+
+    /// The same scene with other world settings (`dt`, `steps`, integrator, springs,
+    /// substeps, gravity), checked like a file's; the bodies and forces are kept as they were
+    /// checked. Errors name the field and no line: the settings did not come from the file.
+    pub fn with_world(mut self, world: WorldDef) -> Result<Self, SceneError> {
+        let file = self.file.name.clone();
+        let ck = Checker {
+            file: &file,
+            locate: &NoText,
         };
-        let springs = match &w.springs {
-            None => SpringSolver::default(),
-            Some(name) => name
-                .parse()
-                .map_err(|e: String| ck.error("world", None, "springs", e))?,
-        };
-        let substeps = match w.substeps {
-            None => NonZeroU32::MIN,
-            Some(n) => u32::try_from(n)
-                .ok()
-                .filter(|&n| n <= MAX_SUBSTEPS)
-                .and_then(NonZeroU32::new)
-                .ok_or_else(|| {
-                    ck.error(
-                        "world",
-                        None,
-                        "substeps",
-                        format!("expected 1 to {MAX_SUBSTEPS} substeps, got {n}"),
-                    )
-                })?,
-        };
-        let settings = PhysicsSettings::new(dt, integrator)
-            .map_err(|e| ck.error("world", None, "dt", e.to_string()))?
-            .with_springs(springs)
-            .with_substeps(substeps);
+        let checked = validate_world(&ck, &world)?;
+        self.settings = checked.settings;
+        self.steps = checked.steps;
+        self.gravity = checked.gravity;
+        self.file.world = world;
+        Ok(self)
+    }
+
+    fn validate(file: &str, locate: &dyn Locate, parsed: SceneFile) -> Result<Self, SceneError> {
+        let ck = Checker { file, locate };
+        let world = validate_world(&ck, &parsed.world)?;
         if let Some(why) = bad_text(&parsed.name) {
             return Err(ck.top_error("name", why));
         }
-        let gravity = w
-            .gravity
-            .map(|g| ck.vec3("world", None, "gravity", g))
-            .transpose()?;
-        let mut names = HashMap::new();
-        let mut bodies = Vec::with_capacity(parsed.bodies.len());
+        // Names are borrowed from the model: a scene of a million bodies holds them once.
+        let mut names: HashMap<&str, usize> = HashMap::with_capacity(parsed.bodies.len());
         for (i, b) in parsed.bodies.iter().enumerate() {
             if let Some(why) = bad_name(&b.name) {
                 return Err(ck.error("bodies", Some(i), "name", why));
             }
-            if names.insert(b.name.clone(), i).is_some() {
+            if names.insert(&b.name, i).is_some() {
                 return Err(ck.error(
                     "bodies",
                     Some(i),
@@ -225,91 +221,17 @@ impl Scene {
                     format!("duplicate body name `{}`", terminal_safe(&b.name)),
                 ));
             }
-            bodies.push(validate_body(&ck, i, b)?);
+            // Checked here, converted again when the world is built: a scene holds its file
+            // model once, not a second, engine-ready copy of every body.
+            validate_body(&ck, i, b)?;
         }
-        let body = |i: usize, key: &str, name: &str| {
-            names.get(name).copied().ok_or_else(|| {
-                ck.error(
-                    "forces",
-                    Some(i),
-                    key,
-                    format!(
-                        "unknown body `{}`; expected one of the [[bodies]] names",
-                        terminal_safe(name)
-                    ),
-                )
-            })
-        };
-        let mut forces = Vec::with_capacity(parsed.forces.len());
-        for (i, f) in parsed.forces.iter().enumerate() {
-            let v = |key: &str, x: [f64; 3]| ck.vec3("forces", Some(i), key, x);
-            forces.push(match f {
-                ForceDef::Constant {
-                    body: b,
-                    force,
-                    point,
-                } => ValidForce::Constant {
-                    body: body(i, "body", b)?,
-                    force: v("force", *force)?,
-                    point: point.map(|p| v("point", p)).transpose()?,
-                },
-                ForceDef::Torque { body: b, torque } => ValidForce::Torque {
-                    body: body(i, "body", b)?,
-                    torque: v("torque", *torque)?,
-                },
-                ForceDef::Spring {
-                    a,
-                    anchor_a,
-                    b,
-                    anchor_b,
-                    stiffness,
-                    damping,
-                    rest_length,
-                } => {
-                    let non_negative = |key: &str, x: f64| -> Result<Real, SceneError> {
-                        let y = ck.scalar("forces", Some(i), key, x)?;
-                        if y < 0.0 {
-                            return Err(ck.error(
-                                "forces",
-                                Some(i),
-                                key,
-                                format!("expected a value >= 0, got {}", compact(x)),
-                            ));
-                        }
-                        Ok(y)
-                    };
-                    let a_index = body(i, "a", a)?;
-                    let b_index = b.as_ref().map(|b| body(i, "b", b)).transpose()?;
-                    if b_index == Some(a_index) {
-                        return Err(ck.error(
-                            "forces",
-                            Some(i),
-                            "b",
-                            format!(
-                                "spring joins `{}` to itself; expected a different body, \
-                                 or no `b` to anchor `a` to the world point `anchor_b`",
-                                terminal_safe(a)
-                            ),
-                        ));
-                    }
-                    ValidForce::Spring {
-                        a: a_index,
-                        anchor_a: v("anchor_a", *anchor_a)?,
-                        b: b_index,
-                        anchor_b: v("anchor_b", *anchor_b)?,
-                        k: non_negative("stiffness", *stiffness)?,
-                        c: non_negative("damping", *damping)?,
-                        rest: non_negative("rest_length", *rest_length)?,
-                    }
-                }
-            });
-        }
+        let forces = validate_forces(&ck, &parsed.forces, &names)?;
+        drop(names);
         Ok(Self {
             file: parsed,
-            settings,
-            steps: w.steps,
-            gravity,
-            bodies,
+            settings: world.settings,
+            steps: world.steps,
+            gravity: world.gravity,
             forces,
         })
     }
@@ -352,12 +274,12 @@ impl Scene {
     /// Each body with its mass properties, initial state and per-body parameters, in file
     /// order.
     pub fn body_states(&self) -> Vec<SceneBody> {
-        self.bodies
-            .iter()
-            .map(|b| {
+        self.valid_bodies()
+            .zip(&self.file.bodies)
+            .map(|(b, def)| {
                 let props = MassProps(b.mass);
                 SceneBody {
-                    name: b.name.clone(),
+                    name: def.name.clone(),
                     mass: b.mass,
                     state: tumble_ecs::components::body_state(&b.transform, &b.velocity, &props),
                     gravity_scale: b.gravity_scale,
@@ -368,6 +290,19 @@ impl Scene {
             .collect()
     }
 
+    /// The bodies in engine form, converted from the file model as they were when checked.
+    fn valid_bodies(&self) -> impl Iterator<Item = ValidBody> + '_ {
+        let ck = Checker {
+            file: &self.file.name,
+            locate: &NoText,
+        };
+        self.file.bodies.iter().enumerate().map(move |(i, b)| {
+            validate_body(&ck, i, b).unwrap_or_else(|e| {
+                unreachable!("body {i} passed this check when the scene was parsed: {e}")
+            })
+        })
+    }
+
     /// The scene as TOML (loading it gives the same scene).
     pub fn to_toml(&self) -> Result<String, SaveError> {
         crate::to_toml_string(&self.file)
@@ -376,34 +311,71 @@ impl Scene {
     /// Builds the world and plans its schedule. Cannot fail: everything was checked when the
     /// scene was parsed.
     pub fn build(&self) -> BuiltScene {
+        let mut world = self.world_for_bodies();
+        let bodies = self
+            .valid_bodies()
+            .zip(&self.file.bodies)
+            .map(|(body, def)| (def.name.clone(), spawn_body(&mut world, &body)))
+            .collect();
+        self.finish_build(world, bodies)
+    }
+
+    /// [`build`](Self::build), consuming the scene as the world fills: each body's file model
+    /// is released once it is spawned, so memory peaks at about the larger of the two, not
+    /// their sum (a million bodies: ≈ 250 MB of file model, ≈ 200 MB of world).
+    pub fn into_built(mut self) -> BuiltScene {
+        let mut world = self.world_for_bodies();
+        let mut defs = std::mem::take(&mut self.file.bodies);
+        let n = defs.len();
+        // Popped from the back in file order; the vector is shrunk as it empties, which hands
+        // its pages back (a large allocation is shrunk in place).
+        defs.reverse();
+        let release_every = (n / 8).max(1 << 16);
+        let ck = Checker {
+            file: &self.file.name,
+            locate: &NoText,
+        };
+        let mut bodies = Vec::with_capacity(n);
+        let mut i = 0;
+        while let Some(def) = defs.pop() {
+            let body = validate_body(&ck, i, &def).unwrap_or_else(|e| {
+                unreachable!("body {i} passed this check when the scene was parsed: {e}")
+            });
+            bodies.push((def.name, spawn_body(&mut world, &body)));
+            i += 1;
+            if i % release_every == 0 {
+                defs.shrink_to_fit();
+            }
+        }
+        drop(defs);
+        self.finish_build(world, bodies)
+    }
+
+    /// A world with the scene's resources, ready for its bodies.
+    fn world_for_bodies(&self) -> World {
         let mut world = World::new();
         world.insert_resource(self.settings);
         if let Some(g) = self.gravity {
             world.insert_resource(Gravity(g));
         }
-        let mut entities = Vec::with_capacity(self.bodies.len());
-        for b in &self.bodies {
-            let mut e = world.spawn((RigidBody, MassProps(b.mass), b.transform, b.velocity));
-            if b.gravity_scale != 1.0 {
-                e.insert(GravityScale(b.gravity_scale));
-            }
-            if b.damping != Damping::default() {
-                e.insert(b.damping);
-            }
-            entities.push(e.id());
-        }
+        world
+    }
+
+    /// Spawns the force generators between the spawned `bodies` and plans the schedule.
+    fn finish_build(&self, mut world: World, bodies: Vec<(String, Entity)>) -> BuiltScene {
+        let entity = |i: usize| bodies[i].1;
         for f in &self.forces {
             match *f {
                 ValidForce::Constant { body, force, point } => {
                     world.spawn(ConstantForce {
-                        body: entities[body],
+                        body: entity(body),
                         force,
                         local_point: point,
                     });
                 }
                 ValidForce::Torque { body, torque } => {
                     world.spawn(ConstantTorque {
-                        body: entities[body],
+                        body: entity(body),
                         torque,
                     });
                 }
@@ -418,13 +390,13 @@ impl Scene {
                 } => {
                     let end = match b {
                         Some(b) => SpringEnd::Body {
-                            body: entities[b],
+                            body: entity(b),
                             anchor: anchor_b,
                         },
                         None => SpringEnd::World(anchor_b),
                     };
                     world.spawn(Spring {
-                        a: entities[a],
+                        a: entity(a),
                         anchor_a,
                         b: end,
                         stiffness: k,
@@ -436,12 +408,6 @@ impl Scene {
         }
         let plan = PhysicsPlan::for_world(&mut world);
         let schedule = plan.build_schedule();
-        let bodies = self
-            .bodies
-            .iter()
-            .map(|b| b.name.clone())
-            .zip(entities)
-            .collect();
         BuiltScene {
             world,
             schedule,
@@ -449,6 +415,18 @@ impl Scene {
             bodies,
         }
     }
+}
+
+/// Spawns one body with only the components it needs.
+fn spawn_body(world: &mut World, b: &ValidBody) -> Entity {
+    let mut e = world.spawn((RigidBody, MassProps(b.mass), b.transform, b.velocity));
+    if b.gravity_scale != 1.0 {
+        e.insert(GravityScale(b.gravity_scale));
+    }
+    if b.damping != Damping::default() {
+        e.insert(b.damping);
+    }
+    e.id()
 }
 
 impl BuiltScene {
@@ -464,6 +442,174 @@ impl BuiltScene {
         self.plan = PhysicsPlan::for_world(&mut self.world);
         self.schedule = self.plan.build_schedule();
     }
+}
+
+/// The world settings of a scene, checked.
+struct CheckedWorld {
+    settings: PhysicsSettings,
+    steps: u64,
+    gravity: Option<Vec3>,
+}
+
+fn validate_world(ck: &Checker<'_>, w: &WorldDef) -> Result<CheckedWorld, SceneError> {
+    let dt = ck.scalar("world", None, "dt", w.dt)?;
+    if w.dt <= 0.0 {
+        return Err(ck.error(
+            "world",
+            None,
+            "dt",
+            format!("expected a time step > 0, got {}", compact(w.dt)),
+        ));
+    }
+    if dt == 0.0 {
+        // Positive in the file, zero in the engine: the step underflows the precision.
+        return Err(ck.error(
+            "world",
+            None,
+            "dt",
+            format!(
+                "{} rounds to 0 in {REAL_NAME}; expected a step ≥ {:.1e} s",
+                compact(w.dt),
+                Real::from_bits(1)
+            ),
+        ));
+    }
+    if w.steps == 0 || w.steps > MAX_STEPS {
+        return Err(ck.error(
+            "world",
+            None,
+            "steps",
+            format!("expected 1 to {MAX_STEPS} steps, got {}", w.steps),
+        ));
+    }
+    let integrator = match &w.integrator {
+        None => Integrator::default(),
+        Some(name) => name
+            .parse()
+            .map_err(|e: tumble_core::integrate::UnknownIntegrator| {
+                ck.error("world", None, "integrator", e.to_string())
+            })?,
+    };
+    let springs = match &w.springs {
+        None => SpringSolver::default(),
+        Some(name) => name
+            .parse()
+            .map_err(|e: String| ck.error("world", None, "springs", e))?,
+    };
+    let substeps = match w.substeps {
+        None => NonZeroU32::MIN,
+        Some(n) => u32::try_from(n)
+            .ok()
+            .filter(|&n| n <= MAX_SUBSTEPS)
+            .and_then(NonZeroU32::new)
+            .ok_or_else(|| {
+                ck.error(
+                    "world",
+                    None,
+                    "substeps",
+                    format!("expected 1 to {MAX_SUBSTEPS} substeps, got {n}"),
+                )
+            })?,
+    };
+    let settings = PhysicsSettings::new(dt, integrator)
+        .map_err(|e| ck.error("world", None, "dt", e.to_string()))?
+        .with_springs(springs)
+        .with_substeps(substeps);
+    let gravity = w
+        .gravity
+        .map(|g| ck.vec3("world", None, "gravity", g))
+        .transpose()?;
+    Ok(CheckedWorld {
+        settings,
+        steps: w.steps,
+        gravity,
+    })
+}
+
+/// The force generators, their bodies looked up by name.
+fn validate_forces(
+    ck: &Checker<'_>,
+    defs: &[ForceDef],
+    names: &HashMap<&str, usize>,
+) -> Result<Vec<ValidForce>, SceneError> {
+    let body = |i: usize, key: &str, name: &str| {
+        names.get(name).copied().ok_or_else(|| {
+            ck.error(
+                "forces",
+                Some(i),
+                key,
+                format!(
+                    "unknown body `{}`; expected one of the [[bodies]] names",
+                    terminal_safe(name)
+                ),
+            )
+        })
+    };
+    let mut forces = Vec::with_capacity(defs.len());
+    for (i, f) in defs.iter().enumerate() {
+        let v = |key: &str, x: [f64; 3]| ck.vec3("forces", Some(i), key, x);
+        forces.push(match f {
+            ForceDef::Constant {
+                body: b,
+                force,
+                point,
+            } => ValidForce::Constant {
+                body: body(i, "body", b)?,
+                force: v("force", *force)?,
+                point: point.map(|p| v("point", p)).transpose()?,
+            },
+            ForceDef::Torque { body: b, torque } => ValidForce::Torque {
+                body: body(i, "body", b)?,
+                torque: v("torque", *torque)?,
+            },
+            ForceDef::Spring {
+                a,
+                anchor_a,
+                b,
+                anchor_b,
+                stiffness,
+                damping,
+                rest_length,
+            } => {
+                let non_negative = |key: &str, x: f64| -> Result<Real, SceneError> {
+                    let y = ck.scalar("forces", Some(i), key, x)?;
+                    if y < 0.0 {
+                        return Err(ck.error(
+                            "forces",
+                            Some(i),
+                            key,
+                            format!("expected a value >= 0, got {}", compact(x)),
+                        ));
+                    }
+                    Ok(y)
+                };
+                let a_index = body(i, "a", a)?;
+                let b_index = b.as_ref().map(|b| body(i, "b", b)).transpose()?;
+                if b_index == Some(a_index) {
+                    return Err(ck.error(
+                        "forces",
+                        Some(i),
+                        "b",
+                        format!(
+                            "spring joins `{}` to itself; expected a different body, \
+                             or no `b` to anchor `a` to the world point `anchor_b`",
+                            terminal_safe(a)
+                        ),
+                    ));
+                }
+                ValidForce::Spring {
+                    a: a_index,
+                    anchor_a: v("anchor_a", *anchor_a)?,
+                    b: b_index,
+                    anchor_b: v("anchor_b", *anchor_b)?,
+                    k: non_negative("stiffness", *stiffness)?,
+                    c: non_negative("damping", *damping)?,
+                    rest: non_negative("rest_length", *rest_length)?,
+                }
+            }
+        });
+    }
+    Ok(forces)
 }
 
 fn validate_body(ck: &Checker<'_>, i: usize, b: &BodyDef) -> Result<ValidBody, SceneError> {
@@ -557,7 +703,6 @@ fn validate_body(ck: &Checker<'_>, i: usize, b: &BodyDef) -> Result<ValidBody, S
         }
     }
     Ok(ValidBody {
-        name: b.name.clone(),
         mass,
         transform: Transform {
             translation: position,
@@ -630,7 +775,7 @@ fn mass_error(ck: &Checker<'_>, i: usize, e: tumble_core::InvalidInput) -> Scene
 }
 
 /// `k` from the messages "unknown field `k`, …" and "unknown variant `k`, …".
-fn unknown_name(message: &str) -> Option<&str> {
+pub(crate) fn unknown_name(message: &str) -> Option<&str> {
     let rest = message
         .strip_prefix("unknown field `")
         .or_else(|| message.strip_prefix("unknown variant `"))?;
@@ -638,7 +783,7 @@ fn unknown_name(message: &str) -> Option<&str> {
 }
 
 /// `M` from the message "expected N numbers, got M" of a fixed-length array.
-fn wrong_length(message: &str) -> Option<usize> {
+pub(crate) fn wrong_length(message: &str) -> Option<usize> {
     let rest = message.split_once("numbers, got ")?.1;
     rest.trim().parse().ok()
 }

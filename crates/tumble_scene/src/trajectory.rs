@@ -37,8 +37,48 @@ pub enum TrajectoryError {
     NoSettings,
 }
 
+/// Which rows a trajectory holds: every `every`-th step (step 0 always), and all bodies or
+/// only some.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Recording {
+    /// Record step 0 and every step that is a multiple of this.
+    pub every: NonZeroU64,
+    /// Indices into [`BuiltScene::bodies`] of the bodies to record, in the order their rows
+    /// are written; `None` records every body in file order.
+    pub bodies: Option<Vec<usize>>,
+}
+
+impl Recording {
+    /// Every body, every `every`-th step.
+    pub fn every(every: NonZeroU64) -> Self {
+        Self {
+            every,
+            bodies: None,
+        }
+    }
+}
+
+/// What [`write_trajectory`] wrote, and how fast.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TrajectoryStats {
+    /// Rows written, header excluded.
+    pub rows: u64,
+    /// Bytes written, header included.
+    pub bytes: u64,
+    /// Seconds spent formatting and writing rows (the steps between them excluded).
+    pub write_seconds: f64,
+}
+
+impl TrajectoryStats {
+    /// Writing throughput in MB/s (10⁶ bytes per second).
+    pub fn megabytes_per_second(&self) -> f64 {
+        self.bytes as f64 / 1e6 / self.write_seconds.max(f64::MIN_POSITIVE)
+    }
+}
+
 /// Runs `steps` steps of a built scene and writes its trajectory as CSV to `out`: the
-/// [`CSV_HEADER`] line, then one row per body for step 0 and for every `every`-th step.
+/// [`CSV_HEADER`] line, then one row per recorded body for step 0 and for every
+/// `record.every`-th step.
 ///
 /// - `px..pz` is `Transform::translation`, `q*` the rotation (glam order), `v*` the linear and
 ///   `w*` the world-frame angular velocity; `time` is `step × dt`, with `dt` read from the
@@ -62,36 +102,80 @@ pub enum TrajectoryError {
 pub fn write_trajectory(
     scene: &mut BuiltScene,
     steps: u64,
-    every: NonZeroU64,
+    record: &Recording,
     out: impl Write,
     mut on_step: impl FnMut(u64, &World) -> ControlFlow<()>,
-) -> Result<(), TrajectoryError> {
+) -> Result<TrajectoryStats, TrajectoryError> {
     let dt = scene
         .world
         .get_resource::<PhysicsSettings>()
         .ok_or(TrajectoryError::NoSettings)?
         .dt();
-    // The cells of the names are computed once: a run writes them millions of times.
-    let names: Vec<String> = scene
-        .bodies
-        .iter()
-        .map(|(name, _)| csv_text_cell(name).into_owned())
-        .collect();
-    let mut w = std::io::BufWriter::with_capacity(1 << 16, out);
+    let every = record.every.get();
+    // The recorded bodies with their name cells, computed once: a run writes them millions
+    // of times.
+    let recorded: Vec<(Entity, String)> = match &record.bodies {
+        None => scene
+            .bodies
+            .iter()
+            .map(|(name, e)| (*e, csv_text_cell(name).into_owned()))
+            .collect(),
+        Some(indices) => indices
+            .iter()
+            .filter_map(|&i| scene.bodies.get(i))
+            .map(|(name, e)| (*e, csv_text_cell(name).into_owned()))
+            .collect(),
+    };
+    let mut stats = TrajectoryStats {
+        rows: 0,
+        bytes: 0,
+        write_seconds: 0.0,
+    };
+    let mut w = Counted {
+        inner: std::io::BufWriter::with_capacity(1 << 16, out),
+        bytes: 0,
+    };
+    let mut write = |w: &mut Counted<_>, scene: &BuiltScene, step: u64| {
+        let start = std::time::Instant::now();
+        stats.rows += write_rows(w, &scene.world, &recorded, step, dt)?;
+        stats.write_seconds += start.elapsed().as_secs_f64();
+        std::io::Result::Ok(())
+    };
     writeln!(w, "{CSV_HEADER}")?;
-    write_rows(&mut w, scene, &names, 0, dt)?;
+    write(&mut w, scene, 0)?;
     for step in 1..=steps {
         scene.step();
-        if step.is_multiple_of(every.get()) {
-            write_rows(&mut w, scene, &names, step, dt)?;
+        if step.is_multiple_of(every) {
+            write(&mut w, scene, step)?;
         }
         if on_step(step, &scene.world).is_break() {
             w.flush()?;
             return Err(TrajectoryError::Stopped { step });
         }
     }
+    let start = std::time::Instant::now();
     w.flush()?;
-    Ok(())
+    stats.write_seconds += start.elapsed().as_secs_f64();
+    stats.bytes = w.bytes;
+    Ok(stats)
+}
+
+/// A writer that counts the bytes it passes on.
+struct Counted<W> {
+    inner: W,
+    bytes: u64,
+}
+
+impl<W: Write> Write for Counted<W> {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        let n = self.inner.write(buf)?;
+        self.bytes += n as u64;
+        Ok(n)
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.inner.flush()
+    }
 }
 
 /// `text` as a CSV cell that a spreadsheet shows as text: a leading `'` before a formula
@@ -119,16 +203,17 @@ pub fn csv_text_cell(text: &str) -> Cow<'_, str> {
     Cow::Owned(cell)
 }
 
+/// Writes one row per recorded body that is not quarantined; returns how many.
 fn write_rows(
     w: &mut impl Write,
-    scene: &BuiltScene,
-    names: &[String],
+    world: &World,
+    recorded: &[(Entity, String)],
     step: u64,
     dt: Real,
-) -> std::io::Result<()> {
+) -> std::io::Result<u64> {
     let time = to_f64(dt) * step as f64;
-    let world: &World = &scene.world;
-    for ((_, e), name) in scene.bodies.iter().zip(names) {
+    let mut rows = 0;
+    for (e, name) in recorded {
         let Ok(body) = world.get_entity(*e) else {
             continue;
         };
@@ -156,8 +241,9 @@ fn write_rows(
             v.angular.y,
             v.angular.z
         )?;
+        rows += 1;
     }
-    Ok(())
+    Ok(rows)
 }
 
 #[cfg(test)]
@@ -176,7 +262,7 @@ mod tests {
         write_trajectory(
             built,
             steps,
-            NonZeroU64::new(every).unwrap(),
+            &Recording::every(NonZeroU64::new(every).unwrap()),
             &mut out,
             |_, _| ControlFlow::Continue(()),
         )
@@ -204,11 +290,49 @@ mod tests {
         assert_eq!(rows.len(), 3 * 3);
         assert_eq!((rows[8][0], rows[8][1], rows[8][2]), ("6", "0.09375", "m3"));
         built.world.remove_resource::<PhysicsSettings>();
-        let err = write_trajectory(&mut built, 1, NonZeroU64::MIN, std::io::sink(), |_, _| {
+        let all = Recording::every(NonZeroU64::MIN);
+        let err = write_trajectory(&mut built, 1, &all, std::io::sink(), |_, _| {
             ControlFlow::Continue(())
         })
         .unwrap_err();
         assert!(matches!(err, TrajectoryError::NoSettings), "{err}");
+    }
+
+    #[test]
+    fn a_selection_records_only_its_bodies_and_the_stats_count_what_was_written() {
+        let mut built = chain();
+        let mut out = Vec::new();
+        let record = Recording {
+            every: NonZeroU64::new(2).unwrap(),
+            bodies: Some(vec![2, 0]),
+        };
+        let stats = write_trajectory(&mut built, 5, &record, &mut out, |_, _| {
+            ControlFlow::Continue(())
+        })
+        .unwrap();
+        let csv = String::from_utf8(out).unwrap();
+        let rows: Vec<(&str, &str)> = csv
+            .lines()
+            .skip(1)
+            .map(|l| {
+                let cells: Vec<&str> = l.split(',').collect();
+                (cells[0], cells[2])
+            })
+            .collect();
+        assert_eq!(
+            rows,
+            [
+                ("0", "m3"),
+                ("0", "m1"),
+                ("2", "m3"),
+                ("2", "m1"),
+                ("4", "m3"),
+                ("4", "m1")
+            ]
+        );
+        assert_eq!(stats.rows, 6);
+        assert_eq!(stats.bytes, csv.len() as u64);
+        assert!(stats.write_seconds > 0.0 && stats.megabytes_per_second().is_finite());
     }
 
     #[test]
@@ -218,7 +342,7 @@ mod tests {
         let err = write_trajectory(
             &mut built,
             10,
-            NonZeroU64::MIN,
+            &Recording::every(NonZeroU64::MIN),
             std::io::sink(),
             |step, _| {
                 seen.push(step);

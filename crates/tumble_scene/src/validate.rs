@@ -1,4 +1,5 @@
-//! Semantic checks of a parsed scene file, with the line of each offending field.
+//! Semantic checks of a parsed scene file, with the line of each offending field (TOML here;
+//! JSON in [`crate::json`]).
 
 use toml::de::{DeTable, DeValue};
 use tumble_core::error::compact;
@@ -141,12 +142,48 @@ pub fn key_after(text: &str, from: usize, name: &str) -> Option<usize> {
     best
 }
 
-/// Context for the checks of one scene: the file name and its text.
+/// Finds the line of a field in a scene's text, for an error message.
+pub trait Locate {
+    /// The 1-based line of `table[index].key` (`table.key` without an index, the top-level
+    /// `key` without a table); 0 when no line can be told.
+    fn line(&self, table: Option<&str>, index: Option<usize>, key: &str) -> usize;
+}
+
+/// TOML text.
+pub struct TomlText<'a>(pub &'a str);
+
+impl Locate for TomlText<'_> {
+    fn line(&self, table: Option<&str>, index: Option<usize>, key: &str) -> usize {
+        let text = self.0;
+        match table {
+            Some(table) => line_of(text, table, index, key),
+            None => DeTable::parse(text)
+                .ok()
+                .and_then(|doc| {
+                    doc.get_ref()
+                        .get_key_value(key)
+                        .map(|(k, _)| line_at(text, k.span().start))
+                })
+                .unwrap_or(1),
+        }
+    }
+}
+
+/// No text to point into (settings given apart from a file): errors name no line.
+pub struct NoText;
+
+impl Locate for NoText {
+    fn line(&self, _: Option<&str>, _: Option<usize>, _: &str) -> usize {
+        0
+    }
+}
+
+/// Context for the checks of one scene: the file name and where its fields stand.
 pub struct Checker<'a> {
     /// File name for messages.
     pub file: &'a str,
-    /// The text, for line numbers.
-    pub text: &'a str,
+    /// Finds the line of a field.
+    pub locate: &'a dyn Locate,
 }
 
 impl Checker<'_> {
@@ -162,24 +199,13 @@ impl Checker<'_> {
             Some(i) => format!("{table}[{i}].{key}"),
             None => format!("{table}.{key}"),
         };
-        SceneError::at(
-            self.file,
-            line_of(self.text, table, index, key),
-            field,
-            message,
-        )
+        let line = self.locate.line(Some(table), index, key);
+        SceneError::at(self.file, line, field, message)
     }
 
     /// An error at the top-level key `key` (e.g. the scene `name`).
     pub fn top_error(&self, key: &str, message: impl Into<String>) -> SceneError {
-        let line = DeTable::parse(self.text)
-            .ok()
-            .and_then(|doc| {
-                doc.get_ref()
-                    .get_key_value(key)
-                    .map(|(k, _)| line_at(self.text, k.span().start))
-            })
-            .unwrap_or(1);
+        let line = self.locate.line(None, None, key);
         SceneError::at(self.file, line, key, message)
     }
 
