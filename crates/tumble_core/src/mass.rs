@@ -4,7 +4,7 @@
 //! expected (or the reverse).
 
 use crate::error::{InvalidInput, check_finite_vec3, check_unit_quat};
-use crate::math::{Quat, Real, Vec3, quat_mul, quat_normalize, quat_rotate, to_f64};
+use crate::math::{Quat, Real, Vec3, Widen, quat_mul, quat_normalize, quat_rotate, to_f64};
 
 /// Smallest accepted mass or nonzero principal moment: the smallest normal [`Real`]
 /// (`2⁻¹²⁶ ≈ 1.2e-38` in `f32`, `2⁻¹⁰²² ≈ 2.2e-308` in `f64`). Below it the reciprocal the
@@ -286,6 +286,17 @@ impl MassProperties {
             frame,
             self.inv_principal_inertia * quat_rotate(frame.inverse(), world),
         )
+    }
+
+    /// The quadratic form of the world inertia, `ωᵀ (R P) I_b (R P)ᵀ ω = Σᵢ Iᵢ bᵢ²` with
+    /// `b = (R P)ᵀ ω` (twice the rotational kinetic energy), summed in `f64`: one rotation
+    /// instead of the two of [`world_inertia_mul`](Self::world_inertia_mul).
+    #[inline]
+    pub fn world_inertia_quadratic_f64(&self, body_rotation: Quat, world: Vec3) -> f64 {
+        let frame = quat_mul(body_rotation, self.principal_frame);
+        let b = quat_rotate(frame.inverse(), world).widen();
+        let i = self.principal_inertia.widen();
+        i.x * b.x * b.x + i.y * b.y * b.y + i.z * b.z * b.z
     }
 
     /// Applies the world inertia `(R P) I_b (R P)ᵀ` to a world vector (e.g. `L = I ω`).

@@ -74,8 +74,7 @@
 
 use bevy_ecs::entity::EntityHashMap;
 use bevy_ecs::prelude::*;
-use std::collections::HashMap;
-use tumble_core::math::{Quat, Real, Vec3, Widen};
+use tumble_core::math::{Real, Vec3, Widen};
 
 use crate::components::{
     ForceAccumulator, Gravity, GravityScale, Kinematic, MassProps, PhysicsSettings, RigidBody,
@@ -123,8 +122,13 @@ const ROUND_OFF_ULPS: f64 = 64.0;
 struct Audited {
     entity: Entity,
     start: (Transform, Velocity),
-    /// Pose at the end of the step (for the springs' energy).
+    /// Pose the force systems saw (before the integration), then at the end of the step (for
+    /// the springs' energy).
     end: Transform,
+    /// Centre of mass in the body frame, for the torque arms of the springs' forces.
+    local_com: Vec3,
+    /// `end` holds the pose the force systems saw (the body was still audited then).
+    at_forces: bool,
     /// Every load except the springs: force and torque (world frame).
     load: (Vec3, Vec3),
     /// Mass (kg), for the springs' reduced mass.
@@ -190,10 +194,13 @@ struct GroupStep {
 #[derive(Resource, Debug, Default)]
 pub struct EnergyLedger {
     bodies: Vec<Audited>,
-    index: EntityHashMap<usize>,
+    /// The index in `bodies` of an entity, at its `index_u32`: a dense table, not a hash map
+    /// (four lookups per body and step). Entries of entities no longer audited are left in
+    /// place: a lookup checks the entity it finds.
+    slots: Vec<u32>,
     links: Vec<Link>,
     groups: Vec<GroupStep>,
-    accounts: HashMap<Entity, Account>,
+    accounts: EntityHashMap<Account>,
     dt: f64,
     /// The plain step with the stability of one substep (`Δt` unless there are substeps or a
     /// composition, see `Stages::stability_span`): the span a spring's `ωh` is measured on.
@@ -237,6 +244,22 @@ impl LedgerState {
 }
 
 impl EnergyLedger {
+    /// The index in `bodies` of an audited entity.
+    #[inline]
+    fn slot(&self, entity: Entity) -> Option<usize> {
+        let i = *self.slots.get(entity.index_u32() as usize)? as usize;
+        (self.bodies.get(i)?.entity == entity).then_some(i)
+    }
+
+    /// Records that `entity` is audited at index `i`.
+    fn set_slot(&mut self, entity: Entity, i: usize) {
+        let at = entity.index_u32() as usize;
+        if at >= self.slots.len() {
+            self.slots.resize(at + 1, u32::MAX);
+        }
+        self.slots[at] = i as u32;
+    }
+
     fn find(&mut self, mut i: usize) -> usize {
         while self.bodies[i].parent != i {
             let grand = self.bodies[self.bodies[i].parent].parent;
@@ -342,8 +365,8 @@ type Ends<'w, 's> = Query<
     (With<RigidBody>, Without<Rejected>),
 >;
 
-fn end_of(index: &EntityHashMap<usize>, ends: &Ends, body: Entity, anchor: Vec3) -> End {
-    if let Some(&i) = index.get(&body) {
+fn end_of(ledger: &EnergyLedger, ends: &Ends, body: Entity, anchor: Vec3) -> End {
+    if let Some(i) = ledger.slot(body) {
         return End::Audited(i, anchor);
     }
     match ends.get(body) {
@@ -371,15 +394,16 @@ pub fn audit_energy_start(
     ledger.stability_span = settings.stages().stability_span(settings.dt()).widen();
     ledger.midpoint = settings.integrator.samples_forces_at_midpoint();
     ledger.bodies.clear();
-    ledger.index.clear();
     ledger.groups.clear();
     for (entity, t, v, m) in &bodies {
         let i = ledger.bodies.len();
-        ledger.index.insert(entity, i);
+        ledger.set_slot(entity, i);
         ledger.bodies.push(Audited {
             entity,
             start: (*t, *v),
             end: *t,
+            local_com: m.local_center_of_mass(),
+            at_forces: false,
             load: (Vec3::ZERO, Vec3::ZERO),
             mass: m.mass().widen(),
             parent: i,
@@ -393,10 +417,10 @@ pub fn audit_energy_start(
     }
     ledger.links.clear();
     for (spring, implicit) in &springs {
-        let a = end_of(&ledger.index, &ends, spring.a, spring.anchor_a);
+        let a = end_of(ledger, &ends, spring.a, spring.anchor_a);
         let b = match spring.b {
             SpringEnd::World(p) => End::Fixed(p),
-            SpringEnd::Body { body, anchor } => end_of(&ledger.index, &ends, body, anchor),
+            SpringEnd::Body { body, anchor } => end_of(ledger, &ends, body, anchor),
         };
         if let (End::Audited(i, _), End::Audited(j, _)) = (a, b) {
             ledger.union(i, j);
@@ -460,15 +484,15 @@ pub fn audit_external_loads(
     settings: Res<PhysicsSettings>,
     cursor: Res<StageCursor>,
     mut ledger: ResMut<EnergyLedger>,
-    accumulators: Query<
+    bodies: Query<
         (
             Entity,
-            &ForceAccumulator,
+            &Transform,
+            Option<&ForceAccumulator>,
             Option<&crate::stiff::ImplicitBody>,
         ),
         Dynamic,
     >,
-    states: Query<(&Transform, &MassProps), Dynamic>,
 ) {
     let ledger = &mut *ledger;
     let span = cursor.span(&settings);
@@ -479,18 +503,27 @@ pub fn audit_external_loads(
     } else {
         Some(span.h / settings.dt())
     };
-    for (entity, acc, implicit) in &accumulators {
-        if let Some(&i) = ledger.index.get(&entity) {
+    if !span.opens_step {
+        // A later stage of the step: only the bodies still audited now get a pose below.
+        for body in &mut ledger.bodies {
+            body.at_forces = false;
+        }
+    }
+    // One pass in storage order: the pose the force systems saw (for the springs below, which
+    // then read the audit's own array instead of querying the world per spring end), and the
+    // loads.
+    for (entity, t, acc, implicit) in &bodies {
+        if let Some(i) = ledger.slot(entity) {
+            let body = &mut ledger.bodies[i];
+            body.end = *t;
+            body.at_forces = true;
+            let Some(acc) = acc else {
+                continue;
+            };
             // The torque of the forces at points an implicit body's solve takes at mid-step,
             // credited here at the pose the forces were sampled at.
-            let torque = acc.torque
-                + implicit.map_or(Vec3::ZERO, |b| {
-                    let rotation = states
-                        .get(entity)
-                        .map_or(Quat::IDENTITY, |(t, _)| t.rotation);
-                    b.point_torque(rotation)
-                });
-            let load = &mut ledger.bodies[i].load;
+            let torque = acc.torque + implicit.map_or(Vec3::ZERO, |b| b.point_torque(t.rotation));
+            let load = &mut body.load;
             match share {
                 None => *load = (acc.force, torque),
                 Some(w) => {
@@ -505,10 +538,13 @@ pub fn audit_external_loads(
     }
     // Anchor point and the centre of mass, on the (half-drifted) state the force systems saw.
     let anchor = |end: End, ledger: &EnergyLedger| match end {
-        End::Audited(i, local) => states
-            .get(ledger.bodies[i].entity)
-            .ok()
-            .map(|(t, m)| (t.transform_point(local), t.center_of_mass(m))),
+        End::Audited(i, local) => {
+            let body = &ledger.bodies[i];
+            body.at_forces.then(|| {
+                let t = body.end;
+                (t.transform_point(local), t.transform_point(body.local_com))
+            })
+        }
         End::Fixed(p) => Some((p, p)),
         End::Kinematic | End::Inactive => None,
     };
@@ -563,7 +599,7 @@ pub fn audit_energy(
     let dt = ledger.dt;
     let gravity = gravity.map(|g| g.0);
     for (entity, t, v, m, scale, has_accumulator) in &bodies {
-        let Some(&i) = ledger.index.get(&entity) else {
+        let Some(i) = ledger.slot(entity) else {
             continue;
         };
         let root = ledger.find(i);
