@@ -1,40 +1,23 @@
 //! The `tumble` binary: CSV exactly as specified, bit-identical to the library, clean failures.
 
-use std::process::Command;
-use tumble_core::math::Real;
+mod common;
 
+use common::{scene_path, scratch, stdout, tumble, tumble_out};
+use tumble_core::math::Real;
 use tumble_ecs::prelude::*;
 use tumble_scene::{CSV_HEADER, load_scene};
 
-fn tumble() -> Command {
-    let mut command = Command::new(env!("CARGO_BIN_EXE_tumble"));
-    // Messages are compared line by line: the caller's log settings must not add any.
-    command.env_remove("RUST_LOG");
-    command
-}
-
-fn scene_path(name: &str) -> String {
-    format!("{}/../../scenes/{name}.toml", env!("CARGO_MANIFEST_DIR"))
+/// The systems `tumble run SCENE --plan` prints.
+fn plan_of(scene: &str) -> String {
+    stdout(&tumble().args(["run", scene, "--plan"]).output().unwrap())
 }
 
 #[test]
 fn run_writes_the_specified_csv_bit_identical_to_the_library() {
-    let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("chain.csv");
-    let status = tumble()
-        .args([
-            "run",
-            &scene_path("spring_chain"),
-            "--steps",
-            "50",
-            "--every",
-            "10",
-            "--out",
-        ])
-        .arg(&out)
-        .status()
-        .unwrap();
-    assert!(status.success());
+    let (_dir, out) = scratch("chain.csv");
+    let chain = scene_path("spring_chain");
+    let args = ["run", &chain, "--steps", "50", "--every", "10"];
+    assert!(tumble_out(&args, &out).status.success());
     let csv = std::fs::read_to_string(&out).unwrap();
     let mut lines = csv.lines();
     assert_eq!(lines.next(), Some(CSV_HEADER));
@@ -138,21 +121,13 @@ fn scenes_lists_the_bundled_scenes_and_plan_prints_the_systems() {
     ] {
         assert!(text.contains(name), "{text}");
     }
-    let plan = tumble()
-        .args(["run", "spinning_top", "--plan"])
-        .output()
-        .unwrap();
-    let plan = String::from_utf8_lossy(&plan.stdout);
+    let plan = plan_of("spinning_top");
     assert!(
         plan.contains("apply_constant_forces") && !plan.contains("apply_springs"),
         "{plan}"
     );
     // The projectile's bodies have no accumulator: gravity needs no system of its own.
-    let plan = tumble()
-        .args(["run", "projectile", "--plan"])
-        .output()
-        .unwrap();
-    let plan = String::from_utf8_lossy(&plan.stdout);
+    let plan = plan_of("projectile");
     assert!(
         plan.trim_end().ends_with("integrate_without_forces"),
         "{plan}"

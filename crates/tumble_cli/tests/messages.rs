@@ -2,72 +2,29 @@
 //! log output on stderr (`RUST_LOG`, `-v`, `-q`), documented exit codes, a progress bar on a
 //! terminal.
 
+mod common;
+
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::Command;
 
+use common::{
+    BadValues, bad_value_runs, error_line, last_error_line, scratch, stderr, tumble, tumble_out,
+};
 use tumble_scene::CSV_HEADER;
-
-fn tumble() -> Command {
-    let mut command = Command::new(env!("CARGO_BIN_EXE_tumble"));
-    command.env_remove("RUST_LOG");
-    command
-}
-
-fn stderr(output: &Output) -> String {
-    String::from_utf8_lossy(&output.stderr).into_owned()
-}
-
-fn error_line(output: &Output) -> String {
-    let text = stderr(output);
-    assert_eq!(text.lines().count(), 1, "one line: {text}");
-    text.trim_end().to_owned()
-}
-
-/// The final `error:` line of a run that also logged warnings or quarantines before it.
-fn last_error_line(output: &Output) -> String {
-    let text = stderr(output);
-    let errors: Vec<&str> = text.lines().filter(|l| l.starts_with("error: ")).collect();
-    assert_eq!(errors.len(), 1, "one error line: {text}");
-    errors[0].to_owned()
-}
 
 #[test]
 fn negative_numbers_reach_tumbles_own_checks() {
-    for (args, expected) in [
+    let cases: [BadValues; 4] = [
+        ("--dt", "expected a time step > 0", &["-1"]),
+        ("--steps", "expected 1 to 1000000000 steps", &["-5"]),
+        ("--every", "expected a value >= 1", &["-2", "0"]),
         (
-            vec!["--dt", "-1"],
-            "error: --dt: expected a time step > 0, got -1",
+            "--substeps",
+            "expected 1 to 1000 substeps",
+            &["0", "-3", "1001"],
         ),
-        (
-            vec!["--steps", "-5"],
-            "error: --steps: expected 1 to 1000000000 steps, got -5",
-        ),
-        (
-            vec!["--every", "-2"],
-            "error: --every: expected a value >= 1, got -2",
-        ),
-        (
-            vec!["--every", "0"],
-            "error: --every: expected a value >= 1, got 0",
-        ),
-        (
-            vec!["--substeps", "0"],
-            "error: --substeps: expected 1 to 1000 substeps, got 0",
-        ),
-        (
-            vec!["--substeps", "-3"],
-            "error: --substeps: expected 1 to 1000 substeps, got -3",
-        ),
-        (
-            vec!["--substeps", "1001"],
-            "error: --substeps: expected 1 to 1000 substeps, got 1001",
-        ),
-    ] {
-        let output = tumble()
-            .args(["run", "projectile"])
-            .args(&args)
-            .output()
-            .unwrap();
+    ];
+    for (args, expected, output) in bad_value_runs(&["run", "projectile"], &cases) {
         assert_eq!(output.status.code(), Some(1), "{args:?}");
         assert_eq!(error_line(&output), expected);
     }
@@ -196,25 +153,20 @@ fn warnings_reach_stderr_and_follow_rust_log_and_the_flags() {
 
 #[test]
 fn a_rejected_body_exits_3_and_its_rows_stop() {
-    let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("chain.csv");
-    let output = tumble()
-        .args([
-            "-q",
-            "run",
-            "spring_chain",
-            "--dt",
-            "0.2",
-            "--steps",
-            "50",
-            "--springs",
-            "explicit",
-            "--allow-unstable",
-            "--out",
-        ])
-        .arg(&out)
-        .output()
-        .unwrap();
+    let (_dir, out) = scratch("chain.csv");
+    let unstable = [
+        "-q",
+        "run",
+        "spring_chain",
+        "--dt",
+        "0.2",
+        "--steps",
+        "50",
+        "--springs",
+        "explicit",
+        "--allow-unstable",
+    ];
+    let output = tumble_out(&unstable, &out);
     assert_eq!(output.status.code(), Some(3), "{}", stderr(&output));
     assert_eq!(
         last_error_line(&output),
@@ -243,21 +195,16 @@ fn a_rejected_body_exits_3_and_its_rows_stop() {
 
 #[test]
 fn a_predicted_divergence_is_refused_with_exit_4_unless_allowed() {
-    let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("chain.csv");
-    let output = tumble()
-        .args([
-            "run",
-            "spring_chain",
-            "--dt",
-            "0.2",
-            "--springs",
-            "explicit",
-            "--out",
-        ])
-        .arg(&out)
-        .output()
-        .unwrap();
+    let (_dir, out) = scratch("chain.csv");
+    let explicit = [
+        "run",
+        "spring_chain",
+        "--dt",
+        "0.2",
+        "--springs",
+        "explicit",
+    ];
+    let output = tumble_out(&explicit, &out);
     assert_eq!(output.status.code(), Some(4), "{}", stderr(&output));
     let text = stderr(&output);
     // Each warning names the spring as the scene file does, before the refusal.

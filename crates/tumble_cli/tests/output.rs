@@ -2,33 +2,16 @@
 //! on SIGINT/SIGTERM, rename last; no device, FIFO, directory, read-only file or input file is
 //! replaced), big work shows itself, and every message is one line that names what the user gave.
 
-use std::path::{Path, PathBuf};
+mod common;
+
+use std::path::Path;
 use std::process::{Child, Command, ExitStatus, Output, Stdio};
 use std::time::{Duration, Instant};
 
+use common::{
+    BadValues, bad_value_runs, error_line, scene_path, scratch, stderr, tumble, tumble_out,
+};
 use tumble_scene::{CSV_HEADER, MAX_SCENE_BYTES};
-
-fn tumble() -> Command {
-    let mut command = Command::new(env!("CARGO_BIN_EXE_tumble"));
-    // Tests that look at stderr must not see the caller's log settings.
-    command.env_remove("RUST_LOG");
-    command
-}
-
-fn scene_path(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("../../scenes/{name}.toml"))
-}
-
-fn stderr(output: &Output) -> String {
-    String::from_utf8_lossy(&output.stderr).into_owned()
-}
-
-/// The one line on stderr of a failed command.
-fn error_line(output: &Output) -> String {
-    let text = stderr(output);
-    assert_eq!(text.lines().count(), 1, "one line: {text}");
-    text.trim_end().to_owned()
-}
 
 /// Names in `dir`, sorted.
 fn listing(dir: &Path) -> Vec<String> {
@@ -114,8 +97,7 @@ fn devices_fifos_and_directories_are_refused_and_left_alone() {
 #[cfg(unix)]
 #[test]
 fn nothing_planted_beside_the_output_is_followed_and_a_symlink_out_keeps_its_link() {
-    let dir = tempfile::tempdir().unwrap();
-    let victim = dir.path().join("victim.txt");
+    let (dir, victim) = scratch("victim.txt");
     std::fs::write(&victim, "precious").unwrap();
     // The temporary name of old builds, planted as a link to another file.
     let out = dir.path().join("out.csv");
@@ -196,8 +178,7 @@ fn the_scene_file_is_never_the_output() {
 #[test]
 fn a_read_only_output_is_an_error_and_a_writable_one_keeps_its_mode() {
     use std::os::unix::fs::PermissionsExt;
-    let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("ro.csv");
+    let (dir, out) = scratch("ro.csv");
     std::fs::write(&out, "keep").unwrap();
     std::fs::set_permissions(&out, std::fs::Permissions::from_mode(0o444)).unwrap();
     let output = run_to(&out, &[]);
@@ -359,22 +340,9 @@ fn two_concurrent_runs_never_mix_their_files() {
 
 #[test]
 fn a_trajectory_bigger_than_the_free_space_is_refused_before_the_run() {
-    let dir = tempfile::tempdir().unwrap();
-    let scene = dir.path().join("many.toml");
-    let status = tumble()
-        .args([
-            "gen",
-            "many",
-            "--n",
-            "1000",
-            "--steps",
-            "1000000000",
-            "--out",
-        ])
-        .arg(&scene)
-        .status()
-        .unwrap();
-    assert!(status.success());
+    let (dir, scene) = scratch("many.toml");
+    let many = ["gen", "many", "--n", "1000", "--steps", "1000000000"];
+    assert!(tumble_out(&many, &scene).status.success());
     let out = dir.path().join("huge.csv");
     let mut child = tumble()
         .arg("run")
@@ -454,31 +422,17 @@ fn out_dash_writes_the_csv_to_stdout_and_the_summary_to_stderr() {
 
 #[test]
 fn gen_writes_only_what_run_accepts() {
-    for (args, expected) in [
+    let cases: [BadValues; 2] = [
         (
-            vec!["--steps", "0"],
-            "error: --steps: expected 1 to 1000000000 steps, got 0",
+            "--steps",
+            "expected 1 to 1000000000 steps",
+            &["0", "1000000001"],
         ),
-        (
-            vec!["--steps", "1000000001"],
-            "error: --steps: expected 1 to 1000000000 steps, got 1000000001",
-        ),
-        (
-            vec!["--n", "0"],
-            "error: --n: expected 1 to 200000 bodies, got 0",
-        ),
-        (
-            vec!["--n", "200001"],
-            "error: --n: expected 1 to 200000 bodies, got 200001",
-        ),
-        (
-            vec!["--n", "-3"],
-            "error: --n: expected 1 to 200000 bodies, got -3",
-        ),
-    ] {
-        let output = tumble().args(["gen", "many"]).args(&args).output().unwrap();
+        ("--n", "expected 1 to 200000 bodies", &["0", "200001", "-3"]),
+    ];
+    for (args, expected, output) in bad_value_runs(&["gen", "many"], &cases) {
         assert_eq!(output.status.code(), Some(1), "{args:?}");
-        assert!(error_line(&output).starts_with(expected), "{args:?}");
+        assert!(error_line(&output).starts_with(&expected), "{args:?}");
         assert!(output.stdout.is_empty());
     }
     // The cap fits under the loader's size limit.
