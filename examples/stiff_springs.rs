@@ -4,6 +4,7 @@
 //!
 //! `cargo run --release --example stiff_springs`
 use tumble::bevy_ecs::prelude::World;
+use tumble::ecs::forces::kinetic_and_elastic_energy as energy;
 use tumble::math::{Quat, Real, Vec3};
 
 use tumble::prelude::*;
@@ -26,42 +27,11 @@ fn world(springs: SpringSolver) -> Result<World, Box<dyn std::error::Error>> {
             },
         ))
         .id();
-    world.spawn(Spring {
-        a,
-        anchor_a: Vec3::new(0.1, 0.05, 0.0),
-        b: SpringEnd::Body {
-            body: b,
-            anchor: Vec3::new(-0.1, 0.0, 0.05),
-        },
-        // √(k/μ)Δt = 50 with μ = ½.
-        stiffness: 0.5 * (50.0 / DT).powi(2),
-        damping: 0.0,
-        rest_length: 0.8,
-    });
+    // √(k/μ)Δt = 50 with μ = ½.
+    let k = 0.5 * (50.0 / DT).powi(2);
+    let end = SpringEnd::on_body(b, Vec3::new(-0.1, 0.0, 0.05));
+    world.spawn(Spring::new(a, Vec3::new(0.1, 0.05, 0.0), end, k, 0.8));
     Ok(world)
-}
-
-/// Kinetic + elastic energy (J).
-fn energy(world: &mut World) -> f64 {
-    let kinetic: f64 = world
-        .query::<(&Transform, &Velocity, &MassProps)>()
-        .iter(world)
-        .map(|(t, v, m)| tumble::ecs::components::kinetic_energy_f64(t, v, m))
-        .sum();
-    let springs: Vec<Spring> = world.query::<&Spring>().iter(world).copied().collect();
-    let mut poses = world.query::<&Transform>();
-    let elastic: f64 = springs
-        .iter()
-        .filter_map(|s| {
-            let pa = poses.get(world, s.a).ok()?.transform_point(s.anchor_a);
-            let SpringEnd::Body { body, anchor } = s.b else {
-                return None;
-            };
-            let pb = poses.get(world, body).ok()?.transform_point(anchor);
-            Some(s.elastic_energy(pa, pb))
-        })
-        .sum();
-    kinetic + elastic
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {

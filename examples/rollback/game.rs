@@ -55,17 +55,13 @@ impl Game {
             let mass =
                 MassProperties::new(Mass::new(1.0 + 0.1 * f).expect("mass > 0"), inertia.into())
                     .expect("valid inertia");
+            let pose = Transform::new(Vec3::new(f, 0.0, 0.0), Quat::from_rotation_z(0.2 * f));
+            let spin = Velocity::angular(Vec3::new(0.5, 1.0 + 0.3 * f, -0.2));
             let mut body = world.spawn((
                 RigidBody,
                 MassProps(mass),
-                Transform {
-                    translation: Vec3::new(f, 0.0, 0.0),
-                    rotation: Quat::from_rotation_z(0.2 * f),
-                },
-                Velocity {
-                    linear: Vec3::ZERO,
-                    angular: Vec3::new(0.5, 1.0 + 0.3 * f, -0.2),
-                },
+                pose,
+                spin,
                 ForceAccumulator::default(),
             ));
             if i % 4 == 1 {
@@ -79,26 +75,13 @@ impl Game {
         for (i, pair) in bodies.windows(2).enumerate() {
             // One stiff pair (ωΔt ≈ 5 there): the plan steps it with the implicit solve.
             let stiffness = if i == 4 { 9.0e4 } else { 60.0 };
-            world.spawn(Spring {
-                a: pair[0],
-                anchor_a: Vec3::new(0.3, 0.1, 0.0),
-                b: SpringEnd::Body {
-                    body: pair[1],
-                    anchor: Vec3::new(-0.3, 0.0, 0.1),
-                },
-                stiffness,
-                damping: if i % 3 == 0 { 0.2 } else { 0.0 },
-                rest_length: 0.5,
-            });
+            let damping = if i % 3 == 0 { 0.2 } else { 0.0 };
+            let next = SpringEnd::on_body(pair[1], Vec3::new(-0.3, 0.0, 0.1));
+            let spring = Spring::new(pair[0], Vec3::new(0.3, 0.1, 0.0), next, stiffness, 0.5);
+            world.spawn(spring.with_damping(damping));
         }
-        world.spawn(Spring {
-            a: bodies[0],
-            anchor_a: Vec3::ZERO,
-            b: SpringEnd::World(Vec3::new(0.0, 2.0, 0.0)),
-            stiffness: 80.0,
-            damping: 0.0,
-            rest_length: 1.0,
-        });
+        let hook = SpringEnd::World(Vec3::new(0.0, 2.0, 0.0));
+        world.spawn(Spring::new(bodies[0], Vec3::ZERO, hook, 80.0, 1.0));
         let players = [bodies[0], bodies[9]];
         let thrusters = players.map(|body| {
             world

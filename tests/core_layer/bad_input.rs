@@ -5,7 +5,7 @@ use tumble::math::{Quat, Real, Vec3};
 
 use tumble::prelude::*;
 
-use super::util::{mass_props, run_schedule, world_with};
+use super::util::{mass_props, run_schedule, spawn_body, world_with};
 
 const STEPS: usize = 200;
 
@@ -250,13 +250,8 @@ fn diverging_explicit_step_is_caught_before_nan_reaches_components() {
 #[test]
 fn quarantined_body_keeps_finite_state_and_can_be_revived() {
     let mut world = base_world();
-    let bad = world
-        .spawn((
-            RigidBody,
-            mass_props(1.0, [0.01, 1.0, 1.005]),
-            Velocity::angular(Vec3::new(1.0, 60.0, 1.0)),
-        ))
-        .id();
+    let spin = Velocity::angular(Vec3::new(1.0, 60.0, 1.0));
+    let bad = spawn_body(&mut world, 1.0, [0.01, 1.0, 1.005], spin);
     let mut schedule = PhysicsPlan::for_world(&mut world).build_schedule();
     run_schedule(&mut world, &mut schedule, STEPS);
     assert!(world.get::<Rejected>(bad).is_some());

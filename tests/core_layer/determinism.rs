@@ -29,17 +29,9 @@ fn scene_bits() -> Vec<u64> {
         bodies.push(e);
     }
     for pair in bodies.windows(2) {
-        world.spawn(Spring {
-            a: pair[0],
-            anchor_a: Vec3::new(0.1, 0.0, 0.0),
-            b: SpringEnd::Body {
-                body: pair[1],
-                anchor: Vec3::new(-0.1, 0.0, 0.0),
-            },
-            stiffness: 30.0,
-            damping: 0.2,
-            rest_length: 1.0,
-        });
+        let next = SpringEnd::on_body(pair[1], Vec3::new(-0.1, 0.0, 0.0));
+        let spring = Spring::new(pair[0], Vec3::new(0.1, 0.0, 0.0), next, 30.0, 1.0);
+        world.spawn(spring.with_damping(0.2));
         world.spawn(ConstantForce {
             body: pair[0],
             force: Vec3::Z,
@@ -153,17 +145,9 @@ fn big_world_bits(parallelism: Parallelism, integrator: Integrator) -> Vec<u64> 
         bodies.push(e.id());
     }
     for pair in bodies.chunks(6) {
-        world.spawn(Spring {
-            a: pair[0],
-            anchor_a: Vec3::new(0.1, 0.0, 0.0),
-            b: SpringEnd::Body {
-                body: pair[3],
-                anchor: Vec3::ZERO,
-            },
-            stiffness: 10.0,
-            damping: 0.1,
-            rest_length: 0.5,
-        });
+        let end = SpringEnd::on_body(pair[3], Vec3::ZERO);
+        let spring = Spring::new(pair[0], Vec3::new(0.1, 0.0, 0.0), end, 10.0, 0.5);
+        world.spawn(spring.with_damping(0.1));
     }
     run(&mut world, 40);
     let mut bits = Vec::new();

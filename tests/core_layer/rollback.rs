@@ -9,7 +9,7 @@ use tumble::math::{Real, Vec3};
 use tumble::prelude::*;
 
 use super::checksum::reference_world;
-use super::util::mass_props;
+use super::util::{mass_props, spawn_body};
 
 #[path = "../../examples/rollback/game.rs"]
 mod game;
@@ -20,29 +20,22 @@ fn world(integrator: Integrator, substeps: u32) -> World {
     let settings = *world.resource::<PhysicsSettings>();
     let substeps = std::num::NonZeroU32::new(substeps).expect("substeps ≥ 1");
     world.insert_resource(settings.with_substeps(substeps));
-    let a = world
-        .spawn((
-            RigidBody,
-            mass_props(0.5, [0.02, 0.03, 0.04]),
-            Velocity::linear(Vec3::new(0.0, 1.0, 0.0)),
-        ))
-        .id();
-    let b = world
-        .spawn((RigidBody, mass_props(0.7, [0.05, 0.02, 0.04])))
-        .insert(Transform::from_translation(Vec3::new(0.6, 0.0, 0.0)))
-        .id();
-    world.spawn(Spring {
-        a,
-        anchor_a: Vec3::new(0.1, 0.05, 0.0),
-        b: SpringEnd::Body {
-            body: b,
-            anchor: Vec3::new(-0.1, 0.0, 0.05),
-        },
-        stiffness: 2.0e5,
-        damping: 0.0,
-        rest_length: 0.35,
-    });
+    let rising = Velocity::linear(Vec3::new(0.0, 1.0, 0.0));
+    let a = spawn_body(&mut world, 0.5, [0.02, 0.03, 0.04], rising);
+    let beside = Transform::from_translation(Vec3::new(0.6, 0.0, 0.0));
+    let b = spawn_body(&mut world, 0.7, [0.05, 0.02, 0.04], beside);
+    let end = SpringEnd::on_body(b, Vec3::new(-0.1, 0.0, 0.05));
+    world.spawn(Spring::new(a, Vec3::new(0.1, 0.05, 0.0), end, 2.0e5, 0.35));
     world
+}
+
+/// The splitting world after one step, its runner, and a capture of it then.
+fn captured_after_a_step() -> (World, PhysicsRunner, RollbackSnapshot) {
+    let mut w = world(Integrator::Splitting, 1);
+    let mut runner = PhysicsRunner::new(&mut w);
+    runner.step(&mut w);
+    let saved = RollbackSnapshot::capture(&mut w);
+    (w, runner, saved)
 }
 
 fn bodies(world: &mut World) -> Vec<Entity> {
@@ -144,10 +137,7 @@ fn a_restore_gives_back_the_captured_world_and_its_future() {
 
 #[test]
 fn a_restore_that_changes_nothing_keeps_the_schedule() {
-    let mut w = world(Integrator::Splitting, 1);
-    let mut runner = PhysicsRunner::new(&mut w);
-    runner.step(&mut w);
-    let saved = RollbackSnapshot::capture(&mut w);
+    let (mut w, mut runner, saved) = captured_after_a_step();
     for _ in 0..3 {
         let ids = bodies(&mut w);
         w.get_mut::<ForceAccumulator>(ids[1])
@@ -184,10 +174,7 @@ fn a_quarantine_at_the_capture_comes_back() {
 
 #[test]
 fn a_restore_into_other_entities_fails_and_changes_nothing() {
-    let mut w = world(Integrator::Splitting, 1);
-    let mut runner = PhysicsRunner::new(&mut w);
-    runner.step(&mut w);
-    let saved = RollbackSnapshot::capture(&mut w);
+    let (mut w, mut runner, saved) = captured_after_a_step();
     runner.step(&mut w);
     let ids = bodies(&mut w);
 

@@ -3,31 +3,33 @@
 //! `x' = x + Δt v'`, `v' ← decay(cΔt/2m) v'` — iterated here in f64.
 //! Two bodies on one spring exchange equal and opposite forces.
 
+use tumble::bevy_ecs::prelude::{Bundle, Entity, World};
 use tumble::math::{Real, Vec3, to_f64};
 use tumble::prelude::*;
 
-use super::util::{mass_props, run, world_with};
+use super::util::{run, spawn_body, world_with};
+
+/// A body of mass `m` (unit moments) with `extra` (its pose, ...) on a spring `(k, c, L₀)` from
+/// its centre of mass to the world origin.
+fn on_spring_to_origin(
+    world: &mut World,
+    m: Real,
+    extra: impl Bundle,
+    (k, c, rest): (Real, Real, Real),
+) -> Entity {
+    let body = spawn_body(world, m, [1.0, 1.0, 1.0], extra);
+    let origin = SpringEnd::World(Vec3::ZERO);
+    world.spawn(Spring::new(body, Vec3::ZERO, origin, k, rest).with_damping(c));
+    body
+}
 
 #[test]
 fn anchored_spring_follows_the_discrete_map() {
     for (k, c) in [(40.0 as Real, 0.0 as Real), (40.0, 0.8)] {
         let (m, dt, x0) = (2.0 as Real, 1.0 / 60.0 as Real, 0.7 as Real);
         let mut world = world_with(dt, Integrator::SymplecticEuler);
-        let body = world
-            .spawn((
-                RigidBody,
-                mass_props(m, [1.0, 1.0, 1.0]),
-                Transform::from_translation(Vec3::new(x0, 0.0, 0.0)),
-            ))
-            .id();
-        world.spawn(Spring {
-            a: body,
-            anchor_a: Vec3::ZERO,
-            b: SpringEnd::World(Vec3::ZERO),
-            stiffness: k,
-            damping: c,
-            rest_length: 0.0,
-        });
+        let at = Transform::from_translation(Vec3::new(x0, 0.0, 0.0));
+        let body = on_spring_to_origin(&mut world, m, at, (k, c, 0.0));
         let steps = 300;
         run(&mut world, steps);
         let (mut x, mut v) = (to_f64(x0), 0.0_f64);
@@ -61,35 +63,15 @@ fn two_body_spring_conserves_linear_momentum() {
     let dt = 1.0 / 120.0;
     let mut world = world_with(dt, Integrator::SymplecticEuler);
     let (ma, mb) = (1.0 as Real, 3.0 as Real);
-    let a = world
-        .spawn((
-            RigidBody,
-            mass_props(ma, [0.1, 0.2, 0.3]),
-            Transform::from_translation(Vec3::new(-1.0, 0.0, 0.0)),
-            Velocity {
-                linear: Vec3::new(0.0, 1.0, 0.0),
-                angular: Vec3::new(0.0, 0.0, 2.0),
-            },
-        ))
-        .id();
-    let b = world
-        .spawn((
-            RigidBody,
-            mass_props(mb, [0.3, 0.2, 0.1]),
-            Transform::from_translation(Vec3::new(1.0, 0.0, 0.0)),
-        ))
-        .id();
-    world.spawn(Spring {
-        a,
-        anchor_a: Vec3::new(0.2, 0.1, 0.0),
-        b: SpringEnd::Body {
-            body: b,
-            anchor: Vec3::new(-0.1, 0.0, 0.3),
-        },
-        stiffness: 50.0,
-        damping: 0.5,
-        rest_length: 1.0,
-    });
+    let velocity = Velocity {
+        linear: Vec3::new(0.0, 1.0, 0.0),
+        angular: Vec3::new(0.0, 0.0, 2.0),
+    };
+    let at = |x: Real| Transform::from_translation(Vec3::new(x, 0.0, 0.0));
+    let a = spawn_body(&mut world, ma, [0.1, 0.2, 0.3], (at(-1.0), velocity));
+    let b = spawn_body(&mut world, mb, [0.3, 0.2, 0.1], at(1.0));
+    let end = SpringEnd::on_body(b, Vec3::new(-0.1, 0.0, 0.3));
+    world.spawn(Spring::new(a, Vec3::new(0.2, 0.1, 0.0), end, 50.0, 1.0).with_damping(0.5));
     let p0 = Vec3::new(0.0, 1.0, 0.0) * ma;
     run(&mut world, 240);
     let va = world.get::<Velocity>(a).unwrap().linear;
@@ -110,22 +92,9 @@ fn default_integrator_spring_is_position_verlet() {
     let mut world = world_with(dt, Integrator::Splitting);
     // ωh = 1.5 is stiff enough for the implicit step by default: force the explicit one.
     world.resource_mut::<PhysicsSettings>().springs = SpringSolver::Explicit;
-    let body = world
-        .spawn((
-            RigidBody,
-            mass_props(m, [1.0, 1.0, 1.0]),
-            Transform::from_translation(Vec3::new(0.3, 0.0, 0.0)),
-            Velocity::linear(Vec3::new(-1.0, 0.0, 0.0)),
-        ))
-        .id();
-    world.spawn(Spring {
-        a: body,
-        anchor_a: Vec3::ZERO,
-        b: SpringEnd::World(Vec3::ZERO),
-        stiffness: k,
-        damping: 0.0,
-        rest_length: 0.0,
-    });
+    let at = Transform::from_translation(Vec3::new(0.3, 0.0, 0.0));
+    let v = Velocity::linear(Vec3::new(-1.0, 0.0, 0.0));
+    let body = on_spring_to_origin(&mut world, m, (at, v), (k, 0.0, 0.0));
     let steps = 2000;
     run(&mut world, steps);
     let (w2, h) = (to_f64(k / m), to_f64(dt));
@@ -165,21 +134,8 @@ fn damped_oscillator_with(
 ) -> Vec<(f64, f64)> {
     let mut world = world_with(dt, integrator);
     world.resource_mut::<PhysicsSettings>().springs = springs;
-    let body = world
-        .spawn((
-            RigidBody,
-            mass_props(m, [1.0, 1.0, 1.0]),
-            Transform::from_translation(Vec3::new(1.5, 0.0, 0.0)),
-        ))
-        .id();
-    world.spawn(Spring {
-        a: body,
-        anchor_a: Vec3::ZERO,
-        b: SpringEnd::World(Vec3::ZERO),
-        stiffness: k,
-        damping: c,
-        rest_length: 1.0,
-    });
+    let at = Transform::from_translation(Vec3::new(1.5, 0.0, 0.0));
+    let body = on_spring_to_origin(&mut world, m, at, (k, c, 1.0));
     let mut physics = PhysicsRunner::new(&mut world);
     (0..steps)
         .map(|_| {

@@ -33,6 +33,12 @@ pub fn mass_props(m: Real, inertia: [Real; 3]) -> MassProps {
     MassProps(MassProperties::new(Mass::new(m).unwrap(), inertia.into()).unwrap())
 }
 
+/// Spawns a rigid body of mass `m` and principal moments `inertia`, with `extra` (its pose,
+/// velocity, ...).
+pub fn spawn_body(world: &mut World, m: Real, inertia: [Real; 3], extra: impl Bundle) -> Entity {
+    world.spawn((RigidBody, mass_props(m, inertia), extra)).id()
+}
+
 /// Relative difference `|a − b| / |b|` in f64.
 pub fn rel(a: f64, b: f64) -> f64 {
     (a - b).abs() / b.abs()

@@ -22,14 +22,13 @@ fn spring_world(omega_dt: Real, integrator: Integrator, springs: SpringSolver) -
             Transform::from_translation(Vec3::new(1.0, 0.0, 0.0)),
         ))
         .id();
-    world.spawn(Spring {
-        a: body,
-        anchor_a: Vec3::ZERO,
-        b: SpringEnd::World(Vec3::ZERO),
-        stiffness: k,
-        damping: 0.0,
-        rest_length: 0.0,
-    });
+    world.spawn(Spring::new(
+        body,
+        Vec3::ZERO,
+        SpringEnd::World(Vec3::ZERO),
+        k,
+        0.0,
+    ));
     (world, body)
 }
 

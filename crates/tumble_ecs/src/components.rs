@@ -60,6 +60,14 @@ impl Transform {
         rotation: Quat::IDENTITY,
     };
 
+    /// A pose at `translation` with `rotation` (unit quaternion).
+    pub const fn new(translation: Vec3, rotation: Quat) -> Self {
+        Self {
+            translation,
+            rotation,
+        }
+    }
+
     /// A pose at `translation`, unrotated.
     pub fn from_translation(translation: Vec3) -> Self {
         Self {
@@ -114,6 +122,11 @@ impl Velocity {
         linear: Vec3::ZERO,
         angular: Vec3::ZERO,
     };
+
+    /// A linear and an angular (world frame) velocity.
+    pub const fn new(linear: Vec3, angular: Vec3) -> Self {
+        Self { linear, angular }
+    }
 
     /// A linear velocity only.
     pub fn linear(linear: Vec3) -> Self {

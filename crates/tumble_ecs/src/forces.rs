@@ -54,6 +54,13 @@ pub enum SpringEnd {
     },
 }
 
+impl SpringEnd {
+    /// The point `anchor` (body coordinates) of `body`.
+    pub const fn on_body(body: Entity, anchor: Vec3) -> Self {
+        Self::Body { body, anchor }
+    }
+}
+
 /// A damped linear spring between a point of body `a` and a second end.
 ///
 /// With anchors `p_a`, `p_b` in world coordinates, `d = p_a − p_b`, `n = d/|d|` and the relative
@@ -87,12 +94,62 @@ pub struct Spring {
 }
 
 impl Spring {
+    /// An undamped spring from `anchor_a` (body coordinates) of `a` to `b`, with stiffness `k`
+    /// (N/m) and rest length `L₀` (m); [`with_damping`](Self::with_damping) adds a damper.
+    pub const fn new(
+        a: Entity,
+        anchor_a: Vec3,
+        b: SpringEnd,
+        stiffness: Real,
+        rest_length: Real,
+    ) -> Self {
+        Self {
+            a,
+            anchor_a,
+            b,
+            stiffness,
+            damping: 0.0,
+            rest_length,
+        }
+    }
+
+    /// This spring with the damping `c` (N·s/m).
+    pub const fn with_damping(self, damping: Real) -> Self {
+        Self { damping, ..self }
+    }
+
     /// Elastic energy `½ k (|d| − L₀)²` (J) with the anchors at the world points `pa` and `pb`,
     /// in `f64` (energy balances sum many such terms).
     pub fn elastic_energy(&self, pa: Vec3, pb: Vec3) -> f64 {
         let stretch = (pa - pb).widen().length() - self.rest_length.widen();
         0.5 * self.stiffness.widen() * stretch * stretch
     }
+}
+
+/// Kinetic energy of every body with a velocity plus the elastic energy of every spring (J), in
+/// `f64`. Panics if a spring names a body without a [`Transform`].
+pub fn kinetic_and_elastic_energy(world: &mut World) -> f64 {
+    let kinetic: f64 = world
+        .query::<(&Transform, &Velocity, &MassProps)>()
+        .iter(world)
+        .map(|(t, v, m)| crate::components::kinetic_energy_f64(t, v, m))
+        .sum();
+    let springs: Vec<Spring> = world.query::<&Spring>().iter(world).copied().collect();
+    let mut poses = world.query::<&Transform>();
+    let elastic: f64 = springs
+        .iter()
+        .map(|s| {
+            let pa = poses.get(world, s.a).unwrap().transform_point(s.anchor_a);
+            let pb = match s.b {
+                SpringEnd::World(p) => p,
+                SpringEnd::Body { body, anchor } => {
+                    poses.get(world, body).unwrap().transform_point(anchor)
+                }
+            };
+            s.elastic_energy(pa, pb)
+        })
+        .sum();
+    kinetic + elastic
 }
 
 /// Inserts a zero [`ForceAccumulator`] on every body a generator names, where missing.

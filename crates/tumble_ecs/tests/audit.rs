@@ -9,6 +9,9 @@ use tumble_ecs::prelude::*;
 
 const DT: Real = 1.0 / 60.0;
 
+/// Principal moments of an asymmetric unit body.
+const ASYMMETRIC: Vec3 = Vec3::new(1.0, 2.0, 3.0);
+
 fn world(integrator: Integrator) -> World {
     let mut world = World::new();
     // The audit watches the explicit spring step (the implicit one conserves energy by
@@ -19,6 +22,13 @@ fn world(integrator: Integrator) -> World {
             .with_springs(SpringSolver::Explicit),
     );
     world.insert_resource(Parallelism::SINGLE_THREAD);
+    world
+}
+
+/// [`world`] with the energy audited at every step.
+fn audited_world(integrator: Integrator) -> World {
+    let mut world = world(integrator);
+    world.insert_resource(EnergyAudit::Always);
     world
 }
 
@@ -50,26 +60,23 @@ fn chain(world: &mut World, n: usize, x0: Real, omega_dt: Real) -> Vec<Entity> {
     let bodies: Vec<Entity> = (0..n)
         .map(|i| body(world, x0 + i as Real, inertia, Vec3::new(0.1, 0.2, 0.3)))
         .collect();
-    world.spawn(Spring {
-        a: bodies[0],
-        anchor_a: Vec3::new(-0.1, 0.05, 0.0),
-        b: SpringEnd::World(Vec3::new(x0 - 1.0, 0.1, 0.0)),
-        stiffness: k,
-        damping: 0.0,
-        rest_length: 0.8,
-    });
+    let wall = SpringEnd::World(Vec3::new(x0 - 1.0, 0.1, 0.0));
+    world.spawn(Spring::new(
+        bodies[0],
+        Vec3::new(-0.1, 0.05, 0.0),
+        wall,
+        k,
+        0.8,
+    ));
     for pair in bodies.windows(2) {
-        world.spawn(Spring {
-            a: pair[0],
-            anchor_a: Vec3::new(0.1, 0.05, 0.0),
-            b: SpringEnd::Body {
-                body: pair[1],
-                anchor: Vec3::new(-0.1, 0.0, 0.05),
-            },
-            stiffness: k,
-            damping: 0.0,
-            rest_length: 0.7,
-        });
+        let next = SpringEnd::on_body(pair[1], Vec3::new(-0.1, 0.0, 0.05));
+        world.spawn(Spring::new(
+            pair[0],
+            Vec3::new(0.1, 0.05, 0.0),
+            next,
+            k,
+            0.7,
+        ));
     }
     bodies
 }
@@ -123,14 +130,11 @@ fn stable_springs_near_the_limit_and_soft_chains_are_never_flagged() {
         let mut w = world(Integrator::Splitting);
         // One world-anchored body: its spring's ωΔt is exactly the nominal one (μ = m).
         let b = body(&mut w, 0.0, Vec3::ONE, Vec3::ZERO);
-        w.spawn(Spring {
-            a: b,
-            anchor_a: Vec3::ZERO,
-            b: SpringEnd::World(Vec3::new(-1.0, 0.0, 0.0)),
-            stiffness: (omega_dt / DT).powi(2),
-            damping: 0.0,
-            rest_length: 0.5,
-        });
+        let (wall, k) = (
+            SpringEnd::World(Vec3::new(-1.0, 0.0, 0.0)),
+            (omega_dt / DT).powi(2),
+        );
+        w.spawn(Spring::new(b, Vec3::ZERO, wall, k, 0.5));
         run(&mut w, 10_000);
         assert!(errors(&w).is_empty(), "ωΔt = {omega_dt}: {:?}", errors(&w));
     }
@@ -158,29 +162,14 @@ fn work_of_gravity_forces_torques_and_game_code_is_credited() {
         Integrator::SymplecticEuler,
         Integrator::Yoshida4,
     ] {
-        let mut w = world(integrator);
+        let mut w = audited_world(integrator);
         w.insert_resource(Gravity(Vec3::new(0.0, -9.81, 0.0)));
-        w.insert_resource(EnergyAudit::Always);
-        let a = body(
-            &mut w,
-            0.0,
-            Vec3::new(1.0, 2.0, 3.0),
-            Vec3::new(0.0, 0.0, 2.0),
-        );
-        let b = body(&mut w, 1.0, Vec3::new(1.0, 2.0, 3.0), Vec3::ZERO);
+        let a = body(&mut w, 0.0, ASYMMETRIC, Vec3::new(0.0, 0.0, 2.0));
+        let b = body(&mut w, 1.0, ASYMMETRIC, Vec3::ZERO);
         let free = body(&mut w, 5.0, Vec3::ONE, Vec3::ZERO);
         w.entity_mut(a).insert(Thruster);
-        w.spawn(Spring {
-            a,
-            anchor_a: Vec3::new(0.2, 0.0, 0.0),
-            b: SpringEnd::Body {
-                body: b,
-                anchor: Vec3::ZERO,
-            },
-            stiffness: 50.0,
-            damping: 0.5,
-            rest_length: 1.0,
-        });
+        let end = SpringEnd::on_body(b, Vec3::ZERO);
+        w.spawn(Spring::new(a, Vec3::new(0.2, 0.0, 0.0), end, 50.0, 1.0).with_damping(0.5));
         w.spawn(ConstantForce {
             body: b,
             force: Vec3::new(0.0, 12.0, 1.0),
@@ -213,14 +202,8 @@ fn work_of_gravity_forces_torques_and_game_code_is_credited() {
 
 #[test]
 fn an_exploding_explicit_spin_is_caught_before_it_is_non_finite() {
-    let mut w = world(Integrator::SymplecticEuler);
-    w.insert_resource(EnergyAudit::Always);
-    let spinning = body(
-        &mut w,
-        0.0,
-        Vec3::new(1.0, 2.0, 3.0),
-        Vec3::new(0.5, 20.0, 0.5),
-    );
+    let mut w = audited_world(Integrator::SymplecticEuler);
+    let spinning = body(&mut w, 0.0, ASYMMETRIC, Vec3::new(0.5, 20.0, 0.5));
     run(&mut w, 2000);
     let errors = errors(&w);
     assert_eq!(errors.len(), 1, "{errors:?}");
@@ -261,7 +244,7 @@ fn the_audit_is_planned_only_where_energy_can_blow_up() {
         if springs {
             chain(&mut w, 2, 0.0, 0.5);
         } else {
-            body(&mut w, 0.0, Vec3::new(1.0, 2.0, 3.0), Vec3::Y);
+            body(&mut w, 0.0, ASYMMETRIC, Vec3::Y);
         }
         PhysicsPlan::for_world(&mut w).contains(Stage::AuditEnergy)
     };

@@ -23,18 +23,12 @@ fn scene(integrator: Integrator) -> World {
         .unwrap()
         .with_center_of_mass(Vec3::new(0.05, 0.0, -0.02))
         .unwrap();
-        let mut e = world.spawn((
-            RigidBody,
-            MassProps(mass),
-            Transform {
-                translation: Vec3::new(f, 1.0, 0.0),
-                rotation: Quat::from_rotation_z(0.2 * f),
-            },
-            Velocity {
-                linear: Vec3::new(0.0, 0.5, 0.1 * f),
-                angular: Vec3::new(1.0, 3.0 - 0.2 * f, 0.3),
-            },
-        ));
+        let pose = Transform::new(Vec3::new(f, 1.0, 0.0), Quat::from_rotation_z(0.2 * f));
+        let velocity = Velocity::new(
+            Vec3::new(0.0, 0.5, 0.1 * f),
+            Vec3::new(1.0, 3.0 - 0.2 * f, 0.3),
+        );
+        let mut e = world.spawn((RigidBody, MassProps(mass), pose, velocity));
         if i % 3 == 0 {
             e.insert(GravityScale(0.5));
         }
@@ -48,29 +42,12 @@ fn scene(integrator: Integrator) -> World {
     }
     world.spawn((RigidBody, Kinematic, Velocity::linear(Vec3::X)));
     for pair in bodies.windows(2) {
-        world.spawn(Spring {
-            a: pair[0],
-            anchor_a: Vec3::new(0.1, 0.0, 0.0),
-            b: SpringEnd::Body {
-                body: pair[1],
-                anchor: Vec3::ZERO,
-            },
-            stiffness: 40.0,
-            damping: 0.3,
-            rest_length: 1.0,
-        });
+        let next = SpringEnd::on_body(pair[1], Vec3::ZERO);
+        let spring = Spring::new(pair[0], Vec3::new(0.1, 0.0, 0.0), next, 40.0, 1.0);
+        world.spawn(spring.with_damping(0.3));
     }
-    world.spawn(Spring {
-        a: bodies[0],
-        anchor_a: Vec3::ZERO,
-        b: SpringEnd::Body {
-            body: anchor,
-            anchor: Vec3::ZERO,
-        },
-        stiffness: 80.0,
-        damping: 0.0,
-        rest_length: 0.5,
-    });
+    let held = SpringEnd::on_body(anchor, Vec3::ZERO);
+    world.spawn(Spring::new(bodies[0], Vec3::ZERO, held, 80.0, 0.5));
     world.spawn(ConstantForce {
         body: bodies[5],
         force: Vec3::new(0.0, 0.0, 2.0),

@@ -5,7 +5,7 @@
 use bevy_ecs::prelude::*;
 use tumble_core::math::{Quat, Real, Vec3, to_f64};
 use tumble_core::{Mass, MassProperties};
-use tumble_ecs::components::kinetic_energy_f64;
+use tumble_ecs::forces::kinetic_and_elastic_energy as energy;
 use tumble_ecs::prelude::*;
 
 const DT: Real = 1.0 / 60.0;
@@ -35,31 +35,6 @@ fn body(
         .id()
 }
 
-/// Kinetic + elastic energy (J).
-fn energy(world: &mut World) -> f64 {
-    let mut bodies = world.query::<(&Transform, &Velocity, &MassProps)>();
-    let kinetic: f64 = bodies
-        .iter(world)
-        .map(|(t, v, m)| kinetic_energy_f64(t, v, m))
-        .sum();
-    let springs: Vec<Spring> = world.query::<&Spring>().iter(world).copied().collect();
-    let mut poses = world.query::<&Transform>();
-    let elastic: f64 = springs
-        .iter()
-        .map(|s| {
-            let pa = poses.get(world, s.a).unwrap().transform_point(s.anchor_a);
-            let pb = match s.b {
-                SpringEnd::World(p) => p,
-                SpringEnd::Body { body, anchor } => {
-                    poses.get(world, body).unwrap().transform_point(anchor)
-                }
-            };
-            s.elastic_energy(pa, pb)
-        })
-        .sum();
-    kinetic + elastic
-}
-
 /// Two unit masses (asymmetric, off-centre anchors), stiffness from the nominal
 /// `√(k/μ)Δt = omega_dt` with `μ = ½`, stretched 20 % past the rest length and spinning.
 fn two_bodies(world: &mut World, omega_dt: Real) {
@@ -80,17 +55,9 @@ fn two_bodies(world: &mut World, omega_dt: Real) {
         Vec3::new(0.0, 0.1, 0.0),
         Vec3::new(-0.1, 0.0, 0.4),
     );
-    world.spawn(Spring {
-        a,
-        anchor_a: Vec3::new(0.1, 0.05, 0.0),
-        b: SpringEnd::Body {
-            body: b,
-            anchor: Vec3::new(-0.1, 0.0, 0.05),
-        },
-        stiffness: 0.5 * (omega_dt / DT).powi(2),
-        damping: 0.0,
-        rest_length: 0.8,
-    });
+    let b = SpringEnd::on_body(b, Vec3::new(-0.1, 0.0, 0.05));
+    let k = 0.5 * (omega_dt / DT).powi(2);
+    world.spawn(Spring::new(a, Vec3::new(0.1, 0.05, 0.0), b, k, 0.8));
 }
 
 /// A chain of `n` asymmetric bodies at off-centre anchors, the first tied to the world, each
@@ -111,26 +78,23 @@ fn chain(world: &mut World, n: usize, omega_dt: Real) {
             )
         })
         .collect();
-    world.spawn(Spring {
-        a: bodies[0],
-        anchor_a: Vec3::new(-0.1, 0.05, 0.0),
-        b: SpringEnd::World(Vec3::new(-1.0, 0.0, 0.0)),
-        stiffness: k,
-        damping: 0.0,
-        rest_length: 0.8,
-    });
+    let wall = SpringEnd::World(Vec3::new(-1.0, 0.0, 0.0));
+    world.spawn(Spring::new(
+        bodies[0],
+        Vec3::new(-0.1, 0.05, 0.0),
+        wall,
+        k,
+        0.8,
+    ));
     for pair in bodies.windows(2) {
-        world.spawn(Spring {
-            a: pair[0],
-            anchor_a: Vec3::new(0.1, 0.05, 0.0),
-            b: SpringEnd::Body {
-                body: pair[1],
-                anchor: Vec3::new(-0.1, -0.05, 0.02),
-            },
-            stiffness: k,
-            damping: 0.0,
-            rest_length: 0.72,
-        });
+        let next = SpringEnd::on_body(pair[1], Vec3::new(-0.1, -0.05, 0.02));
+        world.spawn(Spring::new(
+            pair[0],
+            Vec3::new(0.1, 0.05, 0.0),
+            next,
+            k,
+            0.72,
+        ));
     }
 }
 
@@ -265,14 +229,8 @@ fn the_planner_counts_every_spring_on_a_body() {
         let k = (0.2 / DT).powi(2);
         for i in 0..n {
             let angle = i as Real * 0.7;
-            world.spawn(Spring {
-                a: hub,
-                anchor_a: Vec3::ZERO,
-                b: SpringEnd::World(Vec3::new(angle.cos(), angle.sin(), 0.0)),
-                stiffness: k,
-                damping: 0.0,
-                rest_length: 0.5,
-            });
+            let end = SpringEnd::World(Vec3::new(angle.cos(), angle.sin(), 0.0));
+            world.spawn(Spring::new(hub, Vec3::ZERO, end, k, 0.5));
         }
         PhysicsPlan::for_world(&mut world).contains(Stage::SolveImplicitSprings)
     };
@@ -314,42 +272,16 @@ fn a_stiff_cloth_falls_without_making_energy() {
         }
     }
     let link = |world: &mut World, a: Entity, b: SpringEnd, rest: Real| {
-        world.spawn(Spring {
-            a,
-            anchor_a: Vec3::ZERO,
-            b,
-            stiffness: k,
-            damping: 0.0,
-            rest_length: rest,
-        });
+        world.spawn(Spring::new(a, Vec3::ZERO, b, k, rest));
     };
-    for i in 0..n {
-        for j in 0..n {
-            let here = grid[i * n + j];
-            if i + 1 < n {
-                let body = grid[(i + 1) * n + j];
-                link(
-                    &mut world,
-                    here,
-                    SpringEnd::Body {
-                        body,
-                        anchor: Vec3::ZERO,
-                    },
-                    spacing,
-                );
-            }
-            if j + 1 < n {
-                let body = grid[i * n + j + 1];
-                link(
-                    &mut world,
-                    here,
-                    SpringEnd::Body {
-                        body,
-                        anchor: Vec3::ZERO,
-                    },
-                    spacing,
-                );
-            }
+    let node = |c: usize| SpringEnd::on_body(grid[c], Vec3::ZERO);
+    for c in 0..n * n {
+        // Node (i, j) = c: to (i + 1, j), then to (i, j + 1).
+        if c / n + 1 < n {
+            link(&mut world, grid[c], node(c + n), spacing);
+        }
+        if c % n + 1 < n {
+            link(&mut world, grid[c], node(c + 1), spacing);
         }
     }
     for i in [0, n - 1] {

@@ -122,25 +122,22 @@ pub fn spawn(world: &mut World) -> [Entity; 3] {
                 .id()
         })
         .collect();
-    world.spawn(Spring {
-        a: e[0],
-        anchor_a: v3(LINK.0),
-        b: SpringEnd::Body {
-            body: e[1],
-            anchor: v3(LINK.1),
-        },
-        stiffness: LINK.2 as Real,
-        damping: 0.0,
-        rest_length: LINK.3 as Real,
-    });
-    world.spawn(Spring {
-        a: e[2],
-        anchor_a: v3(HANG.0),
-        b: SpringEnd::World(v3(HANG.1)),
-        stiffness: HANG.2 as Real,
-        damping: 0.0,
-        rest_length: HANG.3 as Real,
-    });
+    let link = SpringEnd::on_body(e[1], v3(LINK.1));
+    world.spawn(Spring::new(
+        e[0],
+        v3(LINK.0),
+        link,
+        LINK.2 as Real,
+        LINK.3 as Real,
+    ));
+    let hang = SpringEnd::World(v3(HANG.1));
+    world.spawn(Spring::new(
+        e[2],
+        v3(HANG.0),
+        hang,
+        HANG.2 as Real,
+        HANG.3 as Real,
+    ));
     world.spawn(ConstantForce {
         body: e[1],
         force: v3(PUSH.0),

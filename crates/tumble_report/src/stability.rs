@@ -263,14 +263,14 @@ fn stiff_spring(
     let body = w
         .spawn((RigidBody, sphere(m), Transform::from_translation(Vec3::X)))
         .id();
-    w.spawn(Spring {
-        a: body,
-        anchor_a: Vec3::ZERO,
-        b: SpringEnd::World(Vec3::ZERO),
-        stiffness: m * (omega_dt / dt).powi(2),
-        damping: 0.0,
-        rest_length: 0.0,
-    });
+    let k = m * (omega_dt / dt).powi(2);
+    w.spawn(Spring::new(
+        body,
+        Vec3::ZERO,
+        SpringEnd::World(Vec3::ZERO),
+        k,
+        0.0,
+    ));
     run(
         &mut w,
         steps,
@@ -293,17 +293,9 @@ fn mass_ratio(integrator: Integrator, dt: Real, steps: usize) -> Cell {
             Transform::from_translation(Vec3::new(1.5, 0.0, 0.0)),
         ))
         .id();
-    w.spawn(Spring {
-        a: light,
-        anchor_a: Vec3::ZERO,
-        b: SpringEnd::Body {
-            body: heavy,
-            anchor: Vec3::ZERO,
-        },
-        stiffness: (1.0 / dt).powi(2),
-        damping: 0.0,
-        rest_length: 1.0,
-    });
+    let k = (1.0 / dt).powi(2);
+    let end = SpringEnd::on_body(heavy, Vec3::ZERO);
+    w.spawn(Spring::new(light, Vec3::ZERO, end, k, 1.0));
     run(
         &mut w,
         steps,
@@ -434,23 +426,13 @@ fn cloth(springs: SpringSolver, omega_dt: Real, steps: usize) -> Cell {
         })
         .collect();
     let mut link = |a: Entity, b: SpringEnd, rest: Real| {
-        w.spawn(Spring {
-            a,
-            anchor_a: Vec3::ZERO,
-            b,
-            stiffness: k,
-            damping: 0.0,
-            rest_length: rest,
-        });
+        w.spawn(Spring::new(a, Vec3::ZERO, b, k, rest));
     };
     for i in 0..n {
         for j in 0..n {
             for (p, q) in [(i + 1, j), (i, j + 1)] {
                 if p < n && q < n {
-                    let end = SpringEnd::Body {
-                        body: grid[p * n + q],
-                        anchor: Vec3::ZERO,
-                    };
+                    let end = SpringEnd::on_body(grid[p * n + q], Vec3::ZERO);
                     link(grid[i * n + j], end, spacing);
                 }
             }
