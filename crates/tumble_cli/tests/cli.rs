@@ -2,14 +2,14 @@
 
 mod common;
 
-use common::{scene_path, scratch, stdout, tumble, tumble_out};
+use common::{scene_path, scratch, scratch_file, stdout, tumble, tumble_out, tumble_run};
 use tumble_core::math::Real;
 use tumble_ecs::prelude::*;
 use tumble_scene::{CSV_HEADER, load_scene};
 
 /// The systems `tumble run SCENE --plan` prints.
 fn plan_of(scene: &str) -> String {
-    stdout(&tumble().args(["run", scene, "--plan"]).output().unwrap())
+    stdout(&tumble_run(&["run", scene, "--plan"]))
 }
 
 #[test]
@@ -60,9 +60,7 @@ fn run_writes_the_specified_csv_bit_identical_to_the_library() {
 
 #[test]
 fn bad_scene_exits_non_zero_with_file_and_line_and_writes_nothing() {
-    let dir = tempfile::tempdir().unwrap();
-    let bad = dir.path().join("bad.toml");
-    std::fs::write(&bad, "name = \"x\"\n[world]\ndt = -1.0\nsteps = 5\n").unwrap();
+    let (dir, bad) = scratch_file("bad.toml", "name = \"x\"\n[world]\ndt = -1.0\nsteps = 5\n");
     let out = dir.path().join("never.csv");
     let output = tumble()
         .args(["run"])
@@ -76,10 +74,7 @@ fn bad_scene_exits_non_zero_with_file_and_line_and_writes_nothing() {
     assert!(stderr.contains("bad.toml:3: world.dt"), "{stderr}");
     assert_eq!(stderr.lines().count(), 1, "one line: {stderr}");
     assert!(!out.exists());
-    let output = tumble()
-        .args(["run", &scene_path("projectile"), "--dt", "0"])
-        .output()
-        .unwrap();
+    let output = tumble_run(&["run", &scene_path("projectile"), "--dt", "0"]);
     assert!(!output.status.success());
     // A bad flag is named as the flag, not as a line of a file the user never wrote.
     let stderr = String::from_utf8_lossy(&output.stderr);
@@ -95,10 +90,7 @@ fn bad_scene_exits_non_zero_with_file_and_line_and_writes_nothing() {
             "error: --integrator: unknown integrator `magic`",
         ),
     ] {
-        let output = tumble()
-            .args(["run", "projectile", flag, value])
-            .output()
-            .unwrap();
+        let output = tumble_run(&["run", "projectile", flag, value]);
         assert!(!output.status.success());
         let stderr = String::from_utf8_lossy(&output.stderr);
         assert!(stderr.starts_with(expected), "{stderr}");
@@ -137,7 +129,7 @@ fn scenes_lists_the_bundled_scenes_and_plan_prints_the_systems() {
 
 #[test]
 fn compare_reports_rapier_and_exact_differences() {
-    let out = tumble().args(["compare", "dzhanibekov"]).output().unwrap();
+    let out = tumble_run(&["compare", "dzhanibekov"]);
     assert!(
         out.status.success(),
         "{}",
@@ -194,10 +186,7 @@ fn compare_accepts_springs_and_names_the_rapier_spring_mode() {
             assert!(text.lines().any(|l| l.starts_with(body)), "{text}");
         }
     }
-    let out = tumble()
-        .args(["compare", "spring_chain", "--rapier-springs", "spring"])
-        .output()
-        .unwrap();
+    let out = tumble_run(&["compare", "spring_chain", "--rapier-springs", "spring"]);
     assert_eq!(out.status.code(), Some(1));
     assert!(
         String::from_utf8_lossy(&out.stderr)
@@ -227,10 +216,7 @@ fn gen_many_writes_a_valid_scene() {
     );
     assert!(String::from_utf8_lossy(&run.stdout).contains("bodies     1000"));
     // The generator's headline size fits under the loader's size limit.
-    let big = tumble()
-        .args(["gen", "many", "--n", "100000"])
-        .output()
-        .unwrap();
+    let big = tumble_run(&["gen", "many", "--n", "100000"]);
     assert!(big.status.success());
     assert!((big.stdout.len() as u64) < tumble_scene::MAX_SCENE_BYTES);
 }
@@ -239,17 +225,14 @@ fn gen_many_writes_a_valid_scene() {
 /// and the planner names `exact` on stderr.
 #[test]
 fn the_thin_plate_runs_exactly_and_splitting_is_told_to_use_exact() {
-    let out = tumble().args(["run", "thin_plate"]).output().unwrap();
+    let out = tumble_run(&["run", "thin_plate"]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{stderr}");
     assert!(!stderr.contains("WARN"), "{stderr}");
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(stdout.contains("(exact)"), "{stdout}");
 
-    let out = tumble()
-        .args(["run", "thin_plate", "--integrator", "splitting"])
-        .output()
-        .unwrap();
+    let out = tumble_run(&["run", "thin_plate", "--integrator", "splitting"]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{stderr}");
     assert!(
@@ -264,18 +247,15 @@ fn the_thin_plate_runs_exactly_and_splitting_is_told_to_use_exact() {
 #[test]
 fn checksum_prints_the_library_checksum_at_every_recorded_step() {
     let run = || {
-        let out = tumble()
-            .args([
-                "run",
-                &scene_path("spring_chain"),
-                "--steps",
-                "25",
-                "--every",
-                "10",
-                "--checksum",
-            ])
-            .output()
-            .unwrap();
+        let out = tumble_run(&[
+            "run",
+            &scene_path("spring_chain"),
+            "--steps",
+            "25",
+            "--every",
+            "10",
+            "--checksum",
+        ]);
         assert!(out.status.success());
         String::from_utf8_lossy(&out.stdout)
             .lines()
@@ -298,18 +278,15 @@ fn checksum_prints_the_library_checksum_at_every_recorded_step() {
     let expected = world_checksum(&built.world).to_string();
     assert!(lines[3].ends_with(&expected), "{} vs {expected}", lines[3]);
     // With the CSV on stdout, the checksums go to stderr.
-    let out = tumble()
-        .args([
-            "run",
-            &scene_path("spring_chain"),
-            "--steps",
-            "5",
-            "--checksum",
-            "--out",
-            "-",
-        ])
-        .output()
-        .unwrap();
+    let out = tumble_run(&[
+        "run",
+        &scene_path("spring_chain"),
+        "--steps",
+        "5",
+        "--checksum",
+        "--out",
+        "-",
+    ]);
     assert!(String::from_utf8_lossy(&out.stderr).contains("checksum   step 5: "));
     assert!(!String::from_utf8_lossy(&out.stdout).contains("checksum"));
 }

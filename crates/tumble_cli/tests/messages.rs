@@ -8,9 +8,21 @@ use std::path::Path;
 use std::process::Command;
 
 use common::{
-    BadValues, bad_value_runs, error_line, last_error_line, scratch, stderr, tumble, tumble_out,
+    BadValues, bad_value_runs, error_line, failure, last_error_line, scratch, scratch_file, stderr,
+    tumble, tumble_out, tumble_run,
 };
 use tumble_scene::CSV_HEADER;
+
+/// The bundled chain at a step of 0.2 s with the explicit spring step: √(k/μ)Δt ≈ 9, far outside
+/// its stable region.
+const EXPLICIT_CHAIN: [&str; 6] = [
+    "run",
+    "spring_chain",
+    "--dt",
+    "0.2",
+    "--springs",
+    "explicit",
+];
 
 #[test]
 fn negative_numbers_reach_tumbles_own_checks() {
@@ -32,29 +44,17 @@ fn negative_numbers_reach_tumbles_own_checks() {
 
 #[test]
 fn usage_errors_are_one_line_with_exit_code_2() {
-    let output = tumble()
-        .args(["run", "projectile", "--bogus"])
-        .output()
-        .unwrap();
-    assert_eq!(output.status.code(), Some(2));
+    let output = tumble_run(&["run", "projectile", "--bogus"]);
     assert_eq!(
-        error_line(&output),
+        failure(&output, 2),
         "error: unexpected argument '--bogus' found (see --help)"
     );
     // A value that is not a number: clap's message, on one line, naming the flag.
-    let output = tumble()
-        .args(["run", "projectile", "--dt", "fast"])
-        .output()
-        .unwrap();
-    assert_eq!(output.status.code(), Some(2));
-    assert!(error_line(&output).contains("'--dt <DT>'"));
+    let output = tumble_run(&["run", "projectile", "--dt", "fast"]);
+    assert!(failure(&output, 2).contains("'--dt <DT>'"));
     // A negative size for the benchmark is a bad value of its flag, not an unknown argument.
-    let output = tumble()
-        .args(["bench", "--max-bodies", "-1"])
-        .output()
-        .unwrap();
-    assert_eq!(output.status.code(), Some(2));
-    assert!(error_line(&output).starts_with("error: invalid value '-1' for '--max-bodies"));
+    let output = tumble_run(&["bench", "--max-bodies", "-1"]);
+    assert!(failure(&output, 2).starts_with("error: invalid value '-1' for '--max-bodies"));
     // Help is not an error.
     assert!(tumble().arg("--help").output().unwrap().status.success());
 }
@@ -95,59 +95,44 @@ fn non_utf8_arguments_are_named_and_non_utf8_paths_work() {
     // A missing one is named (lossily) on one line.
     let missing = dir.path().join(bad("missing", ".toml"));
     let output = tumble().arg("run").arg(&missing).output().unwrap();
-    assert_eq!(output.status.code(), Some(1));
-    assert!(error_line(&output).contains("missing\u{fffd}.toml"));
+    assert!(failure(&output, 1).contains("missing\u{fffd}.toml"));
     // Values that must be text say which flag they belong to.
-    let output = tumble()
-        .args(["run", "projectile", "--integrator"])
-        .arg(bad("rk", ""))
-        .output()
-        .unwrap();
-    assert_eq!(output.status.code(), Some(1));
-    assert_eq!(
-        error_line(&output),
-        "error: --integrator: the value rk\u{fffd} is not valid UTF-8"
-    );
-    let output = tumble()
-        .args(["run", "projectile", "--steps"])
-        .arg(bad("1", ""))
-        .output()
-        .unwrap();
-    assert_eq!(output.status.code(), Some(2));
-    assert_eq!(
-        error_line(&output),
-        "error: --steps: the value 1\u{fffd} is not valid UTF-8"
-    );
+    for (flag, value, code) in [("--integrator", "rk", 1), ("--steps", "1", 2)] {
+        let output = tumble()
+            .args(["run", "projectile", flag])
+            .arg(bad(value, ""))
+            .output()
+            .unwrap();
+        assert_eq!(
+            failure(&output, code),
+            format!("error: {flag}: the value {value}\u{fffd} is not valid UTF-8")
+        );
+    }
 }
 
 #[test]
 fn warnings_reach_stderr_and_follow_rust_log_and_the_flags() {
     // √(k/μ)Δt ≈ 9 for this chain: with the explicit spring step the planner warns before the
     // run (by default the implicit step takes such a chain, see below).
-    let args = [
-        "run",
-        "spring_chain",
-        "--dt",
-        "0.2",
-        "--steps",
-        "3",
-        "--springs",
-        "explicit",
-    ];
-    let output = tumble().args(args).output().unwrap();
+    let args = [&EXPLICIT_CHAIN[..], &["--steps", "3"]].concat();
+    let output = tumble().args(&args).output().unwrap();
     let text = stderr(&output);
     assert!(
         text.contains("WARN") && text.contains("outside the stable region"),
         "{text}"
     );
-    let quiet = tumble().arg("-q").args(args).output().unwrap();
+    let quiet = tumble().arg("-q").args(&args).output().unwrap();
     assert!(!stderr(&quiet).contains("WARN"), "{}", stderr(&quiet));
-    let off = tumble().args(args).env("RUST_LOG", "off").output().unwrap();
+    let off = tumble()
+        .args(&args)
+        .env("RUST_LOG", "off")
+        .output()
+        .unwrap();
     assert!(!stderr(&off).contains("WARN"), "{}", stderr(&off));
     // -vv lowers the level: the warnings stay; -q and -v together are a usage error.
-    let verbose = tumble().arg("-vv").args(args).output().unwrap();
+    let verbose = tumble().arg("-vv").args(&args).output().unwrap();
     assert!(stderr(&verbose).contains("WARN"));
-    let both = tumble().args(["-q", "-v"]).args(args).output().unwrap();
+    let both = tumble().args(["-q", "-v"]).args(&args).output().unwrap();
     assert_eq!(both.status.code(), Some(2));
 }
 
@@ -155,17 +140,11 @@ fn warnings_reach_stderr_and_follow_rust_log_and_the_flags() {
 fn a_rejected_body_exits_3_and_its_rows_stop() {
     let (_dir, out) = scratch("chain.csv");
     let unstable = [
-        "-q",
-        "run",
-        "spring_chain",
-        "--dt",
-        "0.2",
-        "--steps",
-        "50",
-        "--springs",
-        "explicit",
-        "--allow-unstable",
-    ];
+        &["-q"][..],
+        &EXPLICIT_CHAIN,
+        &["--steps", "50", "--allow-unstable"],
+    ]
+    .concat();
     let output = tumble_out(&unstable, &out);
     assert_eq!(output.status.code(), Some(3), "{}", stderr(&output));
     assert_eq!(
@@ -196,15 +175,7 @@ fn a_rejected_body_exits_3_and_its_rows_stop() {
 #[test]
 fn a_predicted_divergence_is_refused_with_exit_4_unless_allowed() {
     let (_dir, out) = scratch("chain.csv");
-    let explicit = [
-        "run",
-        "spring_chain",
-        "--dt",
-        "0.2",
-        "--springs",
-        "explicit",
-    ];
-    let output = tumble_out(&explicit, &out);
+    let output = tumble_out(&EXPLICIT_CHAIN, &out);
     assert_eq!(output.status.code(), Some(4), "{}", stderr(&output));
     let text = stderr(&output);
     // Each warning names the spring as the scene file does, before the refusal.
@@ -215,20 +186,8 @@ fn a_predicted_divergence_is_refused_with_exit_4_unless_allowed() {
     );
     assert!(!out.exists(), "nothing is written for a refused run");
     // Quarantines are named with their step and the state kept.
-    let allowed = tumble()
-        .args([
-            "run",
-            "spring_chain",
-            "--dt",
-            "0.2",
-            "--steps",
-            "5",
-            "--springs",
-            "explicit",
-            "--allow-unstable",
-        ])
-        .output()
-        .unwrap();
+    let allowed =
+        tumble_run(&[&EXPLICIT_CHAIN[..], &["--steps", "5", "--allow-unstable"]].concat());
     assert_eq!(allowed.status.code(), Some(3));
     let text = stderr(&allowed);
     assert!(
@@ -242,16 +201,10 @@ fn a_predicted_divergence_is_refused_with_exit_4_unless_allowed() {
 /// quarantine, exit 0, and (undamped but for its dampers) its energy does not grow.
 #[test]
 fn by_default_a_stiff_chain_runs_on_the_implicit_step() {
-    let output = tumble()
-        .args(["run", "spring_chain", "--dt", "0.2", "--steps", "200"])
-        .output()
-        .unwrap();
+    let output = tumble_run(&["run", "spring_chain", "--dt", "0.2", "--steps", "200"]);
     assert!(output.status.success(), "{}", stderr(&output));
     assert!(!stderr(&output).contains("WARN"), "{}", stderr(&output));
-    let plan = tumble()
-        .args(["run", "spring_chain", "--dt", "0.2", "--plan"])
-        .output()
-        .unwrap();
+    let plan = tumble_run(&["run", "spring_chain", "--dt", "0.2", "--plan"]);
     assert!(
         String::from_utf8_lossy(&plan.stdout).contains("solve_implicit_springs"),
         "{}",
@@ -261,10 +214,7 @@ fn by_default_a_stiff_chain_runs_on_the_implicit_step() {
 
 #[test]
 fn the_summary_gives_total_energy_and_never_an_unexplained_nan() {
-    let output = tumble()
-        .args(["run", "spring_chain", "--steps", "100"])
-        .output()
-        .unwrap();
+    let output = tumble_run(&["run", "spring_chain", "--steps", "100"]);
     assert!(output.status.success(), "{}", stderr(&output));
     let text = String::from_utf8_lossy(&output.stdout);
     let energy = text.lines().find(|l| l.starts_with("energy")).unwrap();
@@ -313,15 +263,12 @@ fn long_runs_show_a_progress_bar_on_a_terminal_only() {
 
 #[test]
 fn compare_never_reports_a_quarantined_body_as_agreement() {
-    let dir = tempfile::tempdir().unwrap();
-    let scene = dir.path().join("thin.toml");
-    std::fs::write(
-        &scene,
+    let (_dir, scene) = scratch_file(
+        "thin.toml",
         "name = \"thin\"\n[world]\ndt = 0.016666668\nsteps = 300\n\
          integrator = \"symplectic-euler\"\n[[bodies]]\nname = \"thin\"\nmass = 1.0\n\
          inertia = [0.01, 1.0, 1.005]\nangular_velocity = [1.0, 60.0, 1.0]\n",
-    )
-    .unwrap();
+    );
     // Predicted: refused.
     let refused = tumble().arg("compare").arg(&scene).output().unwrap();
     assert_eq!(refused.status.code(), Some(4), "{}", stderr(&refused));
@@ -345,33 +292,26 @@ fn compare_never_reports_a_quarantined_body_as_agreement() {
 /// value shows in the plan (the stages of a step) and in the summary.
 #[test]
 fn substeps_are_checked_and_shown() {
-    let dir = tempfile::tempdir().unwrap();
-    let bad = dir.path().join("bad.toml");
-    std::fs::write(
-        &bad,
+    let (_dir, bad) = scratch_file(
+        "bad.toml",
         "name = \"s\"\n[world]\ndt = 0.01\nsteps = 10\nsubsteps = 0\n\n[[bodies]]\nname = \"b\"\nmass = 1.0\ninertia = [1.0, 1.0, 1.0]\n",
-    )
-    .unwrap();
+    );
     let output = tumble().arg("run").arg(&bad).output().unwrap();
-    assert_eq!(output.status.code(), Some(1));
-    let line = error_line(&output);
+    let line = failure(&output, 1);
     assert!(
         line.contains("bad.toml:")
             && line.ends_with("world.substeps: expected 1 to 1000 substeps, got 0"),
         "{line}"
     );
-    let plan = tumble()
-        .args([
-            "run",
-            "projectile",
-            "--plan",
-            "--substeps",
-            "2",
-            "--integrator",
-            "yoshida4",
-        ])
-        .output()
-        .unwrap();
+    let plan = tumble_run(&[
+        "run",
+        "projectile",
+        "--plan",
+        "--substeps",
+        "2",
+        "--integrator",
+        "yoshida4",
+    ]);
     assert!(plan.status.success());
     let text = String::from_utf8_lossy(&plan.stdout);
     assert!(text.contains("(× 6 stages per step)"), "{text}");
@@ -379,10 +319,7 @@ fn substeps_are_checked_and_shown() {
         text.contains("stages per step: 6 (2 substep(s) × 3 of `yoshida4`), h/Δt = 0.675604, -0.851207, 0.675604"),
         "{text}"
     );
-    let run = tumble()
-        .args(["run", "projectile", "--substeps", "3", "--steps", "5"])
-        .output()
-        .unwrap();
+    let run = tumble_run(&["run", "projectile", "--substeps", "3", "--steps", "5"]);
     assert!(run.status.success());
     assert!(String::from_utf8_lossy(&run.stdout).contains("(splitting, 3 substeps)"));
 }

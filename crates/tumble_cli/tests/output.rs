@@ -9,7 +9,8 @@ use std::process::{Child, Command, ExitStatus, Output, Stdio};
 use std::time::{Duration, Instant};
 
 use common::{
-    BadValues, bad_value_runs, error_line, scene_path, scratch, stderr, tumble, tumble_out,
+    BadValues, bad_value_runs, error_line, failure, scene_path, scratch, scratch_file, stderr,
+    tumble, tumble_out, tumble_run,
 };
 use tumble_scene::{CSV_HEADER, MAX_SCENE_BYTES};
 
@@ -64,8 +65,7 @@ fn devices_fifos_and_directories_are_refused_and_left_alone() {
             .success()
     );
     let output = run_to(&fifo, &[]);
-    assert_eq!(output.status.code(), Some(1));
-    assert!(error_line(&output).contains("fifo.csv: is not a regular file"));
+    assert!(failure(&output, 1).contains("fifo.csv: is not a regular file"));
     assert!(std::fs::metadata(&fifo).unwrap().file_type().is_fifo());
     let sub = dir.path().join("sub");
     std::fs::create_dir(&sub).unwrap();
@@ -73,9 +73,8 @@ fn devices_fifos_and_directories_are_refused_and_left_alone() {
     assert!(error_line(&output).ends_with("sub: is a directory, expected a file"));
     // /dev/null last: a build that replaced devices fails on the FIFO before it gets here.
     let output = run_to(Path::new("/dev/null"), &[]);
-    assert_eq!(output.status.code(), Some(1));
     assert_eq!(
-        error_line(&output),
+        failure(&output, 1),
         "error: /dev/null: is not a regular file (a device, FIFO or socket); tumble writes only regular files"
     );
     assert!(
@@ -87,18 +86,14 @@ fn devices_fifos_and_directories_are_refused_and_left_alone() {
     assert_eq!(listing(dir.path()), ["fifo.csv", "sub"]);
     assert!(listing(&sub).is_empty());
     // `gen` follows the same rules.
-    let output = tumble()
-        .args(["gen", "many", "--n", "10", "--out", "/dev/null"])
-        .output()
-        .unwrap();
+    let output = tumble_run(&["gen", "many", "--n", "10", "--out", "/dev/null"]);
     assert!(error_line(&output).contains("/dev/null: is not a regular file"));
 }
 
 #[cfg(unix)]
 #[test]
 fn nothing_planted_beside_the_output_is_followed_and_a_symlink_out_keeps_its_link() {
-    let (dir, victim) = scratch("victim.txt");
-    std::fs::write(&victim, "precious").unwrap();
+    let (dir, victim) = scratch_file("victim.txt", "precious");
     // The temporary name of old builds, planted as a link to another file.
     let out = dir.path().join("out.csv");
     std::os::unix::fs::symlink(&victim, dir.path().join("out.csv.partial")).unwrap();
@@ -145,13 +140,7 @@ fn the_scene_file_is_never_the_output() {
     let scene = dir.path().join("chain.toml");
     let text = std::fs::read_to_string(scene_path("spring_chain")).unwrap();
     std::fs::write(&scene, &text).unwrap();
-    let output = tumble()
-        .arg("run")
-        .arg(&scene)
-        .arg("--out")
-        .arg(&scene)
-        .output()
-        .unwrap();
+    let output = tumble_out(&["run", scene.to_str().unwrap()], &scene);
     assert_eq!(output.status.code(), Some(1));
     assert!(
         error_line(&output).contains("chain.toml: is the input file"),
@@ -162,13 +151,7 @@ fn the_scene_file_is_never_the_output() {
     // Another name for the same file (a hard link) is the same file.
     let other = dir.path().join("other.csv");
     std::fs::hard_link(&scene, &other).unwrap();
-    let output = tumble()
-        .arg("run")
-        .arg(&scene)
-        .arg("--out")
-        .arg(&other)
-        .output()
-        .unwrap();
+    let output = tumble_out(&["run", scene.to_str().unwrap()], &other);
     assert_eq!(output.status.code(), Some(1));
     assert_eq!(std::fs::read_to_string(&scene).unwrap(), text);
     assert_eq!(listing(dir.path()), ["chain.toml", "other.csv"]);
@@ -178,12 +161,10 @@ fn the_scene_file_is_never_the_output() {
 #[test]
 fn a_read_only_output_is_an_error_and_a_writable_one_keeps_its_mode() {
     use std::os::unix::fs::PermissionsExt;
-    let (dir, out) = scratch("ro.csv");
-    std::fs::write(&out, "keep").unwrap();
+    let (dir, out) = scratch_file("ro.csv", "keep");
     std::fs::set_permissions(&out, std::fs::Permissions::from_mode(0o444)).unwrap();
     let output = run_to(&out, &[]);
-    assert_eq!(output.status.code(), Some(1));
-    assert!(error_line(&output).ends_with("ro.csv: is read-only"));
+    assert!(failure(&output, 1).ends_with("ro.csv: is read-only"));
     assert_eq!(std::fs::read_to_string(&out).unwrap(), "keep");
     let mode = |p: &Path| std::fs::metadata(p).unwrap().permissions().mode() & 0o7777;
     assert_eq!(mode(&out), 0o444);
@@ -223,8 +204,7 @@ fn errors_name_the_given_path_escaped_on_one_line() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("no such dir").join("a\u{1b}[2Jb\nc.csv");
     let output = run_to(&out, &[]);
-    assert_eq!(output.status.code(), Some(1));
-    let line = error_line(&output);
+    let line = failure(&output, 1);
     assert!(
         line.contains("no such dir/a\\u{1b}[2Jb\\nc.csv: "),
         "{line}"
@@ -394,10 +374,7 @@ fn force_skips_the_free_space_check() {
 
 #[test]
 fn out_dash_writes_the_csv_to_stdout_and_the_summary_to_stderr() {
-    let output = tumble()
-        .args(["run", "projectile", "--steps", "3", "--out", "-"])
-        .output()
-        .unwrap();
+    let output = tumble_run(&["run", "projectile", "--steps", "3", "--out", "-"]);
     assert!(output.status.success(), "{}", stderr(&output));
     let csv = String::from_utf8(output.stdout.clone()).unwrap();
     let mut lines = csv.lines();
@@ -405,19 +382,12 @@ fn out_dash_writes_the_csv_to_stdout_and_the_summary_to_stderr() {
     assert_eq!(lines.count(), 4, "{csv}");
     assert!(stderr(&output).contains("scene      projectile"));
     assert!(!Path::new("-").exists());
-    let generated = tumble()
-        .args(["gen", "many", "--n", "3", "--out", "-"])
-        .output()
-        .unwrap();
+    let generated = tumble_run(&["gen", "many", "--n", "3", "--out", "-"]);
     assert!(generated.status.success());
     assert!(generated.stdout.starts_with(b"name = \"many-3\""));
     // An empty path is no file name.
-    let output = tumble()
-        .args(["run", "projectile", "--out", ""])
-        .output()
-        .unwrap();
-    assert_eq!(output.status.code(), Some(2));
-    assert!(error_line(&output).contains("'--out <OUT>'"));
+    let output = tumble_run(&["run", "projectile", "--out", ""]);
+    assert!(failure(&output, 2).contains("'--out <OUT>'"));
 }
 
 #[test]
@@ -436,19 +406,14 @@ fn gen_writes_only_what_run_accepts() {
         assert!(output.stdout.is_empty());
     }
     // The cap fits under the loader's size limit.
-    let at_cap = tumble()
-        .args(["gen", "many", "--n", "200000", "--steps", "1000000000"])
-        .output()
-        .unwrap();
+    let at_cap = tumble_run(&["gen", "many", "--n", "200000", "--steps", "1000000000"]);
     assert!(at_cap.status.success());
     assert!((at_cap.stdout.len() as u64) < MAX_SCENE_BYTES);
 }
 
 #[test]
 fn report_and_bench_name_an_output_that_is_not_a_directory_before_working() {
-    let dir = tempfile::tempdir().unwrap();
-    let file = dir.path().join("taken");
-    std::fs::write(&file, "x").unwrap();
+    let (_dir, file) = scratch_file("taken", "x");
     for command in ["report", "bench"] {
         let mut child = tumble()
             .args([command, "--quick", "--out"])

@@ -74,3 +74,21 @@ pub fn bad_value_runs(command: &[&str], cases: &[BadValues]) -> Vec<([String; 2]
     }
     runs
 }
+
+/// Runs the binary with `args`.
+pub fn tumble_run(args: &[&str]) -> Output {
+    tumble().args(args).output().unwrap()
+}
+
+/// The one error line of a run that must fail with exit code `code`.
+pub fn failure(output: &Output, code: i32) -> String {
+    assert_eq!(output.status.code(), Some(code), "{}", stderr(output));
+    error_line(output)
+}
+
+/// A fresh temporary directory holding the file `name` with `contents`, and its path.
+pub fn scratch_file(name: &str, contents: &str) -> (tempfile::TempDir, PathBuf) {
+    let (dir, path) = scratch(name);
+    std::fs::write(&path, contents).unwrap();
+    (dir, path)
+}
