@@ -119,23 +119,26 @@ fn oscillator_error(integrator: Integrator, rate: u32) -> f64 {
 
 const RATES: [u32; 5] = [30, 60, 120, 240, 480];
 
-#[test]
-fn splitting_is_second_order_on_the_damped_oscillator() {
+/// Asserts that the splitting's `error` at the step rates [`RATES`] (steps per second) falls
+/// with an observed order within 0.2 of 2.
+fn assert_second_order(name: &str, error: impl Fn(u32) -> f64) {
     let errors: Vec<(f64, f64)> = RATES
         .iter()
-        .map(|&n| {
-            (
-                1.0 / f64::from(n),
-                oscillator_error(Integrator::Splitting, n),
-            )
-        })
+        .map(|&n| (1.0 / f64::from(n), error(n)))
         .collect();
     let order = observed_order(&errors);
-    eprintln!("damped oscillator, splitting: observed order {order:.3} from {errors:?}");
+    eprintln!("{name}, splitting: observed order {order:.3} from {errors:?}");
     assert!(
         (order - 2.0).abs() <= 0.2,
         "order {order:.3}, errors {errors:?}"
     );
+}
+
+#[test]
+fn splitting_is_second_order_on_the_damped_oscillator() {
+    assert_second_order("damped oscillator", |n| {
+        oscillator_error(Integrator::Splitting, n)
+    });
 }
 
 #[test]
@@ -437,21 +440,9 @@ fn splitting_is_second_order_on_a_damped_spring_net() {
         .map(|(a, b)| (a.0 - b.0).length() + a.2.angle_between(b.2))
         .sum();
     assert!(spread < 1e-9, "reference not converged: {spread:e}");
-    let errors: Vec<(f64, f64)> = RATES
-        .iter()
-        .map(|&n| {
-            (
-                1.0 / f64::from(n),
-                net_error(&run_net(Integrator::Splitting, n), &reference),
-            )
-        })
-        .collect();
-    let order = observed_order(&errors);
-    eprintln!("damped net, splitting: observed order {order:.3} from {errors:?}");
-    assert!(
-        (order - 2.0).abs() <= 0.2,
-        "order {order:.3}, errors {errors:?}"
-    );
+    assert_second_order("damped net", |n| {
+        net_error(&run_net(Integrator::Splitting, n), &reference)
+    });
 }
 
 /// Total mechanical energy of the net's world (kinetic + rotational + elastic), in f64.

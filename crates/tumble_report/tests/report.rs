@@ -24,6 +24,13 @@ fn ratio(scene: &str, integrator: Integrator, n: f64) -> f64 {
     coarse.orientation_error_rad / fine.orientation_error_rad
 }
 
+/// Asserts that the JSON object `value` (at `path`) has every key of `keys`.
+fn assert_has_keys(value: &serde_json::Value, path: &str, keys: &[&str]) {
+    for key in keys {
+        assert!(value.get(key).is_some(), "{path}.{key}");
+    }
+}
+
 #[test]
 fn error_falls_with_the_methods_order() {
     // Order p: 2^p per halving, on the stable top where the error (≫ the f32 floor of ≈1e-5 rad
@@ -79,11 +86,10 @@ fn results_json_has_the_documented_shape() {
     let results = Results::new(Machine::detect(true), points, cells, energy, springs, thin);
     let json: serde_json::Value = serde_json::to_value(&results).unwrap();
     assert_eq!(json["schema"], 1);
-    for key in ["cpu", "cores", "os", "tumble_version", "quick"] {
-        assert!(json["machine"].get(key).is_some(), "machine.{key}");
-    }
+    let machine = ["cpu", "cores", "os", "tumble_version", "quick"];
+    assert_has_keys(&json["machine"], "machine", &machine);
     let p = &json["work_precision"][0];
-    for key in [
+    let point = [
         "scene",
         "method",
         "dt_s",
@@ -94,12 +100,10 @@ fn results_json_has_the_documented_shape() {
         "momentum_drift",
         "ns_per_body_step",
         "finite",
-    ] {
-        assert!(p.get(key).is_some(), "work_precision[].{key}");
-    }
+    ];
+    assert_has_keys(p, "work_precision[]", &point);
     assert!(p["orientation_error_rad"].as_f64().unwrap() < 1e-3);
-    let s = &json["stability"][0];
-    for key in [
+    let cell = [
         "scene",
         "integrator",
         "setting",
@@ -109,9 +113,8 @@ fn results_json_has_the_documented_shape() {
         "energy_range",
         "springs",
         "warned",
-    ] {
-        assert!(s.get(key).is_some(), "stability[].{key}");
-    }
+    ];
+    assert_has_keys(&json["stability"][0], "stability[]", &cell);
     assert_eq!(json["units"]["ns_per_body_step"], "ns");
     let e = &json["energy"][0];
     assert_eq!(
@@ -122,15 +125,14 @@ fn results_json_has_the_documented_shape() {
     assert!(e.get("spin").is_some() && e.get("method").is_some());
     let runs = json["springs"].as_array().unwrap();
     assert_eq!(runs.len(), 12, "4 variants × 3 ωΔt");
-    for key in [
+    let run = [
         "variant",
         "omega_dt",
         "energy_ratio",
         "failed_at",
         "us_per_step",
-    ] {
-        assert!(runs[0].get(key).is_some(), "springs[].{key}");
-    }
+    ];
+    assert_has_keys(&runs[0], "springs[]", &run);
     assert_eq!(runs[0]["energy_ratio"].as_array().unwrap().len(), 4);
     // The explicit chain at ωΔt = 10 is quarantined at step 2: null from there, not a number.
     let explicit = runs

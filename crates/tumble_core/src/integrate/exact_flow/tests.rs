@@ -48,6 +48,15 @@ fn worst_errors(inertia: DVec3, omega0: DVec3, q0: DQuat, h: f64, steps: usize) 
     worst_errors_against(&reference, inertia, omega0, q0, h, steps)
 }
 
+/// Asserts that the orientation error `dq` (rad) and the body-rate error `dw` are both below
+/// `tolerance`.
+fn assert_within((dq, dw): (f64, f64), tolerance: f64, case: String) {
+    assert!(
+        dq < tolerance && dw < tolerance,
+        "{case}: orientation {dq:e} rad, rates {dw:e}"
+    );
+}
+
 /// [`worst_errors`] against any reference.
 fn worst_errors_against(
     reference: &Reference,
@@ -97,9 +106,10 @@ fn matches_the_closed_form_at_any_step_and_spin() {
             let (dq, dw) = worst_errors(inertia, omega0, tilted(), h, steps.min(400));
             // Round-off: ≈ ε per flow and the reference's 1e-13; 1e-10 leaves room for
             // the phase's growth over hundreds of flows, and is 1e5× below the target.
-            assert!(
-                dq < 1e-10 && dw < 1e-10,
-                "I = {inertia}, ω₀ = {omega0}, |ω|Δt = {omega_dt}: orientation {dq:e} rad, rates {dw:e}"
+            assert_within(
+                (dq, dw),
+                1e-10,
+                format!("I = {inertia}, ω₀ = {omega0}, |ω|Δt = {omega_dt}"),
             );
         }
     }
@@ -116,10 +126,7 @@ fn the_thin_asymmetric_body_circling_its_largest_axis() {
         let reference = runge_kutta(inertia, omega0, tilted(), h, steps);
         let (dq, dw) = worst_errors_against(&reference, inertia, omega0, tilted(), h, steps);
         eprintln!("thin, |ω|Δt = {omega_dt}: {dq:e} rad, rates {dw:e}");
-        assert!(
-            dq < 1e-9 && dw < 1e-9,
-            "|ω|Δt = {omega_dt}: orientation {dq:e} rad, rates {dw:e}"
-        );
+        assert_within((dq, dw), 1e-9, format!("|ω|Δt = {omega_dt}"));
     }
 }
 
@@ -156,10 +163,7 @@ fn near_the_separatrix_and_near_axis_spins() {
         ),
     ] {
         let (dq, dw) = worst_errors(inertia, omega0, tilted(), 0.05, 200);
-        assert!(
-            dq < tolerance && dw < tolerance,
-            "I = {inertia}, ω₀ = {omega0}: {dq:e} rad, rates {dw:e}"
-        );
+        assert_within((dq, dw), tolerance, format!("I = {inertia}, ω₀ = {omega0}"));
     }
 }
 
@@ -176,10 +180,7 @@ fn symmetric_spherical_and_steady_bodies() {
         (DVec3::new(1.0, 2.0, 3.0), DVec3::ZERO),
     ] {
         let (dq, dw) = worst_errors(inertia, omega0, tilted(), 0.37, 40);
-        assert!(
-            dq < 1e-12 && dw < 1e-12,
-            "I = {inertia}, ω₀ = {omega0}: {dq:e} rad, rates {dw:e}"
-        );
+        assert_within((dq, dw), 1e-12, format!("I = {inertia}, ω₀ = {omega0}"));
     }
 }
 
