@@ -281,11 +281,7 @@ impl MassProperties {
     /// `body_rotation` is `R` (body → world).
     #[inline]
     pub fn world_inv_inertia_mul(&self, body_rotation: Quat, world: Vec3) -> Vec3 {
-        let frame = quat_mul(body_rotation, self.principal_frame);
-        quat_rotate(
-            frame,
-            self.inv_principal_inertia * quat_rotate(frame.inverse(), world),
-        )
+        self.world_diagonal_mul(body_rotation, self.inv_principal_inertia, world)
     }
 
     /// The quadratic form of the world inertia, `ωᵀ (R P) I_b (R P)ᵀ ω = Σᵢ Iᵢ bᵢ²` with
@@ -302,11 +298,15 @@ impl MassProperties {
     /// Applies the world inertia `(R P) I_b (R P)ᵀ` to a world vector (e.g. `L = I ω`).
     #[inline]
     pub fn world_inertia_mul(&self, body_rotation: Quat, world: Vec3) -> Vec3 {
+        self.world_diagonal_mul(body_rotation, self.principal_inertia, world)
+    }
+
+    /// Applies `(R P) D (R P)ᵀ` to a world vector, `D` the diagonal matrix of `diagonal` in the
+    /// principal frame.
+    #[inline(always)]
+    fn world_diagonal_mul(&self, body_rotation: Quat, diagonal: Vec3, world: Vec3) -> Vec3 {
         let frame = quat_mul(body_rotation, self.principal_frame);
-        quat_rotate(
-            frame,
-            self.principal_inertia * quat_rotate(frame.inverse(), world),
-        )
+        quat_rotate(frame, diagonal * quat_rotate(frame.inverse(), world))
     }
 }
 

@@ -94,27 +94,6 @@ impl Widen for Real {
     }
 }
 
-impl Widen for Vec3 {
-    type Wide = DVec3;
-    #[inline(always)]
-    fn widen(self) -> DVec3 {
-        DVec3::new(self.x.widen(), self.y.widen(), self.z.widen())
-    }
-}
-
-impl Widen for Quat {
-    type Wide = DQuat;
-    #[inline(always)]
-    fn widen(self) -> DQuat {
-        DQuat::from_xyzw(
-            self.x.widen(),
-            self.y.widen(),
-            self.z.widen(),
-            self.w.widen(),
-        )
-    }
-}
-
 impl Narrow for f64 {
     type Narrow = Real;
     #[inline(always)]
@@ -123,26 +102,29 @@ impl Narrow for f64 {
     }
 }
 
-impl Narrow for DVec3 {
-    type Narrow = Vec3;
-    #[inline(always)]
-    fn narrow(self) -> Vec3 {
-        Vec3::new(self.x.narrow(), self.y.narrow(), self.z.narrow())
-    }
+/// [`Widen`] and [`Narrow`] between a glam type of [`Real`]s and its `f64` counterpart, one
+/// component at a time (trait impls for several types: a function cannot write them).
+macro_rules! widen_and_narrow {
+    ($($real:ty => $wide:ty),*) => {$(
+        impl Widen for $real {
+            type Wide = $wide;
+            #[inline(always)]
+            fn widen(self) -> $wide {
+                <$wide>::from_array(self.to_array().map(Widen::widen))
+            }
+        }
+
+        impl Narrow for $wide {
+            type Narrow = $real;
+            #[inline(always)]
+            fn narrow(self) -> $real {
+                <$real>::from_array(self.to_array().map(Narrow::narrow))
+            }
+        }
+    )*};
 }
 
-impl Narrow for DQuat {
-    type Narrow = Quat;
-    #[inline(always)]
-    fn narrow(self) -> Quat {
-        Quat::from_xyzw(
-            self.x.narrow(),
-            self.y.narrow(),
-            self.z.narrow(),
-            self.w.narrow(),
-        )
-    }
-}
+widen_and_narrow!(Vec3 => DVec3, Quat => DQuat);
 
 #[cfg(test)]
 mod tests {

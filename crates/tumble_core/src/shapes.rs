@@ -312,20 +312,20 @@ fn quickhull(points: &[DVec3]) -> Result<Vec<[u32; 3]>, HullError> {
     }
     let (p0, p1) = (points[i0], points[i1]);
     let line = (p1 - p0).normalize();
-    let (d2, i2) = points
-        .iter()
-        .enumerate()
-        .map(|(i, p)| ((*p - p0).reject_from_normalized(line).length(), i))
-        .fold((0.0, 0), |a, b| if b.0 > a.0 { b } else { a });
+    // The point farthest by `distance` from p0 (the first of equals), with that distance.
+    let farthest = |distance: &dyn Fn(DVec3) -> f64| {
+        points
+            .iter()
+            .enumerate()
+            .map(|(i, p)| (distance(*p - p0), i))
+            .fold((0.0, 0), |a, b| if b.0 > a.0 { b } else { a })
+    };
+    let (d2, i2) = farthest(&|d| d.reject_from_normalized(line).length());
     if d2 <= eps {
         return Err(degenerate());
     }
     let plane = (p1 - p0).cross(points[i2] - p0).normalize();
-    let (d3, i3) = points
-        .iter()
-        .enumerate()
-        .map(|(i, p)| ((*p - p0).dot(plane).abs(), i))
-        .fold((0.0, 0), |a, b| if b.0 > a.0 { b } else { a });
+    let (d3, i3) = farthest(&|d| d.dot(plane).abs());
     if d3 <= eps {
         return Err(degenerate());
     }

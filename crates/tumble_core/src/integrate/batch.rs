@@ -310,6 +310,28 @@ struct Slices<'a, M> {
     diverged: Vec<usize>,
 }
 
+impl<'a, M> Slices<'a, M> {
+    /// The batch of `states[i]` with `masses[i]` (and `wrenches[i]`); panics if the lengths
+    /// differ.
+    fn new(states: &'a mut [BodyState], masses: &'a [M], wrenches: Option<&'a [Wrench]>) -> Self {
+        assert!(states.len() == masses.len());
+        assert!(wrenches.is_none_or(|w| w.len() == states.len()));
+        Self {
+            states,
+            masses,
+            wrenches,
+            diverged: Vec::new(),
+        }
+    }
+
+    /// The indices of the bodies that diverged, in increasing order.
+    fn sorted_diverged(self) -> Vec<usize> {
+        let mut diverged = self.diverged;
+        diverged.sort_unstable();
+        diverged
+    }
+}
+
 impl<M: Borrow<MassProperties>> BodyBatch for Slices<'_, M> {
     fn len(&self) -> usize {
         self.states.len()
@@ -430,18 +452,9 @@ impl Integrator {
         wrenches: Option<&[Wrench]>,
         h: Real,
     ) -> Vec<usize> {
-        assert!(states.len() == masses.len());
-        assert!(wrenches.is_none_or(|w| w.len() == states.len()));
-        let mut slices = Slices {
-            states,
-            masses,
-            wrenches,
-            diverged: Vec::new(),
-        };
+        let mut slices = Slices::new(states, masses, wrenches);
         self.stage_batch(phase, &mut slices, h);
-        let mut diverged = slices.diverged;
-        diverged.sort_unstable();
-        diverged
+        slices.sorted_diverged()
     }
 
     /// [`try_step`](Self::try_step) for every body: `states[i]` advances by `dt` under
@@ -455,17 +468,9 @@ impl Integrator {
         wrenches: &[Wrench],
         dt: Real,
     ) -> Vec<usize> {
-        assert!(states.len() == masses.len() && wrenches.len() == states.len());
-        let mut slices = Slices {
-            states,
-            masses,
-            wrenches: Some(wrenches),
-            diverged: Vec::new(),
-        };
+        let mut slices = Slices::new(states, masses, Some(wrenches));
         self.step_batch(&mut slices, dt);
-        let mut diverged = slices.diverged;
-        diverged.sort_unstable();
-        diverged
+        slices.sorted_diverged()
     }
 
     /// [`try_begin_stage`](Self::try_begin_stage) for every body (see

@@ -68,6 +68,15 @@ fn conjugate<T: Lane>(q: Quat4<T>) -> Quat4<T> {
     [-q[0], -q[1], -q[2], q[3]]
 }
 
+/// `(sin θ/2, cos θ/2)` of `angle` θ, and `(cos θ, sin θ)` from them by the double-angle
+/// formulas.
+#[inline(always)]
+fn half_and_whole<T: Lane>(angle: T) -> ((T, T), (T, T)) {
+    let cpu = angle.cpu();
+    let (s, c) = sin_cos(T::splat(cpu, 0.5) * angle);
+    ((s, c), (c * c - s * s, T::splat(cpu, 2.0) * s * c))
+}
+
 /// The principal orientation `Q` and body momentum `m` a free flow advances.
 struct Free<T> {
     q: Quat4<T>,
@@ -78,9 +87,7 @@ impl<T: Lane> Free<T> {
     /// `Q ← Q exp(θ e_x)`, `m ← exp(−θ e_x) m`.
     #[inline(always)]
     fn rotate_x(&mut self, angle: T) {
-        let cpu = angle.cpu();
-        let (s, c) = sin_cos(T::splat(cpu, 0.5) * angle);
-        let (cos, sin) = (c * c - s * s, T::splat(cpu, 2.0) * s * c);
+        let ((s, c), (cos, sin)) = half_and_whole(angle);
         let [x, y, z, w] = self.q;
         self.q = [c * x + w * s, c * y + z * s, c * z - y * s, c * w - x * s];
         let [m0, m1, m2] = self.m;
@@ -90,9 +97,7 @@ impl<T: Lane> Free<T> {
     /// `Q ← Q exp(θ e_z)`, `m ← exp(−θ e_z) m`.
     #[inline(always)]
     fn rotate_z(&mut self, angle: T) {
-        let cpu = angle.cpu();
-        let (s, c) = sin_cos(T::splat(cpu, 0.5) * angle);
-        let (cos, sin) = (c * c - s * s, T::splat(cpu, 2.0) * s * c);
+        let ((s, c), (cos, sin)) = half_and_whole(angle);
         let [x, y, z, w] = self.q;
         self.q = [c * x + y * s, c * y - x * s, c * z + w * s, c * w - z * s];
         let [m0, m1, m2] = self.m;
