@@ -2,6 +2,8 @@
 //! bodies keep the last state that passed, and honest physics (stable springs near the limit,
 //! work done by gravity, forces, torques and game code) is never flagged.
 
+mod common;
+
 use bevy_ecs::prelude::*;
 use tumble_core::math::{Quat, Real, Vec3};
 use tumble_core::{Integrator, Mass, MassProperties};
@@ -60,24 +62,8 @@ fn chain(world: &mut World, n: usize, x0: Real, omega_dt: Real) -> Vec<Entity> {
     let bodies: Vec<Entity> = (0..n)
         .map(|i| body(world, x0 + i as Real, inertia, Vec3::new(0.1, 0.2, 0.3)))
         .collect();
-    let wall = SpringEnd::World(Vec3::new(x0 - 1.0, 0.1, 0.0));
-    world.spawn(Spring::new(
-        bodies[0],
-        Vec3::new(-0.1, 0.05, 0.0),
-        wall,
-        k,
-        0.8,
-    ));
-    for pair in bodies.windows(2) {
-        let next = SpringEnd::on_body(pair[1], Vec3::new(-0.1, 0.0, 0.05));
-        world.spawn(Spring::new(
-            pair[0],
-            Vec3::new(0.1, 0.05, 0.0),
-            next,
-            k,
-            0.7,
-        ));
-    }
+    let wall = Vec3::new(x0 - 1.0, 0.1, 0.0);
+    common::tie_chain(world, &bodies, wall, k, (Vec3::new(-0.1, 0.0, 0.05), 0.7));
     bodies
 }
 

@@ -2,6 +2,8 @@
 //! asymmetric bodies at off-centre anchors keep their total energy at every `ωΔt` from 0.5 to
 //! 100, without numerical damping; the choice of method is the planner's, and can be forced.
 
+mod common;
+
 use bevy_ecs::prelude::*;
 use tumble_core::math::{Quat, Real, Vec3, to_f64};
 use tumble_core::{Mass, MassProperties};
@@ -78,24 +80,8 @@ fn chain(world: &mut World, n: usize, omega_dt: Real) {
             )
         })
         .collect();
-    let wall = SpringEnd::World(Vec3::new(-1.0, 0.0, 0.0));
-    world.spawn(Spring::new(
-        bodies[0],
-        Vec3::new(-0.1, 0.05, 0.0),
-        wall,
-        k,
-        0.8,
-    ));
-    for pair in bodies.windows(2) {
-        let next = SpringEnd::on_body(pair[1], Vec3::new(-0.1, -0.05, 0.02));
-        world.spawn(Spring::new(
-            pair[0],
-            Vec3::new(0.1, 0.05, 0.0),
-            next,
-            k,
-            0.72,
-        ));
-    }
+    let next = (Vec3::new(-0.1, -0.05, 0.02), 0.72);
+    common::tie_chain(world, &bodies, Vec3::new(-1.0, 0.0, 0.0), k, next);
 }
 
 /// Runs `steps` steps with default settings; returns (max |E − E₀|/E₀, final (E − E₀)/E₀, plan).

@@ -1378,6 +1378,27 @@ mod jacobian_tests {
         }
     }
 
+    /// Three poses and angular velocities `(x, q, ω)` of the bodies of the Newton-matrix tests.
+    fn test_poses() -> [(Vec3, Quat, Vec3); 3] {
+        [
+            (
+                Vec3::ZERO,
+                Quat::from_rotation_z(0.3),
+                Vec3::new(1.0, 2.0, -1.0),
+            ),
+            (
+                Vec3::new(0.9, 0.1, 0.0),
+                Quat::from_rotation_x(0.5),
+                Vec3::new(-2.0, 0.5, 3.0),
+            ),
+            (
+                Vec3::new(0.4, 0.8, 0.1),
+                Quat::from_rotation_y(-0.4),
+                Vec3::new(0.3, 0.0, 1.0),
+            ),
+        ]
+    }
+
     /// The Newton matrix against central differences of the residual, column by column.
     #[test]
     fn jacobian_matches_finite_differences() {
@@ -1385,19 +1406,8 @@ mod jacobian_tests {
             force: Vec3::new(0.0, -9.8, 0.0),
             torque: Vec3::new(0.01, 0.0, 0.02),
         };
-        let body = |x: Vec3, q: Quat, w: Vec3| test_body(1.0, load, x, q, w);
-        let bodies = [
-            body(
-                Vec3::ZERO,
-                Quat::from_rotation_z(0.3),
-                Vec3::new(1.0, 2.0, -1.0),
-            ),
-            body(
-                Vec3::new(0.9, 0.1, 0.0),
-                Quat::from_rotation_x(0.5),
-                Vec3::new(-2.0, 0.5, 3.0),
-            ),
-        ];
+        let [first, second, _] = test_poses();
+        let bodies = [first, second].map(|(x, q, w)| test_body(1.0, load, x, q, w));
         let springs = [
             GroupSpring {
                 a: 0,
@@ -1474,24 +1484,7 @@ mod jacobian_tests {
     /// three bodies (fill-in).
     #[test]
     fn the_factorization_inverts_the_newton_matrix() {
-        let body = |x: Vec3, q: Quat, w: Vec3| test_body(1.3, Wrench::default(), x, q, w);
-        let bodies = [
-            body(
-                Vec3::ZERO,
-                Quat::from_rotation_z(0.3),
-                Vec3::new(1.0, 2.0, -1.0),
-            ),
-            body(
-                Vec3::new(0.9, 0.1, 0.0),
-                Quat::from_rotation_x(0.5),
-                Vec3::new(-2.0, 0.5, 3.0),
-            ),
-            body(
-                Vec3::new(0.4, 0.8, 0.1),
-                Quat::from_rotation_y(-0.4),
-                Vec3::new(0.3, 0.0, 1.0),
-            ),
-        ];
+        let bodies = test_poses().map(|(x, q, w)| test_body(1.3, Wrench::default(), x, q, w));
         let spring = |a: usize, anchor_a: Vec3, b: LinkEnd, stiffness: Real| GroupSpring {
             a,
             anchor_a,
