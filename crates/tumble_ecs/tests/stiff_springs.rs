@@ -261,13 +261,13 @@ fn a_stiff_cloth_falls_without_making_energy() {
         world.spawn(Spring::new(a, Vec3::ZERO, b, k, rest));
     };
     let node = |c: usize| SpringEnd::on_body(grid[c], Vec3::ZERO);
-    for c in 0..n * n {
+    for (c, &here) in grid.iter().enumerate() {
         // Node (i, j) = c: to (i + 1, j), then to (i, j + 1).
         if c / n + 1 < n {
-            link(&mut world, grid[c], node(c + n), spacing);
+            link(&mut world, here, node(c + n), spacing);
         }
         if c % n + 1 < n {
-            link(&mut world, grid[c], node(c + 1), spacing);
+            link(&mut world, here, node(c + 1), spacing);
         }
     }
     for i in [0, n - 1] {
