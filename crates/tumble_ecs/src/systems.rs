@@ -16,6 +16,32 @@ use crate::stiff::ImplicitBody;
 use crate::table::{Bodies, Loads, StageTiming, step_table};
 use crate::validate::{BodyError, Rejected, reject};
 
+/// Steps every table of the query `$bodies` ([`Stepped`] items) through [`step_table`], each
+/// table's loads made from its load column by the closure-like last argument, then quarantines
+/// the bodies that failed. A macro rather than a function: bevy hands out each load
+/// component's contiguous column as a type of its own that borrows the query table by table,
+/// which a closure parameter of a function cannot name.
+macro_rules! step_each_table {
+    ($bodies:ident, $stage:ident, $parallelism:ident, $commands:ident, |$load:pat_param| $loads:expr) => {{
+        let parallelism = $parallelism.map_or_else(Parallelism::default, |p| *p);
+        let mut errors = Vec::new();
+        for (entities, mut t, mut v, masses, $load, dampings) in
+            dense($bodies.contiguous_iter_mut())
+        {
+            let bodies = Bodies {
+                entities,
+                transforms: &mut t,
+                velocities: &mut v,
+                masses,
+                dampings,
+                loads: $loads,
+            };
+            step_table(&$stage, &parallelism, bodies, &mut errors);
+        }
+        reject_all(&mut $commands, errors);
+    }};
+}
+
 /// Quarantines the bodies in `errors` (in the order found: table by table, entity order
 /// within a table).
 fn reject_all(commands: &mut Commands, errors: Vec<BodyError>) {
@@ -85,20 +111,9 @@ pub fn begin_stage(
     }
     drifted.0 = true;
     let stage = StageTiming::new(&settings, *cursor, StepPhase::Begin);
-    let parallelism = parallelism.map_or_else(Parallelism::default, |p| *p);
-    let mut errors = Vec::new();
-    for (entities, mut t, mut v, masses, accs, dampings) in dense(bodies.contiguous_iter_mut()) {
-        let bodies = Bodies {
-            entities,
-            transforms: &mut t,
-            velocities: &mut v,
-            masses,
-            dampings,
-            loads: Loads::Checked(accs),
-        };
-        step_table(&stage, &parallelism, bodies, &mut errors);
-    }
-    reject_all(&mut commands, errors);
+    step_each_table!(bodies, stage, parallelism, commands, |accs| Loads::Checked(
+        accs
+    ));
 }
 
 /// Integrates bodies that have a [`ForceAccumulator`], consuming (reading and zeroing) it.
@@ -132,21 +147,9 @@ pub fn integrate_with_forces(
     }
     drifted.0 = false;
     let stage = StageTiming::new(&settings, *cursor, phase);
-    let parallelism = parallelism.map_or_else(Parallelism::default, |p| *p);
-    let mut errors = Vec::new();
-    for (entities, mut t, mut v, masses, mut accs, dampings) in dense(bodies.contiguous_iter_mut())
-    {
-        let bodies = Bodies {
-            entities,
-            transforms: &mut t,
-            velocities: &mut v,
-            masses,
-            dampings,
-            loads: Loads::Consumed(&mut accs),
-        };
-        step_table(&stage, &parallelism, bodies, &mut errors);
-    }
-    reject_all(&mut commands, errors);
+    step_each_table!(bodies, stage, parallelism, commands, |mut accs| {
+        Loads::Consumed(&mut accs)
+    });
 }
 
 /// Integrates bodies without a [`ForceAccumulator`]: free motion, plus gravity when a
@@ -166,20 +169,9 @@ pub fn integrate_without_forces(
     let Some(stage) = StageTiming::free_motion(&settings, *cursor) else {
         return;
     };
-    let parallelism = parallelism.map_or_else(Parallelism::default, |p| *p);
-    let mut errors = Vec::new();
-    for (entities, mut t, mut v, masses, scales, dampings) in dense(bodies.contiguous_iter_mut()) {
-        let bodies = Bodies {
-            entities,
-            transforms: &mut t,
-            velocities: &mut v,
-            masses,
-            dampings,
-            loads: Loads::Field { gravity, scales },
-        };
-        step_table(&stage, &parallelism, bodies, &mut errors);
-    }
-    reject_all(&mut commands, errors);
+    step_each_table!(bodies, stage, parallelism, commands, |scales| {
+        Loads::Field { gravity, scales }
+    });
 }
 
 /// The physics queries hold only table components and archetype filters, so they are always

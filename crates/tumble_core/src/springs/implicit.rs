@@ -1133,15 +1133,9 @@ impl ImplicitSpringSolver {
 
     /// Kinetic + elastic energy of the group (J) with body `i` at `poses[i]`.
     fn energy(&self, poses: &[Pose]) -> f64 {
-        let kinetic: f64 = self
-            .starts
-            .iter()
-            .zip(poses)
-            .map(|(s, p)| {
-                let w = p.body_rate(s);
-                0.5 * s.mass * p.v.length_squared() + 0.5 * (s.inertia * w * w).element_sum()
-            })
-            .sum();
+        let kinetic = self.sum_over_bodies(poses, |s, p, w| {
+            0.5 * s.mass * p.v.length_squared() + 0.5 * (s.inertia * w * w).element_sum()
+        });
         let elastic: f64 = self
             .links
             .iter()
@@ -1175,16 +1169,19 @@ impl ImplicitSpringSolver {
                 l.k * ((pa - pb).length() - l.rest).abs() * eps * (ra + rb)
             })
             .sum();
-        let bodies: f64 = self
-            .starts
-            .iter()
-            .zip(exact)
-            .map(|(s, p)| {
-                let w = p.body_rate(s);
-                eps * (s.mass * p.v.length_squared() + w.length() * (s.inertia * w).length())
-            })
-            .sum();
+        let bodies = self.sum_over_bodies(exact, |s, p, w| {
+            eps * (s.mass * p.v.length_squared() + w.length() * (s.inertia * w).length())
+        });
         springs + bodies
+    }
+
+    /// `Σ term(start, pose, ω_body)` over the bodies, `ω_body` the body-frame rate at `pose`.
+    fn sum_over_bodies(&self, poses: &[Pose], term: impl Fn(&Start, &Pose, DVec3) -> f64) -> f64 {
+        self.starts
+            .iter()
+            .zip(poses)
+            .map(|(s, p)| term(s, p, p.body_rate(s)))
+            .sum()
     }
 
     /// Storing the end state in the engine's precision moves the group's energy: a rounded

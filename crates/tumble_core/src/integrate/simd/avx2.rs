@@ -11,21 +11,13 @@
 
 use std::arch::x86_64::*;
 
-use super::{Lane, lane_ops};
+use super::{Lane, cpu_proof, intrinsic_lane_members, lane_ops};
 
-/// Proof that the CPU runs AVX2: made only by [`Avx2::detect`] (the field is private).
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct Avx2 {
-    _detected: (),
-}
-
-impl Avx2 {
-    /// The proof, if the CPU has AVX2.
-    #[inline]
-    pub(crate) fn detect() -> Option<Self> {
-        is_x86_feature_detected!("avx2").then_some(Self { _detected: () })
-    }
-}
+cpu_proof!(
+    /// Proof that the CPU runs AVX2: made only by [`Avx2::detect`].
+    Avx2,
+    "avx2"
+);
 
 /// Four f64 lanes in a `__m256d`.
 #[derive(Clone, Copy)]
@@ -55,37 +47,14 @@ impl std::ops::Neg for Avx4 {
 
 impl Lane for Avx4 {
     type Mask = Mask4;
-    type Cpu = Avx2;
-    const WIDTH: usize = 4;
-    #[inline(always)]
-    fn splat(cpu: Avx2, x: f64) -> Self {
-        // SAFETY: the `cpu` token proves AVX.
-        let v = unsafe { _mm256_set1_pd(x) };
-        Self { v, cpu }
-    }
-    #[inline(always)]
-    fn load(cpu: Avx2, values: &[f64]) -> Self {
-        let values = &values[..4];
-        // SAFETY: the `cpu` token proves AVX; `values` holds the 4 f64 the load reads.
-        let v = unsafe { _mm256_loadu_pd(values.as_ptr()) };
-        Self { v, cpu }
-    }
-    #[inline(always)]
-    fn store(self, out: &mut [f64]) {
-        let out = &mut out[..4];
-        // SAFETY: the `cpu` token proves AVX; `out` holds the 4 f64 the store writes.
-        unsafe { _mm256_storeu_pd(out.as_mut_ptr(), self.v) };
-    }
-    #[inline(always)]
-    fn cpu(self) -> Avx2 {
-        self.cpu
-    }
-    #[inline(always)]
-    fn sqrt(self) -> Self {
-        // SAFETY: the `cpu` token proves AVX. Correctly rounded, as `f64::sqrt`.
-        let v = unsafe { _mm256_sqrt_pd(self.v) };
-        Self { v, cpu: self.cpu }
-    }
+    intrinsic_lane_members!(
+        cpu: Avx2,
+        width: 4,
+        splat: _mm256_set1_pd,
+        load: _mm256_loadu_pd,
+        store: _mm256_storeu_pd,
+        sqrt: _mm256_sqrt_pd,
+    );
     #[inline(always)]
     fn gt(self, other: Self) -> Mask4 {
         // SAFETY: the `cpu` token proves AVX. Ordered, quiet: false for NaN, as `>`.

@@ -8,21 +8,13 @@
 
 use std::arch::x86_64::*;
 
-use super::{Lane, lane_ops};
+use super::{Lane, cpu_proof, intrinsic_lane_members, lane_ops};
 
-/// Proof that the CPU runs AVX-512F: made only by [`Avx512::detect`] (the field is private).
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct Avx512 {
-    _detected: (),
-}
-
-impl Avx512 {
-    /// The proof, if the CPU has AVX-512F.
-    #[inline]
-    pub(crate) fn detect() -> Option<Self> {
-        is_x86_feature_detected!("avx512f").then_some(Self { _detected: () })
-    }
-}
+cpu_proof!(
+    /// Proof that the CPU runs AVX-512F: made only by [`Avx512::detect`].
+    Avx512,
+    "avx512f"
+);
 
 /// Eight f64 lanes in a `__m512d`.
 #[derive(Clone, Copy)]
@@ -52,37 +44,14 @@ impl std::ops::Neg for Avx8 {
 impl Lane for Avx8 {
     /// A bit per lane: a plain integer, so no proof is needed to test it.
     type Mask = __mmask8;
-    type Cpu = Avx512;
-    const WIDTH: usize = 8;
-    #[inline(always)]
-    fn splat(cpu: Avx512, x: f64) -> Self {
-        // SAFETY: the `cpu` token proves AVX-512F.
-        let v = unsafe { _mm512_set1_pd(x) };
-        Self { v, cpu }
-    }
-    #[inline(always)]
-    fn load(cpu: Avx512, values: &[f64]) -> Self {
-        let values = &values[..8];
-        // SAFETY: the `cpu` token proves AVX-512F; `values` holds the 8 f64 the load reads.
-        let v = unsafe { _mm512_loadu_pd(values.as_ptr()) };
-        Self { v, cpu }
-    }
-    #[inline(always)]
-    fn store(self, out: &mut [f64]) {
-        let out = &mut out[..8];
-        // SAFETY: the `cpu` token proves AVX-512F; `out` holds the 8 f64 the store writes.
-        unsafe { _mm512_storeu_pd(out.as_mut_ptr(), self.v) };
-    }
-    #[inline(always)]
-    fn cpu(self) -> Avx512 {
-        self.cpu
-    }
-    #[inline(always)]
-    fn sqrt(self) -> Self {
-        // SAFETY: the `cpu` token proves AVX-512F. Correctly rounded, as `f64::sqrt`.
-        let v = unsafe { _mm512_sqrt_pd(self.v) };
-        Self { v, cpu: self.cpu }
-    }
+    intrinsic_lane_members!(
+        cpu: Avx512,
+        width: 8,
+        splat: _mm512_set1_pd,
+        load: _mm512_loadu_pd,
+        store: _mm512_storeu_pd,
+        sqrt: _mm512_sqrt_pd,
+    );
     #[inline(always)]
     fn gt(self, other: Self) -> __mmask8 {
         // SAFETY: the `cpu` token proves AVX-512F. Ordered, quiet: false for NaN, as `>`.

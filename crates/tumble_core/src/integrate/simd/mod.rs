@@ -143,3 +143,75 @@ macro_rules! lane_ops {
     };
 }
 pub(crate) use lane_ops;
+
+/// The members of [`Lane`] that both intrinsic backends write the same way around their own
+/// instructions: `Cpu`, `WIDTH`, `splat`, `load` and `store` (unaligned, `WIDTH` values),
+/// `cpu`, and `sqrt` (correctly rounded, as `f64::sqrt`). For a lane type `{ v, cpu }` whose
+/// `cpu` token proves the feature the intrinsics need.
+macro_rules! intrinsic_lane_members {
+    (
+        cpu: $cpu:ident,
+        width: $width:literal,
+        splat: $splat:path,
+        load: $load:path,
+        store: $store:path,
+        sqrt: $sqrt:path $(,)?
+    ) => {
+        type Cpu = $cpu;
+        const WIDTH: usize = $width;
+        #[inline(always)]
+        fn splat(cpu: $cpu, x: f64) -> Self {
+            // SAFETY: the `cpu` token proves the feature the intrinsic needs.
+            let v = unsafe { $splat(x) };
+            Self { v, cpu }
+        }
+        #[inline(always)]
+        fn load(cpu: $cpu, values: &[f64]) -> Self {
+            let values = &values[..$width];
+            // SAFETY: the `cpu` token proves the feature; `values` holds the `WIDTH` f64 the
+            // load reads.
+            let v = unsafe { $load(values.as_ptr()) };
+            Self { v, cpu }
+        }
+        #[inline(always)]
+        fn store(self, out: &mut [f64]) {
+            let out = &mut out[..$width];
+            // SAFETY: the `cpu` token proves the feature; `out` holds the `WIDTH` f64 the
+            // store writes.
+            unsafe { $store(out.as_mut_ptr(), self.v) };
+        }
+        #[inline(always)]
+        fn cpu(self) -> $cpu {
+            self.cpu
+        }
+        #[inline(always)]
+        fn sqrt(self) -> Self {
+            // SAFETY: the `cpu` token proves the feature. Correctly rounded, as `f64::sqrt`.
+            let v = unsafe { $sqrt(self.v) };
+            Self { v, cpu: self.cpu }
+        }
+    };
+}
+pub(crate) use intrinsic_lane_members;
+
+/// A zero-sized proof that the CPU runs the feature `$feature` (a literal for
+/// `is_x86_feature_detected!`): its field is private, so only `detect` makes one, and a lane
+/// value that carries it cannot exist on a CPU without the feature.
+macro_rules! cpu_proof {
+    ($(#[$doc:meta])* $name:ident, $feature:tt) => {
+        $(#[$doc])*
+        #[derive(Debug, Clone, Copy)]
+        pub(crate) struct $name {
+            _detected: (),
+        }
+
+        impl $name {
+            /// The proof, if the CPU has the feature.
+            #[inline]
+            pub(crate) fn detect() -> Option<Self> {
+                is_x86_feature_detected!($feature).then_some(Self { _detected: () })
+            }
+        }
+    };
+}
+pub(crate) use cpu_proof;
