@@ -122,13 +122,24 @@ fn check_body_in_detail(
     check_finite_vec3("linear velocity", velocity.linear).map_err(invalid("Velocity"))?;
     check_finite_vec3("angular velocity", velocity.angular).map_err(invalid("Velocity"))?;
     match forces {
-        Some(acc) => check_accumulator(acc),
+        Some(acc) => check_accumulator_in_detail(acc),
         None => Ok(()),
     }
 }
 
-/// Checks that a [`ForceAccumulator`] holds finite values.
+/// Checks that a [`ForceAccumulator`] holds finite values (an inlined test; only bad values go
+/// through the checks that build the error).
+#[inline]
 pub fn check_accumulator(acc: &ForceAccumulator) -> Result<(), BodyErrorKind> {
+    if acc.force.is_finite() && acc.torque.is_finite() {
+        return Ok(());
+    }
+    check_accumulator_in_detail(acc)
+}
+
+/// The detailed checks behind [`check_accumulator`], naming the field at fault.
+#[cold]
+fn check_accumulator_in_detail(acc: &ForceAccumulator) -> Result<(), BodyErrorKind> {
     use tumble_core::error::check_finite_vec3;
     let invalid = |source| BodyErrorKind::Invalid {
         component: "ForceAccumulator",
