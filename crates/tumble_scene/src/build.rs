@@ -177,7 +177,7 @@ impl Scene {
     /// `source` is read again only to locate an error.
     pub(crate) fn read_json(
         file: &str,
-        input: impl std::io::Read,
+        input: impl std::io::BufRead,
         source: JsonSource<'_>,
     ) -> Result<Self, SceneError> {
         let parsed = crate::json::parse(file, input, source)?;

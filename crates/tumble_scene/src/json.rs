@@ -6,7 +6,7 @@
 //! `serde_path_to_error` tracks the field path during the parse, and the scanner in
 //! [`crate::json_locate`] finds the line of a field that fails a later check.
 
-use std::io::Read;
+use std::io::BufRead;
 
 use serde::Deserialize;
 use std::path::Path;
@@ -28,12 +28,12 @@ pub enum JsonSource<'a> {
 
 impl JsonSource<'_> {
     /// The text again, from its start; `None` when the file cannot be opened again.
-    fn open(&self) -> Option<Box<dyn Read + '_>> {
+    fn open(&self) -> Option<Box<dyn BufRead + '_>> {
         match self {
             Self::Text(text) => Some(Box::new(*text)),
             Self::File(file) => std::fs::File::open(file)
                 .ok()
-                .map(|f| Box::new(std::io::BufReader::new(f)) as Box<dyn Read>),
+                .map(|f| Box::new(std::io::BufReader::new(f)) as Box<dyn BufRead>),
         }
     }
 
@@ -60,9 +60,10 @@ impl Locate for JsonSource<'_> {
 /// `source` with the path tracked, to name the field.
 pub fn parse(
     file: &str,
-    input: impl Read,
+    mut input: impl BufRead,
     source: JsonSource<'_>,
 ) -> Result<SceneFile, SceneError> {
+    skip_byte_order_mark(&mut input);
     let mut de = serde_json::Deserializer::from_reader(input);
     let model = SceneFile::deserialize(&mut de).and_then(|model| de.end().map(|()| model));
     model.map_err(|e| match source.open() {
@@ -71,9 +72,19 @@ pub fn parse(
     })
 }
 
+/// Skips a UTF-8 byte order mark at the start of `input` (editors on Windows write one; JSON
+/// parsers may ignore it, RFC 8259 §8.1).
+fn skip_byte_order_mark(input: &mut impl BufRead) {
+    const BOM: &[u8] = b"\xEF\xBB\xBF";
+    if input.fill_buf().is_ok_and(|start| start.starts_with(BOM)) {
+        input.consume(BOM.len());
+    }
+}
+
 /// The error of a second parse, with its field path; `None` if the second parse passes (the
 /// file changed in between).
-fn located(file: &str, input: impl Read, source: JsonSource<'_>) -> Option<SceneError> {
+fn located(file: &str, mut input: impl BufRead, source: JsonSource<'_>) -> Option<SceneError> {
+    skip_byte_order_mark(&mut input);
     let mut de = serde_json::Deserializer::from_reader(input);
     let tracked = serde_path_to_error::deserialize::<_, SceneFile>(&mut de);
     let e = match tracked {

@@ -83,11 +83,20 @@ struct Scanner<R> {
 }
 
 impl<R: Read> Scanner<R> {
+    /// A cursor at the start of `input`, past a UTF-8 byte order mark (the parse skips one).
     fn new(input: R) -> Self {
-        Self {
+        let mut scan = Self {
             input: BufReader::with_capacity(1 << 16, input),
             line: 1,
+        };
+        if scan
+            .input
+            .fill_buf()
+            .is_ok_and(|start| start.starts_with(b"\xEF\xBB\xBF"))
+        {
+            scan.input.consume(3);
         }
+        scan
     }
 
     /// The next byte without consuming it; `None` at the end or on a read error.
@@ -313,6 +322,12 @@ mod tests {
         assert_eq!(line(&[Key("bodies"), Index(1), Key("mass")]), 10);
         // An escaped key is compared decoded.
         assert_eq!(line(&[Key("forces"), Index(0), Key("type")]), 13);
+    }
+
+    #[test]
+    fn a_byte_order_mark_is_skipped() {
+        let doc = "\u{feff}{\"a\": 1,\n\"b\": 2}";
+        assert_eq!(line_of(doc.as_bytes(), &[Key("b")]), 2);
     }
 
     #[test]

@@ -194,6 +194,14 @@ fn parse_errors_name_the_line_and_the_field() {
             "EOF while parsing an object",
         ),
         ("\0\0\0".to_owned(), 1, "json", "expected value"),
+        // A byte order mark is skipped, and the lines still count from the first.
+        (
+            "\u{feff}{\"name\": \"s\",\n\"world\": {\"dt\": 0.1, \"steps\": 3, \"x\": 1}}"
+                .to_owned(),
+            2,
+            "world.x",
+            "unknown field `x`, expected one of `dt`, `steps`, `integrator`, `springs`, `substeps`, `gravity`",
+        ),
     ];
     for (text, line, field, message) in cases {
         let e = json_error(text);
