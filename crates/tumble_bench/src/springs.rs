@@ -8,9 +8,9 @@ use tumble_core::math::{Real, Vec3, to_f64};
 use tumble_core::{BodyState, Integrator};
 use tumble_ecs::prelude::{PhysicsSettings, SpringSolver};
 use tumble_rapier::presets::{ChainStart, spring_chain};
-use tumble_rapier::{Load, TumbleScene};
+use tumble_rapier::{ComparisonScene, Load, TumbleScene};
 
-use crate::engines::Engine;
+use crate::engines::{Engine, Rapier};
 use crate::measure::{Effort, compare};
 
 /// How a spring world is loaded.
@@ -20,6 +20,29 @@ pub enum Loads {
     None,
     /// Gravity, a constant force at a point of every body, and damping of every body.
     GravityForcesDamping,
+}
+
+/// `chains` spring chains ([`spring_chain`]) loaded as `loads` says: the scene both engines
+/// step.
+pub fn chains_scene(
+    chains: usize,
+    omega_dt: Real,
+    start: ChainStart,
+    loads: Loads,
+) -> ComparisonScene {
+    let mut scene = spring_chain(omega_dt, start, chains);
+    if loads == Loads::GravityForcesDamping {
+        scene.gravity = Some(Vec3::new(0.0, -9.81, 0.0));
+        for body in &mut scene.bodies {
+            body.loads.push(Load::Force {
+                force: Vec3::new(0.5, 0.0, 0.0),
+                local_point: Some(Vec3::new(0.0, 0.05, 0.02)),
+            });
+            body.linear_damping = 0.05;
+            body.angular_damping = 0.05;
+        }
+    }
+    scene
 }
 
 /// `chains` spring chains ([`spring_chain`]) through tumble's ECS schedule, the springs
@@ -60,18 +83,7 @@ impl SpringWorld {
         integrator: Integrator,
         substeps: u32,
     ) -> Self {
-        let mut scene = spring_chain(omega_dt, start, chains);
-        if loads == Loads::GravityForcesDamping {
-            scene.gravity = Some(Vec3::new(0.0, -9.81, 0.0));
-            for body in &mut scene.bodies {
-                body.loads.push(Load::Force {
-                    force: Vec3::new(0.5, 0.0, 0.0),
-                    local_point: Some(Vec3::new(0.0, 0.05, 0.02)),
-                });
-                body.linear_damping = 0.05;
-                body.angular_damping = 0.05;
-            }
-        }
+        let scene = chains_scene(chains, omega_dt, start, loads);
         let mut tumble = TumbleScene::with_springs(&scene, integrator, springs);
         if substeps > 1 {
             let substeps = NonZeroU32::new(substeps).expect("more than one substep");
@@ -128,13 +140,17 @@ pub struct StiffnessRow {
 pub struct ThroughputRow {
     /// Number of springs (ten per chain).
     pub springs: usize,
-    /// `"explicit"` or `"implicit"`.
+    /// `"explicit"` or `"implicit"` (tumble), or `"rapier SpringJoint"` (the same loaded
+    /// chains in rapier, each spring its `SpringJoint`).
     pub mode: String,
     /// Nominal `√(k/μ)Δt`.
     pub omega_dt: f64,
     /// Median ns per spring-step.
     pub ns_per_spring_step: f64,
 }
+
+/// The name of the rapier rows of the spring throughput.
+pub const RAPIER_JOINT: &str = "rapier SpringJoint";
 
 /// Steps of several stages: a loaded spring world stepped with substeps or the fourth-order
 /// composition, against the same world in one stage.
@@ -253,6 +269,23 @@ pub fn run(quick: bool, mut progress: impl FnMut(&str)) -> SpringResults {
                 ns_per_spring_step: ns,
             });
         }
+        progress(&format!(
+            "{springs} springs in rapier, SpringJoint at ωΔt 0.5"
+        ));
+        let scene = chains_scene(
+            chains,
+            0.5,
+            ChainStart::Relaxed,
+            Loads::GravityForcesDamping,
+        );
+        let mut rapier = Rapier::new(&scene);
+        let ns = compare(&mut [&mut rapier], springs, &effort)[0];
+        throughput.push(ThroughputRow {
+            springs,
+            mode: RAPIER_JOINT.to_owned(),
+            omega_dt: 0.5,
+            ns_per_spring_step: ns,
+        });
     }
     let mut stages = Vec::new();
     for &springs in sizes {
