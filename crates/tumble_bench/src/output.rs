@@ -360,11 +360,7 @@ pub fn targets_table(targets: &[Target]) -> String {
 /// Replaces the text between `<!-- bench:begin -->` and `<!-- bench:end -->`; `None` when the
 /// markers are missing.
 pub fn replace_between_markers(text: &str, section: &str) -> Option<String> {
-    const BEGIN: &str = "<!-- bench:begin -->";
-    const END: &str = "<!-- bench:end -->";
-    let start = text.find(BEGIN)? + BEGIN.len();
-    let end = start + text[start..].find(END)?;
-    Some(format!("{}\n{}{}", &text[..start], section, &text[end..]))
+    tumble_scene::text::replace_between_markers(text, "bench", section)
 }
 
 /// The README's section: the latest ratios of the default integrator, and the targets.

@@ -2,8 +2,6 @@
 
 use thiserror::Error;
 
-use crate::text::is_unsafe_char;
-
 /// A scene file that cannot be used, with where and why.
 #[derive(Debug, Clone, PartialEq, Error)]
 #[error("{}", location(self))]
@@ -55,23 +53,12 @@ const MAX_FIELD_CHARS: usize = 120;
 const MAX_MESSAGE_CHARS: usize = 400;
 
 /// `text` made safe to print on one line: control and format characters
-/// ([`is_unsafe_char`]: line breaks, ESC, bidi overrides, zero-width characters) are shown as
-/// Rust escapes, the same rule as [`crate::text::terminal_safe`], and the text is cut to `max`
+/// ([`crate::text::is_unsafe_char`]: line breaks, ESC, bidi overrides, zero-width characters) are shown as
+/// Rust escapes, through [`crate::text::terminal_safe_within`], and the text is cut to `max`
 /// characters with an ellipsis. Messages quote user strings (keys, names, values), so this
 /// applies to the whole message, not only to the parts known to come from the user.
 fn one_line(text: String, max: usize) -> String {
-    let mut out = String::with_capacity(text.len().min(4 * max));
-    for c in text.chars().take(max) {
-        if is_unsafe_char(c) {
-            out.extend(c.escape_default());
-        } else {
-            out.push(c);
-        }
-    }
-    if text.chars().nth(max).is_some() {
-        out.push('…');
-    }
-    out
+    crate::text::terminal_safe_within(&text, max).into_owned()
 }
 
 /// A scene model that could not be written as TOML.

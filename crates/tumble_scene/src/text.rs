@@ -50,12 +50,17 @@ fn is_format_char(c: char) -> bool {
 /// shown as Rust escapes (`\n`, `\u{1b}`, `\u{202e}`), and text longer than
 /// [`MAX_ECHO_CHARS`] is cut with `…`. Borrowed when nothing changes.
 pub fn terminal_safe(text: &str) -> Cow<'_, str> {
-    let long = text.chars().nth(MAX_ECHO_CHARS).is_some();
+    terminal_safe_within(text, MAX_ECHO_CHARS)
+}
+
+/// [`terminal_safe`] with the cut at `max` characters instead of [`MAX_ECHO_CHARS`].
+pub fn terminal_safe_within(text: &str, max: usize) -> Cow<'_, str> {
+    let long = text.chars().nth(max).is_some();
     if !long && !text.chars().any(is_unsafe_char) {
         return Cow::Borrowed(text);
     }
-    let mut out = String::with_capacity(text.len().min(4 * MAX_ECHO_CHARS));
-    for c in text.chars().take(MAX_ECHO_CHARS) {
+    let mut out = String::with_capacity(text.len().min(4 * max));
+    for c in text.chars().take(max) {
         if is_unsafe_char(c) {
             out.extend(c.escape_default());
         } else {
@@ -71,6 +76,16 @@ pub fn terminal_safe(text: &str) -> Cow<'_, str> {
 /// A path made safe to print (see [`terminal_safe`]); non-UTF-8 bytes are shown as `�`.
 pub fn path_for_terminal(path: &std::path::Path) -> String {
     terminal_safe(&path.to_string_lossy()).into_owned()
+}
+
+/// `text` with what stands between `<!-- {name}:begin -->` and `<!-- {name}:end -->` replaced
+/// by a line break and `section`; `None` when the markers are missing.
+pub fn replace_between_markers(text: &str, name: &str, section: &str) -> Option<String> {
+    let begin = format!("<!-- {name}:begin -->");
+    let end = format!("<!-- {name}:end -->");
+    let start = text.find(&begin)? + begin.len();
+    let end = start + text[start..].find(&end)?;
+    Some(format!("{}\n{}{}", &text[..start], section, &text[end..]))
 }
 
 #[cfg(test)]
