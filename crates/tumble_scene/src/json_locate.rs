@@ -48,32 +48,16 @@ pub fn array_member_of_len(
         scan.enter(*step)?;
     }
     scan.skip_space();
-    if scan.bump()? != b'{' {
-        return None;
-    }
-    loop {
-        scan.skip_space();
-        if scan.peek()? != b'"' {
-            return None;
-        }
-        let line = scan.line;
-        let key = scan.string()?;
-        scan.skip_space();
-        if scan.bump()? != b':' {
-            return None;
-        }
+    scan.find_member(|scan, key, line| {
         scan.skip_space();
         if scan.peek()? == b'[' && scan.array_len()? == len {
-            return Some((key, line));
+            return Some(Some((key, line)));
         }
         if scan.peek()? != b',' && scan.peek()? != b'}' {
             scan.skip_value()?;
         }
-        scan.skip_space();
-        if scan.bump()? != b',' {
-            return None;
-        }
-    }
+        Some(None)
+    })
 }
 
 /// A byte cursor over buffered input that counts lines.
@@ -125,32 +109,15 @@ impl<R: Read> Scanner<R> {
     fn enter(&mut self, step: Step<'_>) -> Option<usize> {
         self.skip_space();
         match step {
-            Step::Key(key) => {
-                if self.bump()? != b'{' {
-                    return None;
+            Step::Key(key) => self.find_member(|scan, name, line| {
+                if name == key {
+                    scan.skip_space();
+                    Some(Some(line))
+                } else {
+                    scan.skip_value()?;
+                    Some(None)
                 }
-                loop {
-                    self.skip_space();
-                    if self.peek()? != b'"' {
-                        return None;
-                    }
-                    let line = self.line;
-                    let name = self.string()?;
-                    self.skip_space();
-                    if self.bump()? != b':' {
-                        return None;
-                    }
-                    if name == key {
-                        self.skip_space();
-                        return Some(line);
-                    }
-                    self.skip_value()?;
-                    self.skip_space();
-                    if self.bump()? != b',' {
-                        return None;
-                    }
-                }
-            }
+            }),
             Step::Index(index) => {
                 if self.bump()? != b'[' {
                     return None;
@@ -170,6 +137,38 @@ impl<R: Read> Scanner<R> {
                     }
                 }
                 None
+            }
+        }
+    }
+
+    /// Walks the members of the object at the cursor. For each, `visit` gets its key and the line
+    /// where it starts, with the cursor just after its `:`; `visit` returns `Some(Some(found))`
+    /// to stop there with `found`, `Some(None)` having moved past the value to go on, or `None`
+    /// on text it cannot follow. `None` at the object's end or on text it cannot follow.
+    fn find_member<T>(
+        &mut self,
+        mut visit: impl FnMut(&mut Self, String, usize) -> Option<Option<T>>,
+    ) -> Option<T> {
+        if self.bump()? != b'{' {
+            return None;
+        }
+        loop {
+            self.skip_space();
+            if self.peek()? != b'"' {
+                return None;
+            }
+            let line = self.line;
+            let key = self.string()?;
+            self.skip_space();
+            if self.bump()? != b':' {
+                return None;
+            }
+            if let Some(found) = visit(self, key, line)? {
+                return Some(found);
+            }
+            self.skip_space();
+            if self.bump()? != b',' {
+                return None;
             }
         }
     }
