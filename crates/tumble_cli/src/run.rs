@@ -77,6 +77,23 @@ fn stages_line(world: &World) -> Option<String> {
     ))
 }
 
+/// The count given to `flag`, if any, checked to be in `1..=max`: an error `flag: expected 1
+/// to {max} {unit}, got {n}` otherwise.
+fn count_up_to(
+    flag: &str,
+    given: Option<i64>,
+    max: u64,
+    unit: &str,
+) -> Result<Option<u64>, Failure> {
+    match given {
+        Some(n) if !(1..=max as i64).contains(&n) => Err(Failure::new(
+            exit::ERROR,
+            format!("{flag}: expected 1 to {max} {unit}, got {n}"),
+        )),
+        other => Ok(other.map(|n| n as u64)),
+    }
+}
+
 /// `tumble run`.
 pub fn run(args: RunArgs) -> Result<(), Failure> {
     let every = u64::try_from(args.every)
@@ -88,15 +105,7 @@ pub fn run(args: RunArgs) -> Result<(), Failure> {
                 format!("--every: expected a value >= 1, got {}", args.every),
             )
         })?;
-    let steps = match args.steps {
-        Some(s) if !(1..=MAX_STEPS as i64).contains(&s) => {
-            return Err(Failure::new(
-                exit::ERROR,
-                format!("--steps: expected 1 to {MAX_STEPS} steps, got {s}"),
-            ));
-        }
-        other => other.map(|s| s as u64),
-    };
+    let steps = count_up_to("--steps", args.steps, MAX_STEPS, "steps")?;
     let integrator = args
         .integrator
         .map(|v| crate::utf8("--integrator", v))
@@ -105,15 +114,7 @@ pub fn run(args: RunArgs) -> Result<(), Failure> {
         .springs
         .map(|v| crate::utf8("--springs", v))
         .transpose()?;
-    let substeps = match args.substeps {
-        Some(n) if !(1..=i64::from(MAX_SUBSTEPS)).contains(&n) => {
-            return Err(Failure::new(
-                exit::ERROR,
-                format!("--substeps: expected 1 to {MAX_SUBSTEPS} substeps, got {n}"),
-            ));
-        }
-        other => other.map(|n| n as u64),
-    };
+    let substeps = count_up_to("--substeps", args.substeps, MAX_SUBSTEPS.into(), "substeps")?;
     let patterns = args
         .bodies
         .map(|v| crate::utf8("--bodies", v))
