@@ -195,26 +195,17 @@ fn bodies(world: &World, out: &mut Stream) {
 }
 
 fn generators(world: &World, out: &mut Stream) {
-    let forces = rows::<(Entity, &ConstantForce), (), _>(world, |(e, f)| (e, *f));
-    out.bytes(&(forces.len() as u64).to_le_bytes());
-    for (e, f) in forces {
-        out.entity(e);
+    components::<ConstantForce>(world, out, |out, f| {
         out.entity(f.body);
         out.vec3(f.force);
         out.flag(f.local_point.is_some());
         out.vec3(f.local_point.unwrap_or(Vec3::ZERO));
-    }
-    let torques = rows::<(Entity, &ConstantTorque), (), _>(world, |(e, t)| (e, *t));
-    out.bytes(&(torques.len() as u64).to_le_bytes());
-    for (e, t) in torques {
-        out.entity(e);
+    });
+    components::<ConstantTorque>(world, out, |out, t| {
         out.entity(t.body);
         out.vec3(t.torque);
-    }
-    let springs = rows::<(Entity, &Spring), (), _>(world, |(e, s)| (e, *s));
-    out.bytes(&(springs.len() as u64).to_le_bytes());
-    for (e, s) in springs {
-        out.entity(e);
+    });
+    components::<Spring>(world, out, |out, s| {
         out.entity(s.a);
         out.vec3(s.anchor_a);
         match s.b {
@@ -231,5 +222,20 @@ fn generators(world: &World, out: &mut Stream) {
         out.real(s.stiffness);
         out.real(s.damping);
         out.real(s.rest_length);
+    });
+}
+
+/// One section of the stream: how many entities hold a `C`, then each (in entity order) as its
+/// entity and what `write` writes of its `C`.
+fn components<C: Component + Copy>(
+    world: &World,
+    out: &mut Stream,
+    write: impl Fn(&mut Stream, C),
+) {
+    let rows = rows::<(Entity, &C), (), _>(world, |(e, c)| (e, *c));
+    out.bytes(&(rows.len() as u64).to_le_bytes());
+    for (e, c) in rows {
+        out.entity(e);
+        write(out, c);
     }
 }
