@@ -5,8 +5,8 @@
 mod common;
 
 use bevy_ecs::prelude::*;
+use tumble_core::Integrator;
 use tumble_core::math::{Quat, Real, Vec3};
-use tumble_core::{Integrator, Mass, MassProperties};
 use tumble_ecs::prelude::*;
 
 const DT: Real = 1.0 / 60.0;
@@ -34,22 +34,16 @@ fn audited_world(integrator: Integrator) -> World {
     world
 }
 
+/// A unit body at rest on the x axis at `x`, turned by `0.3 x` about z, spinning at `omega`.
 fn body(world: &mut World, x: Real, inertia: Vec3, omega: Vec3) -> Entity {
-    let mass = MassProperties::new(Mass::new(1.0).unwrap(), inertia).unwrap();
-    world
-        .spawn((
-            RigidBody,
-            MassProps(mass),
-            Transform {
-                translation: Vec3::new(x, 0.0, 0.0),
-                rotation: Quat::from_rotation_z(0.3 * x),
-            },
-            Velocity {
-                linear: Vec3::ZERO,
-                angular: omega,
-            },
-        ))
-        .id()
+    common::unit_body(
+        world,
+        Vec3::new(x, 0.0, 0.0),
+        Quat::from_rotation_z(0.3 * x),
+        inertia,
+        Vec3::ZERO,
+        omega,
+    )
 }
 
 /// A chain of `n` asymmetric bodies joined by springs at off-centre anchors, the first one tied

@@ -12,30 +12,7 @@ use tumble_ecs::prelude::*;
 
 const DT: Real = 1.0 / 60.0;
 
-fn body(
-    world: &mut World,
-    position: Vec3,
-    rotation: Quat,
-    inertia: Vec3,
-    v: Vec3,
-    w: Vec3,
-) -> Entity {
-    let mass = MassProperties::new(Mass::new(1.0).unwrap(), inertia).unwrap();
-    world
-        .spawn((
-            RigidBody,
-            MassProps(mass),
-            Transform {
-                translation: position,
-                rotation,
-            },
-            Velocity {
-                linear: v,
-                angular: w,
-            },
-        ))
-        .id()
-}
+use common::unit_body as body;
 
 /// Two unit masses (asymmetric, off-centre anchors), stiffness from the nominal
 /// `√(k/μ)Δt = omega_dt` with `μ = ½`, stretched 20 % past the rest length and spinning.

@@ -1,7 +1,8 @@
 //! Helpers shared by the integration tests of `tumble_ecs`.
 
 use bevy_ecs::prelude::*;
-use tumble_core::math::{Real, Vec3};
+use tumble_core::math::{Quat, Real, Vec3};
+use tumble_core::{Mass, MassProperties};
 use tumble_ecs::prelude::*;
 
 /// Ties `bodies` into a chain of springs of stiffness `k`: the first from its point
@@ -32,4 +33,31 @@ pub fn tie_chain(
             rest,
         ));
     }
+}
+
+/// Spawns a body of unit mass with principal moments `inertia` at `position` and `rotation`,
+/// moving at `v` and turning at `w`.
+pub fn unit_body(
+    world: &mut World,
+    position: Vec3,
+    rotation: Quat,
+    inertia: Vec3,
+    v: Vec3,
+    w: Vec3,
+) -> Entity {
+    let mass = MassProperties::new(Mass::new(1.0).unwrap(), inertia).unwrap();
+    world
+        .spawn((
+            RigidBody,
+            MassProps(mass),
+            Transform {
+                translation: position,
+                rotation,
+            },
+            Velocity {
+                linear: v,
+                angular: w,
+            },
+        ))
+        .id()
 }
