@@ -70,65 +70,62 @@ pub fn plot_spring_energy(
     dir: &Path,
     runs: &[SpringRun],
 ) -> Result<String, Box<dyn std::error::Error>> {
-    let path = dir.join(SPRING_PLOT);
-    let root = SVGBackend::new(&path, (1200, 460)).into_drawing_area();
-    root.fill(&WHITE)?;
-    let panels = root.split_evenly((1, OMEGA_DTS.len()));
-    let dt = 1.0 / 60.0;
-    for (panel, omega_dt) in panels.iter().zip(OMEGA_DTS) {
-        let omega_dt = tumble_core::math::to_f64(omega_dt);
-        let here: Vec<&SpringRun> = runs.iter().filter(|r| r.omega_dt == omega_dt).collect();
-        let seconds = here
-            .iter()
-            .map(|r| r.energy_ratio.len().saturating_sub(1))
-            .max()
-            .unwrap_or(1) as f64
-            * dt;
-        let mut chart = ChartBuilder::on(panel)
-            .caption(format!("√(k/μ)Δt = {omega_dt}: E/E₀"), ("sans-serif", 16))
-            .margin(10)
-            .x_label_area_size(36)
-            .y_label_area_size(56)
-            .build_cartesian_2d(0.0..seconds.max(dt), (RANGE.0..RANGE.1).log_scale())?;
-        chart
-            .configure_mesh()
-            .x_desc("time (s)")
-            .y_label_formatter(&|y| format!("{y:.0e}"))
-            .draw()?;
-        for (k, variant) in Variant::ALL.iter().enumerate() {
-            let Some(run) = here.iter().find(|r| r.variant == variant.name()) else {
-                continue;
-            };
-            let color = Palette99::pick(k).to_rgba();
-            let series: Vec<(f64, f64)> = run
-                .energy_ratio
+    crate::output::svg(dir, SPRING_PLOT.to_owned(), (1200, 460), |root| {
+        let panels = root.split_evenly((1, OMEGA_DTS.len()));
+        let dt = 1.0 / 60.0;
+        for (panel, omega_dt) in panels.iter().zip(OMEGA_DTS) {
+            let omega_dt = tumble_core::math::to_f64(omega_dt);
+            let here: Vec<&SpringRun> = runs.iter().filter(|r| r.omega_dt == omega_dt).collect();
+            let seconds = here
                 .iter()
-                .take_while(|e| e.is_finite())
-                .enumerate()
-                .map(|(i, e)| (i as f64 * dt, e.clamp(RANGE.0, RANGE.1)))
-                .collect();
-            let label = match run.failed_at {
-                Some(step) => format!("{} (fails at step {step})", run.variant),
-                None => run.variant.clone(),
-            };
-            if let (Some(_), Some(&last)) = (run.failed_at, series.last()) {
-                chart.draw_series(std::iter::once(Cross::new(last, 6, color.stroke_width(2))))?;
+                .map(|r| r.energy_ratio.len().saturating_sub(1))
+                .max()
+                .unwrap_or(1) as f64
+                * dt;
+            let mut chart = ChartBuilder::on(panel)
+                .caption(format!("√(k/μ)Δt = {omega_dt}: E/E₀"), ("sans-serif", 16))
+                .margin(10)
+                .x_label_area_size(36)
+                .y_label_area_size(56)
+                .build_cartesian_2d(0.0..seconds.max(dt), (RANGE.0..RANGE.1).log_scale())?;
+            chart
+                .configure_mesh()
+                .x_desc("time (s)")
+                .y_label_formatter(&|y| format!("{y:.0e}"))
+                .draw()?;
+            for (k, variant) in Variant::ALL.iter().enumerate() {
+                let Some(run) = here.iter().find(|r| r.variant == variant.name()) else {
+                    continue;
+                };
+                let color = Palette99::pick(k).to_rgba();
+                let series: Vec<(f64, f64)> = run
+                    .energy_ratio
+                    .iter()
+                    .take_while(|e| e.is_finite())
+                    .enumerate()
+                    .map(|(i, e)| (i as f64 * dt, e.clamp(RANGE.0, RANGE.1)))
+                    .collect();
+                let label = match run.failed_at {
+                    Some(step) => format!("{} (fails at step {step})", run.variant),
+                    None => run.variant.clone(),
+                };
+                if let (Some(_), Some(&last)) = (run.failed_at, series.last()) {
+                    chart.draw_series(std::iter::once(Cross::new(
+                        last,
+                        6,
+                        color.stroke_width(2),
+                    )))?;
+                }
+                crate::output::legend_line(&mut chart, series, color, label)?;
             }
             chart
-                .draw_series(LineSeries::new(series, color.stroke_width(2)))?
-                .label(label)
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 16, y)], color.stroke_width(2))
-                });
+                .configure_series_labels()
+                .position(SeriesLabelPosition::LowerLeft)
+                .background_style(WHITE.mix(0.8))
+                .border_style(BLACK)
+                .label_font(("sans-serif", 11))
+                .draw()?;
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::LowerLeft)
-            .background_style(WHITE.mix(0.8))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 11))
-            .draw()?;
-    }
-    root.present()?;
-    Ok(SPRING_PLOT.to_owned())
+        Ok(())
+    })
 }
