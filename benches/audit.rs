@@ -3,12 +3,9 @@
 //! audit (`EnergyAudit::Auto`, the default for a world with springs) and without it
 //! (`EnergyAudit::Never`). Report the ratio, not the absolute time.
 
-#![expect(
-    missing_docs,
-    reason = "criterion_group! generates a public fn without docs; a bench has no API"
-)]
+mod common;
 
-use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
+use criterion::{BenchmarkId, Criterion, Throughput};
 use tumble::bevy_ecs::prelude::*;
 use tumble::math::{Quat, Real, Vec3};
 use tumble::prelude::*;
@@ -82,9 +79,6 @@ fn audit_cost(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group! {
-    name = benches;
-    config = Criterion::default().sample_size(20).measurement_time(std::time::Duration::from_secs(3));
-    targets = audit_cost
+fn main() {
+    common::run(audit_cost, 3);
 }
-criterion_main!(benches);

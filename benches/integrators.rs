@@ -3,12 +3,10 @@
 //! Rates stay below 1.5 rad/s so that even the explicit textbook step stays finite for the
 //! whole measurement (its blow-up time is over 1000 s here): a benchmark of NaN arithmetic
 //! would measure nothing.
-#![expect(
-    missing_docs,
-    reason = "criterion_group! generates a public fn without docs; a bench has no API"
-)]
 
-use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
+mod common;
+
+use criterion::{BenchmarkId, Criterion, Throughput};
 use tumble::math::{Quat, Real, Vec3};
 
 use tumble::prelude::*;
@@ -75,9 +73,6 @@ fn step_all(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group! {
-    name = benches;
-    config = Criterion::default().sample_size(20).measurement_time(std::time::Duration::from_secs(2));
-    targets = step_all
+fn main() {
+    common::run(step_all, 2);
 }
-criterion_main!(benches);
