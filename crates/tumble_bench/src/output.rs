@@ -148,6 +148,25 @@ fn fmt_ns(ns: f64) -> String {
     }
 }
 
+/// Appends a markdown table to `s`: the paragraph `caption`, the `header` row, the `align` row,
+/// one row per item as `row` writes it, and a blank line.
+fn table<T>(
+    s: &mut String,
+    caption: &str,
+    header: &str,
+    align: &str,
+    items: impl IntoIterator<Item = T>,
+    row: impl Fn(T) -> String,
+) {
+    let _ = writeln!(s, "{caption}\n");
+    let _ = writeln!(s, "{header}");
+    let _ = writeln!(s, "{align}");
+    for item in items {
+        let _ = writeln!(s, "{}", row(item));
+    }
+    s.push('\n');
+}
+
 /// The full markdown report: machine, per-size table per integrator, targets.
 pub fn markdown(results: &BenchResults) -> String {
     let mut s = String::new();
@@ -161,37 +180,33 @@ pub fn markdown(results: &BenchResults) -> String {
         results.kernel_path, results.pool_threads, results.bytes_per_body_step
     );
     for integrator in crate::INTEGRATORS.map(|i| i.name()) {
-        let _ = writeln!(s, "**{integrator}** — ns per body-step (median)\n");
-        let _ = writeln!(
-            s,
-            "| bodies | raw 1t | ECS 1t | ECS/raw | raw 2t | ECS 2t | ECS/raw | 1t/2t | rapier | rapier/ECS 1t | ECS 1t / memory floor |"
+        table(
+            &mut s,
+            &format!("**{integrator}** — ns per body-step (median)"),
+            "| bodies | raw 1t | ECS 1t | ECS/raw | raw 2t | ECS 2t | ECS/raw | 1t/2t | rapier | rapier/ECS 1t | ECS 1t / memory floor |",
+            "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
+            rows_of(results, integrator),
+            |r| {
+                let rapier = r.rapier.map_or("–".into(), fmt_ns);
+                let vs = r
+                    .rapier
+                    .map_or("–".into(), |x| format!("{:.1}×", x / r.ecs_1t));
+                format!(
+                    "| {} | {} | {} | {:.2} | {} | {} | {:.2} | {:.2} | {} | {} | {:.1} |",
+                    r.bodies,
+                    fmt_ns(r.raw_1t),
+                    fmt_ns(r.ecs_1t),
+                    r.ecs_1t / r.raw_1t,
+                    fmt_ns(r.raw_2t),
+                    fmt_ns(r.ecs_2t),
+                    r.ecs_2t / r.raw_2t,
+                    r.ecs_1t / r.ecs_2t,
+                    rapier,
+                    vs,
+                    r.ecs_1t / floor,
+                )
+            },
         );
-        let _ = writeln!(
-            s,
-            "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
-        );
-        for r in rows_of(results, integrator) {
-            let rapier = r.rapier.map_or("–".into(), fmt_ns);
-            let vs = r
-                .rapier
-                .map_or("–".into(), |x| format!("{:.1}×", x / r.ecs_1t));
-            let _ = writeln!(
-                s,
-                "| {} | {} | {} | {:.2} | {} | {} | {:.2} | {:.2} | {} | {} | {:.1} |",
-                r.bodies,
-                fmt_ns(r.raw_1t),
-                fmt_ns(r.ecs_1t),
-                r.ecs_1t / r.raw_1t,
-                fmt_ns(r.raw_2t),
-                fmt_ns(r.ecs_2t),
-                r.ecs_2t / r.raw_2t,
-                r.ecs_1t / r.ecs_2t,
-                rapier,
-                vs,
-                r.ecs_1t / floor,
-            );
-        }
-        s.push('\n');
     }
     let u = &results.unused_feature;
     let _ = writeln!(
@@ -214,30 +229,26 @@ pub fn rollback_markdown(rows: &[crate::rollback::RollbackRow]) -> String {
     if rows.is_empty() {
         return s;
     }
-    let _ = writeln!(
-        s,
+    table(
+        &mut s,
         "**rollback** snapshot of a loaded spring world (chains, gravity, a force at a point and \
-         damping on every body), `RollbackSnapshot::capture_into` and `restore`, medians\n"
+         damping on every body), `RollbackSnapshot::capture_into` and `restore`, medians",
+        "| bodies | bytes / body | rapier bytes / body | capture | restore | one step | restore + 8 steps |",
+        "|---:|---:|---:|---:|---:|---:|---:|",
+        rows,
+        |r| {
+            format!(
+                "| {} | {:.0} | ≈ {:.0} (its #991) | {:.0} µs | {:.0} µs | {:.0} µs | {:.1} ms |",
+                r.bodies,
+                r.bytes_per_body,
+                crate::rollback::RAPIER_BYTES_PER_BODY,
+                r.capture_us,
+                r.restore_us,
+                r.step_us,
+                (r.restore_us + 8.0 * r.step_us) / 1000.0
+            )
+        },
     );
-    let _ = writeln!(
-        s,
-        "| bodies | bytes / body | rapier bytes / body | capture | restore | one step | restore + 8 steps |"
-    );
-    let _ = writeln!(s, "|---:|---:|---:|---:|---:|---:|---:|");
-    for r in rows {
-        let _ = writeln!(
-            s,
-            "| {} | {:.0} | ≈ {:.0} (its #991) | {:.0} µs | {:.0} µs | {:.0} µs | {:.1} ms |",
-            r.bodies,
-            r.bytes_per_body,
-            crate::rollback::RAPIER_BYTES_PER_BODY,
-            r.capture_us,
-            r.restore_us,
-            r.step_us,
-            (r.restore_us + 8.0 * r.step_us) / 1000.0
-        );
-    }
-    s.push('\n');
     s
 }
 
@@ -247,23 +258,22 @@ pub fn exact_markdown(rows: &[crate::exact::ExactRow]) -> String {
     if rows.is_empty() {
         return s;
     }
-    let _ = writeln!(
-        s,
-        "**exact** free rotation against `splitting` — ns per body-step, ECS, 1 thread\n"
+    table(
+        &mut s,
+        "**exact** free rotation against `splitting` — ns per body-step, ECS, 1 thread",
+        "| bodies | splitting | exact | exact / splitting |",
+        "|---:|---:|---:|---:|",
+        rows,
+        |r| {
+            format!(
+                "| {} | {} | {} | {:.1}× |",
+                r.bodies,
+                fmt_ns(r.splitting_ns),
+                fmt_ns(r.exact_ns),
+                r.ratio()
+            )
+        },
     );
-    let _ = writeln!(s, "| bodies | splitting | exact | exact / splitting |");
-    let _ = writeln!(s, "|---:|---:|---:|---:|");
-    for r in rows {
-        let _ = writeln!(
-            s,
-            "| {} | {} | {} | {:.1}× |",
-            r.bodies,
-            fmt_ns(r.splitting_ns),
-            fmt_ns(r.exact_ns),
-            r.ratio()
-        );
-    }
-    s.push('\n');
     s
 }
 
@@ -271,72 +281,63 @@ pub fn exact_markdown(rows: &[crate::exact::ExactRow]) -> String {
 pub fn springs_markdown(springs: &SpringResults) -> String {
     let mut s = String::new();
     let reference = springs.explicit_reference().unwrap_or(f64::NAN);
-    let _ = writeln!(
-        s,
+    table(
+        &mut s,
         "**Spring chain** (ten asymmetric bodies, off-centre anchors, Δt = 1/60; `relaxed`: springs \
          at rest length, the same energy at every stiffness; `stretched`: springs 10 % long, energy \
-         ∝ k) — µs per step (median), and relative to the explicit step at ωΔt = 0.5 (relaxed)\n"
+         ∝ k) — µs per step (median), and relative to the explicit step at ωΔt = 0.5 (relaxed)",
+        "| start | spring step | ωΔt | µs/step | × explicit 0.5 | clean |",
+        "|---|---|---:|---:|---:|:---:|",
+        &springs.stiffness,
+        |r| {
+            format!(
+                "| {} | {} | {} | {:.1} | {:.1} | {} |",
+                r.start,
+                r.springs,
+                r.omega_dt,
+                r.us_per_step,
+                r.us_per_step / reference,
+                if r.clean { "yes" } else { "**no**" }
+            )
+        },
     );
-    let _ = writeln!(
-        s,
-        "| start | spring step | ωΔt | µs/step | × explicit 0.5 | clean |"
-    );
-    let _ = writeln!(s, "|---|---|---:|---:|---:|:---:|");
-    for r in &springs.stiffness {
-        let _ = writeln!(
-            s,
-            "| {} | {} | {} | {:.1} | {:.1} | {} |",
-            r.start,
-            r.springs,
-            r.omega_dt,
-            r.us_per_step,
-            r.us_per_step / reference,
-            if r.clean { "yes" } else { "**no**" }
-        );
-    }
-    s.push('\n');
-    let _ = writeln!(
-        s,
+    table(
+        &mut s,
         "**Spring throughput** (chains of ten, relaxed, with gravity, a force at a body point and \
-         damping on every body) — ns per spring-step (median)\n"
+         damping on every body) — ns per spring-step (median)",
+        "| springs | spring step | ωΔt | ns/spring-step |",
+        "|---:|---|---:|---:|",
+        &springs.throughput,
+        |r| {
+            format!(
+                "| {} | {} | {} | {} |",
+                r.springs,
+                r.mode,
+                r.omega_dt,
+                fmt_ns(r.ns_per_spring_step)
+            )
+        },
     );
-    let _ = writeln!(s, "| springs | spring step | ωΔt | ns/spring-step |");
-    let _ = writeln!(s, "|---:|---|---:|---:|");
-    for r in &springs.throughput {
-        let _ = writeln!(
-            s,
-            "| {} | {} | {} | {} |",
-            r.springs,
-            r.mode,
-            r.omega_dt,
-            fmt_ns(r.ns_per_spring_step)
-        );
-    }
-    s.push('\n');
-    let _ = writeln!(
-        s,
+    table(
+        &mut s,
         "**Stages** (the same loaded chains, explicit springs at ωΔt = 0.5, through the ECS): \
          substeps and `yoshida4`'s fourth-order composition, ns per body-step (median) and \
-         relative to `splitting` in one stage\n"
+         relative to `splitting` in one stage",
+        "| bodies | integrator | substeps | stages | ns/body-step | × one stage |",
+        "|---:|---|---:|---:|---:|---:|",
+        &springs.stages,
+        |r| {
+            format!(
+                "| {} | `{}` | {} | {} | {} | {:.2} |",
+                r.bodies,
+                r.integrator,
+                r.substeps,
+                r.stages,
+                fmt_ns(r.ns_per_body_step),
+                r.ratio
+            )
+        },
     );
-    let _ = writeln!(
-        s,
-        "| bodies | integrator | substeps | stages | ns/body-step | × one stage |"
-    );
-    let _ = writeln!(s, "|---:|---|---:|---:|---:|---:|");
-    for r in &springs.stages {
-        let _ = writeln!(
-            s,
-            "| {} | `{}` | {} | {} | {} | {:.2} |",
-            r.bodies,
-            r.integrator,
-            r.substeps,
-            r.stages,
-            fmt_ns(r.ns_per_body_step),
-            r.ratio
-        );
-    }
-    s.push('\n');
     s
 }
 
@@ -366,33 +367,31 @@ pub fn replace_between_markers(text: &str, section: &str) -> Option<String> {
 /// The README's section: the latest ratios of the default integrator, and the targets.
 pub fn readme_section(results: &BenchResults) -> String {
     let mut s = String::new();
-    let _ = writeln!(
-        s,
-        "Latest `tumble bench` ({} pool threads, {:.1} GB/s copy bandwidth, kernel path `{}`), \
-         default integrator, ns per body-step:\n",
-        results.pool_threads, results.bandwidth_gb_s[0], results.kernel_path
+    table(
+        &mut s,
+        &format!(
+            "Latest `tumble bench` ({} pool threads, {:.1} GB/s copy bandwidth, kernel path `{}`), \
+             default integrator, ns per body-step:",
+            results.pool_threads, results.bandwidth_gb_s[0], results.kernel_path
+        ),
+        "| bodies | raw loop | ECS | ECS/raw | ECS, 2 threads | speed-up | rapier | rapier/ECS |",
+        "|---:|---:|---:|---:|---:|---:|---:|---:|",
+        rows_of(results, DEFAULT),
+        |r| {
+            format!(
+                "| {} | {} | {} | {:.2} | {} | {:.2}× | {} | {} |",
+                r.bodies,
+                fmt_ns(r.raw_1t),
+                fmt_ns(r.ecs_1t),
+                r.ecs_1t / r.raw_1t,
+                fmt_ns(r.ecs_2t),
+                r.ecs_1t / r.ecs_2t,
+                r.rapier.map_or("–".into(), fmt_ns),
+                r.rapier
+                    .map_or("–".into(), |x| format!("{:.1}×", x / r.ecs_1t)),
+            )
+        },
     );
-    let _ = writeln!(
-        s,
-        "| bodies | raw loop | ECS | ECS/raw | ECS, 2 threads | speed-up | rapier | rapier/ECS |"
-    );
-    let _ = writeln!(s, "|---:|---:|---:|---:|---:|---:|---:|---:|");
-    for r in rows_of(results, DEFAULT) {
-        let _ = writeln!(
-            s,
-            "| {} | {} | {} | {:.2} | {} | {:.2}× | {} | {} |",
-            r.bodies,
-            fmt_ns(r.raw_1t),
-            fmt_ns(r.ecs_1t),
-            r.ecs_1t / r.raw_1t,
-            fmt_ns(r.ecs_2t),
-            r.ecs_1t / r.ecs_2t,
-            r.rapier.map_or("–".into(), fmt_ns),
-            r.rapier
-                .map_or("–".into(), |x| format!("{:.1}×", x / r.ecs_1t)),
-        );
-    }
-    s.push('\n');
     s.push_str(&springs_markdown(&results.springs));
     s.push_str(&exact_markdown(&results.exact));
     s.push_str(&rollback_markdown(&results.rollback));
