@@ -12,6 +12,9 @@ use tumble::bevy_ecs::prelude::*;
 use tumble::math::{Quat, Real, Vec3};
 use tumble::prelude::*;
 
+#[path = "../crates/tumble_ecs/tests/common/stages.rs"]
+mod stages;
+
 /// The system allocator, counting allocations per thread.
 struct Counting;
 
@@ -108,13 +111,8 @@ fn world(integrator: Integrator, bodies: usize) -> World {
 fn physics_steps_do_not_allocate() {
     // The plain step, a kick–drift method, and steps of several stages (the composition, and
     // substeps of it: the stage systems and the held loads).
-    for (integrator, substeps) in [
-        (Integrator::Splitting, 1),
-        (Integrator::SymplecticEuler, 1),
-        (Integrator::Yoshida4, 1),
-        (Integrator::Splitting, 4),
-        (Integrator::Yoshida4, 2),
-    ] {
+    let one_stage = [(Integrator::Splitting, 1), (Integrator::SymplecticEuler, 1)];
+    for (integrator, substeps) in one_stage.into_iter().chain(stages::SEVERAL_STAGES) {
         let mut world = world(integrator, 1000);
         world.resource_mut::<PhysicsSettings>().substeps =
             std::num::NonZeroU32::new(substeps).unwrap();

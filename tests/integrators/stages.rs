@@ -14,11 +14,7 @@ use tumble::prelude::*;
 /// drift integrates a constant force exactly, so `x = ½ (F/m) Δt²`.
 #[test]
 fn a_load_added_before_a_step_of_several_stages_is_applied_once() {
-    for (integrator, substeps) in [
-        (Integrator::Splitting, 4),
-        (Integrator::Yoshida4, 1),
-        (Integrator::Yoshida4, 3),
-    ] {
+    for (integrator, substeps) in crate::several_stages::SEVERAL_STAGES {
         let dt: Real = 0.1;
         let mut w = World::new();
         w.insert_resource(

@@ -3,6 +3,8 @@
 //! 100, without numerical damping; the choice of method is the planner's, and can be forced.
 
 mod common;
+#[path = "common/stages.rs"]
+mod stages;
 
 use bevy_ecs::prelude::*;
 use tumble_core::math::{Quat, Real, Vec3, to_f64};
@@ -118,11 +120,7 @@ fn stiff_springs_keep_their_energy_at_every_omega_dt() {
 /// backward stage included): a stiff chain keeps its energy within the same 5 %.
 #[test]
 fn stiff_springs_keep_their_energy_in_steps_of_several_stages() {
-    for (integrator, substeps) in [
-        (Integrator::Yoshida4, 1),
-        (Integrator::Splitting, 3),
-        (Integrator::Yoshida4, 2),
-    ] {
+    for (integrator, substeps) in stages::SEVERAL_STAGES {
         for omega_dt in [10.0, 100.0] {
             let settings = PhysicsSettings::new(DT, integrator)
                 .unwrap()
