@@ -3,7 +3,7 @@
 use tumble::math::{Quat, Real, Vec3, to_f64};
 use tumble::parry::math::Pose;
 use tumble::parry::shape::{
-    Ball, Capsule, Compound, Cone, ConvexPolyhedron, Cuboid, Cylinder, SharedShape,
+    Ball, Capsule, Compound, Cone, ConvexPolyhedron, Cuboid, Cylinder, Shape, SharedShape,
 };
 use tumble::prelude::*;
 
@@ -18,6 +18,20 @@ fn rho() -> Density {
 fn close(a: Real, b: f64, tol: f64, what: &str) {
     let r = (to_f64(a) - b).abs() / b.abs();
     assert!(r < tol, "{what}: {a} vs {b} (rel {r:e})");
+}
+
+/// The mass properties (density 750 kg/m³) of the round shape along y of half height `hh` and
+/// radius `r` that `new(hh, r)` builds, and its full height.
+fn along_y<S: Shape>(hh: f64, r: f64, new: fn(Real, Real) -> S) -> (MassProperties, f64) {
+    let props = mass_properties_of(&new(hh as Real, r as Real), rho()).unwrap();
+    (props, 2.0 * hh)
+}
+
+/// [`close`] with [`TOL`] for each `(value, closed form, what)`.
+fn closed_forms(checks: &[(Real, f64, &str)]) {
+    for &(a, b, what) in checks {
+        close(a, b, TOL, what);
+    }
 }
 
 /// [`close`] for each of `values` against the one expected `b` (moments equal by symmetry).
@@ -52,69 +66,62 @@ fn cuboid_is_m_b2_c2_over_12() {
     let shape = Cuboid::new(Vec3::new(a as Real, b as Real, c as Real) * 0.5);
     let props = mass_properties_of(&shape, rho()).unwrap();
     let m = 750.0 * a * b * c;
-    close(props.mass(), m, TOL, "box mass");
     let i = props.principal_inertia();
-    close(i.x, m * (b * b + c * c) / 12.0, TOL, "box Ixx");
-    close(i.y, m * (a * a + c * c) / 12.0, TOL, "box Iyy");
-    close(i.z, m * (a * a + b * b) / 12.0, TOL, "box Izz");
     // The closed-form constructor agrees.
     let direct =
         MassProperties::solid_cuboid(Mass::new(m as Real).unwrap(), shape.half_extents).unwrap();
-    close(
-        direct.principal_inertia().y,
-        m * (a * a + c * c) / 12.0,
-        TOL,
-        "solid_cuboid",
-    );
+    closed_forms(&[
+        (props.mass(), m, "box mass"),
+        (i.x, m * (b * b + c * c) / 12.0, "box Ixx"),
+        (i.y, m * (a * a + c * c) / 12.0, "box Iyy"),
+        (i.z, m * (a * a + b * b) / 12.0, "box Izz"),
+        (
+            direct.principal_inertia().y,
+            m * (a * a + c * c) / 12.0,
+            "solid_cuboid",
+        ),
+    ]);
 }
 
 #[test]
 fn cylinder_axial_half_m_r2_transverse_m_3r2_h2_over_12() {
     let (hh, r) = (0.4_f64, 0.15);
-    let h = 2.0 * hh;
-    let props = mass_properties_of(&Cylinder::new(hh as Real, r as Real), rho()).unwrap();
+    let (props, h) = along_y(hh, r, Cylinder::new);
     let m = 750.0 * PI * r * r * h;
-    close(props.mass(), m, TOL, "cylinder mass");
     let i = props.principal_inertia();
-    close(i.y, 0.5 * m * r * r, TOL, "cylinder axial (y)");
-    all_close(
-        &[i.x, i.z],
-        m * (3.0 * r * r + h * h) / 12.0,
-        TOL,
-        "cylinder transverse",
-    );
+    let transverse = m * (3.0 * r * r + h * h) / 12.0;
+    closed_forms(&[
+        (props.mass(), m, "cylinder mass"),
+        (i.y, 0.5 * m * r * r, "cylinder axial (y)"),
+        (i.x, transverse, "cylinder transverse"),
+        (i.z, transverse, "cylinder transverse"),
+    ]);
 }
 
 #[test]
 fn cone_moments_and_centre_of_mass() {
     let (hh, r) = (0.5_f64, 0.2);
-    let h = 2.0 * hh;
-    let props = mass_properties_of(&Cone::new(hh as Real, r as Real), rho()).unwrap();
+    let (props, h) = along_y(hh, r, Cone::new);
     let m = 750.0 * PI * r * r * h / 3.0;
-    close(props.mass(), m, TOL, "cone mass");
     let i = props.principal_inertia();
-    close(i.y, 0.3 * m * r * r, TOL, "cone axial");
-    // About the centre of mass: 3/20 m r² + 3/80 m h².
-    close(
-        i.x,
-        0.15 * m * r * r + 3.0 / 80.0 * m * h * h,
-        TOL,
-        "cone transverse",
-    );
-    // Centre of mass a quarter of the height above the base (base at y = −h/2).
-    close(
-        props.local_center_of_mass().y,
-        -hh + h / 4.0,
-        TOL,
-        "cone com",
-    );
+    closed_forms(&[
+        (props.mass(), m, "cone mass"),
+        (i.y, 0.3 * m * r * r, "cone axial"),
+        // About the centre of mass: 3/20 m r² + 3/80 m h².
+        (
+            i.x,
+            0.15 * m * r * r + 3.0 / 80.0 * m * h * h,
+            "cone transverse",
+        ),
+        // Centre of mass a quarter of the height above the base (base at y = −h/2).
+        (props.local_center_of_mass().y, -hh + h / 4.0, "cone com"),
+    ]);
 }
 
 #[test]
 fn capsule_is_cylinder_plus_two_hemispheres() {
     let (hh, r) = (0.3_f64, 0.1);
-    let h = 2.0 * hh;
-    let props = mass_properties_of(&Capsule::new_y(hh as Real, r as Real), rho()).unwrap();
+    let (props, h) = along_y(hh, r, Capsule::new_y);
     let m_cyl = 750.0 * PI * r * r * h;
     let m_sph = 750.0 * 4.0 / 3.0 * PI * r.powi(3);
     close(props.mass(), m_cyl + m_sph, TOL, "capsule mass");
