@@ -10,7 +10,7 @@ use tumble_rapier::{
 };
 use tumble_reference::exact::TorqueFreeTop;
 use tumble_scene::text::terminal_safe;
-use tumble_scene::{ForceDef, Scene};
+use tumble_scene::{Scene, SceneForce};
 
 use crate::exit::{self, Failure};
 
@@ -40,7 +40,7 @@ pub fn run(scene: &Scene, settings: Settings) -> Result<(), Failure> {
         springs,
         rapier_springs,
     } = settings;
-    let comparison = comparison_scene(scene)?;
+    let comparison = comparison_scene(scene);
     let mut sprung = vec![false; comparison.bodies.len()];
     for spring in &comparison.springs {
         sprung[spring.a] = true;
@@ -185,7 +185,7 @@ pub fn run(scene: &Scene, settings: Settings) -> Result<(), Failure> {
 }
 
 /// The scene as both engines run it: bodies with their loads and damping, and the springs.
-fn comparison_scene(scene: &Scene) -> Result<ComparisonScene, Failure> {
+fn comparison_scene(scene: &Scene) -> ComparisonScene {
     let states = scene.body_states();
     let mut bodies: Vec<ComparisonBody> = states
         .iter()
@@ -197,56 +197,46 @@ fn comparison_scene(scene: &Scene) -> Result<ComparisonScene, Failure> {
             b
         })
         .collect();
-    let index = |name: &str| {
-        states
-            .iter()
-            .position(|s| s.name == name)
-            .ok_or_else(|| Failure::from("unknown body"))
-    };
-    let vec = |v: &[f64; 3]| glam::DVec3::from_array(*v).narrow();
     let mut spring_defs = Vec::new();
-    for force in &scene.file().forces {
-        match force {
-            ForceDef::Constant { body, force, point } => {
-                bodies[index(body)?].loads.push(Load::Force {
-                    force: vec(force),
-                    local_point: point.as_ref().map(vec),
+    for force in scene.forces() {
+        match *force {
+            SceneForce::Constant { body, force, point } => {
+                bodies[body].loads.push(Load::Force {
+                    force,
+                    local_point: point,
                 });
             }
-            ForceDef::Torque { body, torque } => {
-                bodies[index(body)?].loads.push(Load::Torque(vec(torque)));
+            SceneForce::Torque { body, torque } => {
+                bodies[body].loads.push(Load::Torque(torque));
             }
-            ForceDef::Spring {
+            SceneForce::Spring {
                 a,
                 anchor_a,
                 b,
                 anchor_b,
-                stiffness,
-                damping,
-                rest_length,
-            } => {
-                let b = match b {
-                    Some(b) => ComparisonSpringEnd::Body {
-                        body: index(b)?,
-                        anchor: vec(anchor_b),
+                k,
+                c,
+                rest,
+            } => spring_defs.push(ComparisonSpring {
+                a,
+                anchor_a,
+                b: match b {
+                    Some(body) => ComparisonSpringEnd::Body {
+                        body,
+                        anchor: anchor_b,
                     },
-                    None => ComparisonSpringEnd::World(vec(anchor_b)),
-                };
-                spring_defs.push(ComparisonSpring {
-                    a: index(a)?,
-                    anchor_a: vec(anchor_a),
-                    b,
-                    stiffness: stiffness.narrow(),
-                    damping: damping.narrow(),
-                    rest_length: rest_length.narrow(),
-                });
-            }
+                    None => ComparisonSpringEnd::World(anchor_b),
+                },
+                stiffness: k,
+                damping: c,
+                rest_length: rest,
+            }),
         }
     }
-    Ok(ComparisonScene {
+    ComparisonScene {
         springs: spring_defs,
         ..ComparisonScene::new(scene.dt(), scene.gravity(), bodies)
-    })
+    }
 }
 
 /// Prints each engine's total energy (kinetic + spring + gravity, [`ComparisonScene::total_energy`])
@@ -290,7 +280,7 @@ mod tests {
     fn the_bundled_stiff_chain_is_the_preset() {
         let text = include_str!("../../../scenes/stiff_chain.toml");
         let scene = Scene::parse("stiff_chain.toml", text).expect("a valid scene");
-        let file = comparison_scene(&scene).expect("a comparable scene");
+        let file = comparison_scene(&scene);
         let preset = spring_chain(10.0, ChainStart::Stretched, 1);
         let close = |a: Real, b: Real| (a - b).abs() <= 1e-6 * (1.0 + b.abs());
         let close3 = |a: Vec3, b: Vec3| (0..3).all(|k| close(a[k], b[k]));

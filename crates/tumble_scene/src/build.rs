@@ -31,7 +31,7 @@ pub struct Scene {
     settings: PhysicsSettings,
     steps: u64,
     gravity: Option<Vec3>,
-    forces: Vec<ValidForce>,
+    forces: Vec<SceneForce>,
 }
 
 /// One body of a [`Scene`], as the engine will start it.
@@ -60,24 +60,42 @@ struct ValidBody {
     damping: Damping,
 }
 
-#[derive(Debug, Clone, PartialEq)]
-enum ValidForce {
+/// A force generator of a [`Scene`] as its checks accepted it: bodies by their index in file
+/// order ([`Scene::body_states`]), vectors and numbers in the engine precision.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum SceneForce {
+    /// A constant force on `body`, at its centre of mass or at `point` (body frame).
     Constant {
+        /// The body's index.
         body: usize,
+        /// The force (N), world frame.
         force: Vec3,
+        /// Where it acts, body coordinates relative to the origin; `None`: the centre of mass.
         point: Option<Vec3>,
     },
+    /// A constant torque on `body`.
     Torque {
+        /// The body's index.
         body: usize,
+        /// The torque (N·m), world frame.
         torque: Vec3,
     },
+    /// A spring from `anchor_a` on body `a` to `anchor_b` on body `b` (body coordinates), or to
+    /// the world point `anchor_b` when `b` is `None`.
     Spring {
+        /// The first body's index.
         a: usize,
+        /// The anchor on `a`.
         anchor_a: Vec3,
+        /// The other body's index, or `None` for a world point.
         b: Option<usize>,
+        /// The anchor on `b`, or the world point.
         anchor_b: Vec3,
+        /// Stiffness (N/m), `>= 0`.
         k: Real,
+        /// Damping (N·s/m), `>= 0`.
         c: Real,
+        /// Rest length (m), `>= 0`.
         rest: Real,
     },
 }
@@ -271,6 +289,11 @@ impl Scene {
         self.gravity
     }
 
+    /// The force generators, in file order, as checked.
+    pub fn forces(&self) -> &[SceneForce] {
+        &self.forces
+    }
+
     /// Each body with its mass properties, initial state and per-body parameters, in file
     /// order.
     pub fn body_states(&self) -> Vec<SceneBody> {
@@ -366,20 +389,20 @@ impl Scene {
         let entity = |i: usize| bodies[i].1;
         for f in &self.forces {
             match *f {
-                ValidForce::Constant { body, force, point } => {
+                SceneForce::Constant { body, force, point } => {
                     world.spawn(ConstantForce {
                         body: entity(body),
                         force,
                         local_point: point,
                     });
                 }
-                ValidForce::Torque { body, torque } => {
+                SceneForce::Torque { body, torque } => {
                     world.spawn(ConstantTorque {
                         body: entity(body),
                         torque,
                     });
                 }
-                ValidForce::Spring {
+                SceneForce::Spring {
                     a,
                     anchor_a,
                     b,
@@ -531,7 +554,7 @@ fn validate_forces(
     ck: &Checker<'_>,
     defs: &[ForceDef],
     names: &HashMap<&str, usize>,
-) -> Result<Vec<ValidForce>, SceneError> {
+) -> Result<Vec<SceneForce>, SceneError> {
     let body = |i: usize, key: &str, name: &str| {
         names.get(name).copied().ok_or_else(|| {
             ck.error(
@@ -553,12 +576,12 @@ fn validate_forces(
                 body: b,
                 force,
                 point,
-            } => ValidForce::Constant {
+            } => SceneForce::Constant {
                 body: body(i, "body", b)?,
                 force: v("force", *force)?,
                 point: point.map(|p| v("point", p)).transpose()?,
             },
-            ForceDef::Torque { body: b, torque } => ValidForce::Torque {
+            ForceDef::Torque { body: b, torque } => SceneForce::Torque {
                 body: body(i, "body", b)?,
                 torque: v("torque", *torque)?,
             },
@@ -597,7 +620,7 @@ fn validate_forces(
                         ),
                     ));
                 }
-                ValidForce::Spring {
+                SceneForce::Spring {
                     a: a_index,
                     anchor_a: v("anchor_a", *anchor_a)?,
                     b: b_index,

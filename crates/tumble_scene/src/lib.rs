@@ -21,7 +21,7 @@ mod trajectory;
 mod validate;
 
 pub use build::{
-    BuiltScene, MAX_NAME_BYTES, MAX_STEPS, MAX_SUBSTEPS, Scene, SceneBody, SceneSyntax,
+    BuiltScene, MAX_NAME_BYTES, MAX_STEPS, MAX_SUBSTEPS, Scene, SceneBody, SceneForce, SceneSyntax,
 };
 pub use error::{SaveError, SceneError};
 pub use format::{BodyDef, ForceDef, SceneFile, ShapeDef, WorldDef};
