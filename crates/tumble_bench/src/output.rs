@@ -167,6 +167,21 @@ fn table<T>(
     s.push('\n');
 }
 
+/// A [`table`] of `rows` on its own, or nothing when there are none.
+fn table_if_any<T>(
+    caption: &str,
+    header: &str,
+    align: &str,
+    rows: &[T],
+    row: impl Fn(&T) -> String,
+) -> String {
+    let mut s = String::new();
+    if !rows.is_empty() {
+        table(&mut s, caption, header, align, rows, row);
+    }
+    s
+}
+
 /// The full markdown report: machine, per-size table per integrator, targets.
 pub fn markdown(results: &BenchResults) -> String {
     let mut s = String::new();
@@ -225,12 +240,7 @@ pub fn markdown(results: &BenchResults) -> String {
 
 /// Rollback snapshots: size and time next to a step and rapier's snapshot size.
 pub fn rollback_markdown(rows: &[crate::rollback::RollbackRow]) -> String {
-    let mut s = String::new();
-    if rows.is_empty() {
-        return s;
-    }
-    table(
-        &mut s,
+    table_if_any(
         "**rollback** snapshot of a loaded spring world (chains, gravity, a force at a point and \
          damping on every body), `RollbackSnapshot::capture_into` and `restore`, medians",
         "| bodies | bytes / body | rapier bytes / body | capture | restore | one step | restore + 8 steps |",
@@ -248,18 +258,12 @@ pub fn rollback_markdown(rows: &[crate::rollback::RollbackRow]) -> String {
                 (r.restore_us + 8.0 * r.step_us) / 1000.0
             )
         },
-    );
-    s
+    )
 }
 
 /// The exact free flow's cost against the default.
 pub fn exact_markdown(rows: &[crate::exact::ExactRow]) -> String {
-    let mut s = String::new();
-    if rows.is_empty() {
-        return s;
-    }
-    table(
-        &mut s,
+    table_if_any(
         "**exact** free rotation against `splitting` — ns per body-step, ECS, 1 thread",
         "| bodies | splitting | exact | exact / splitting |",
         "|---:|---:|---:|---:|",
@@ -273,8 +277,7 @@ pub fn exact_markdown(rows: &[crate::exact::ExactRow]) -> String {
                 r.ratio()
             )
         },
-    );
-    s
+    )
 }
 
 /// The spring tables: one chain at each stiffness, then spring throughput.
