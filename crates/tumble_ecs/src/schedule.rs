@@ -415,6 +415,32 @@ impl PhysicsPlan {
     }
 }
 
+/// A [`PhysicsPlan`] with the schedule built from it: the step of a bare `World`, planned once
+/// and again only on request ([`PhysicsRunner`](crate::runner::PhysicsRunner) re-plans by
+/// itself when the world changes).
+pub struct PlannedStep {
+    /// The plan the schedule was built from.
+    pub plan: PhysicsPlan,
+    /// The schedule holding only the planned systems (one run is one stage of a step: step
+    /// with [`step`](Self::step)).
+    pub schedule: Schedule,
+}
+
+impl PlannedStep {
+    /// Plans the step for `world` ([`PhysicsPlan::for_world`]) and builds its schedule.
+    pub fn for_world(world: &mut World) -> Self {
+        let plan = PhysicsPlan::for_world(world);
+        let schedule = plan.build_schedule();
+        Self { plan, schedule }
+    }
+
+    /// Advances `world` by one step ([`PhysicsPlan::run_step`]) and clears its change trackers.
+    pub fn step(&mut self, world: &mut World) {
+        self.plan.run_step(&mut self.schedule, world);
+        world.clear_trackers();
+    }
+}
+
 /// A marker set per stage, used to chain the stages in plan order.
 #[derive(SystemSet, Debug, Clone, Copy, PartialEq, Eq, Hash)]
 struct StageSet(Stage);

@@ -1,19 +1,18 @@
 //! The same scene in tumble, through the ECS schedule a game would run.
 
 use bevy_ecs::prelude::*;
-use bevy_ecs::schedule::Schedule;
 use tumble_core::math::Vec3;
 use tumble_core::{BodyState, Integrator};
 use tumble_ecs::components::{body_state, write_body_state};
 use tumble_ecs::prelude::*;
+use tumble_ecs::schedule::PlannedStep;
 
 use crate::scene::{ComparisonScene, ComparisonSpringEnd, Load};
 
 /// A tumble world holding the bodies of a [`ComparisonScene`] and its planned schedule.
 pub struct TumbleScene {
     world: World,
-    schedule: Schedule,
-    plan: PhysicsPlan,
+    physics: PlannedStep,
     entities: Vec<Entity>,
 }
 
@@ -97,12 +96,10 @@ impl TumbleScene {
                 rest_length: spring.rest_length,
             });
         }
-        let plan = PhysicsPlan::for_world(&mut world);
-        let schedule = plan.build_schedule();
+        let physics = PlannedStep::for_world(&mut world);
         Self {
             world,
-            schedule,
-            plan,
+            physics,
             entities,
         }
     }
@@ -110,8 +107,7 @@ impl TumbleScene {
     /// Plans the world again (after a change of its settings or resources) and rebuilds the
     /// schedule.
     pub fn replan(&mut self) {
-        self.plan = PhysicsPlan::for_world(&mut self.world);
-        self.schedule = self.plan.build_schedule();
+        self.physics = PlannedStep::for_world(&mut self.world);
     }
 
     /// The world, to add resources (e.g. a threading policy) or read components.
@@ -121,8 +117,7 @@ impl TumbleScene {
 
     /// Advances tumble by one step.
     pub fn step(&mut self) {
-        self.plan.run_step(&mut self.schedule, &mut self.world);
-        self.world.clear_trackers();
+        self.physics.step(&mut self.world);
     }
 
     /// The state of body `i` (position = centre of mass).

@@ -5,12 +5,12 @@ use std::num::NonZeroU32;
 use tumble_core::math::{Quat, REAL_NAME, Real, Vec3};
 
 use bevy_ecs::prelude::*;
-use bevy_ecs::schedule::Schedule;
 
 use tumble_core::shapes::parry::shape::{Ball, Capsule, Cone, Cuboid, Cylinder};
 use tumble_core::shapes::{HullError, convex_hull_mass_properties, mass_properties_of};
 use tumble_core::{Density, Integrator, Mass, MassProperties};
 use tumble_ecs::prelude::*;
+use tumble_ecs::schedule::PlannedStep;
 
 use crate::error::{SaveError, SceneError};
 use crate::format::{BodyDef, ForceDef, SceneFile, ShapeDef, WorldDef};
@@ -104,11 +104,9 @@ pub enum SceneForce {
 pub struct BuiltScene {
     /// The world.
     pub world: World,
-    /// The schedule holding only the systems the scene needs (one run is one stage of a step:
-    /// step with [`step`](Self::step)).
-    pub schedule: Schedule,
-    /// The plan the schedule was built from.
-    pub plan: PhysicsPlan,
+    /// The plan of the systems the scene needs and their schedule (step with
+    /// [`step`](Self::step)).
+    pub physics: PlannedStep,
     /// `(name, entity)` of every body, in file order.
     pub bodies: Vec<(String, Entity)>,
 }
@@ -429,12 +427,10 @@ impl Scene {
                 }
             }
         }
-        let plan = PhysicsPlan::for_world(&mut world);
-        let schedule = plan.build_schedule();
+        let physics = PlannedStep::for_world(&mut world);
         BuiltScene {
             world,
-            schedule,
-            plan,
+            physics,
             bodies,
         }
     }
@@ -456,14 +452,12 @@ impl BuiltScene {
     /// Advances the world by one step (the schedule once per stage) and clears its change
     /// trackers.
     pub fn step(&mut self) {
-        self.plan.run_step(&mut self.schedule, &mut self.world);
-        self.world.clear_trackers();
+        self.physics.step(&mut self.world);
     }
 
     /// Plans the world again (after a change of its resources) and rebuilds the schedule.
     pub fn replan(&mut self) {
-        self.plan = PhysicsPlan::for_world(&mut self.world);
-        self.schedule = self.plan.build_schedule();
+        self.physics = PlannedStep::for_world(&mut self.world);
     }
 }
 

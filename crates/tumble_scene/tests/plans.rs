@@ -13,10 +13,10 @@ fn plan_of(name: &str) -> (String, usize) {
         .join(format!("{name}.toml"));
     let mut built = load_scene(&path).unwrap().build();
     let world: &mut World = &mut built.world;
-    built.schedule.initialize(world).unwrap();
+    built.physics.schedule.initialize(world).unwrap();
     (
         PhysicsPlan::for_world(world).to_string(),
-        built.schedule.systems_len(),
+        built.physics.schedule.systems_len(),
     )
 }
 
