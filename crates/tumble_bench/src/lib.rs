@@ -10,6 +10,7 @@
 #![warn(missing_docs)]
 
 pub mod bandwidth;
+pub mod csv;
 pub mod engines;
 pub mod exact;
 pub mod measure;
@@ -22,7 +23,7 @@ use std::path::PathBuf;
 use tumble_core::math::Vec3;
 
 use serde::Serialize;
-use tumble_core::Integrator;
+use tumble_core::{Integrator, KernelPath};
 use tumble_ecs::parallel::{Parallelism, pool_threads};
 use tumble_scene::output::{OutputError, create_directory, write_atomically};
 use tumble_scene::text::path_for_terminal;
@@ -108,6 +109,12 @@ pub struct BenchResults {
     pub pool_threads: usize,
     /// The SIMD kernel path that ran (`avx512`, `avx2`, `portable`; `TUMBLE_KERNEL` forces one).
     pub kernel_path: String,
+    /// The widest kernel path this CPU runs: a run on another one was forced.
+    pub widest_kernel_path: String,
+    /// The CPU, as the operating system names it (`model name` of `/proc/cpuinfo`).
+    pub cpu: String,
+    /// When the run started (UTC, RFC 3339, to the second).
+    pub date: String,
     /// Copy bandwidth (read + write), GB/s, one thread and all pool threads.
     pub bandwidth_gb_s: [f64; 2],
     /// Bytes a body-step must move through memory in the ECS (read + write), for the floor.
@@ -124,6 +131,8 @@ pub struct BenchResults {
     pub exact: Vec<exact::ExactRow>,
     /// Rollback snapshots: bytes per body, capture and restore time.
     pub rollback: Vec<rollback::RollbackRow>,
+    /// Trajectory CSV writing throughput.
+    pub csv: Vec<csv::CsvRow>,
     /// The targets of issue #7 and of the stiff-springs issue.
     pub targets: Vec<Target>,
 }
@@ -141,6 +150,7 @@ pub fn bytes_per_body_step() -> usize {
 
 /// Runs the benchmark; `progress` receives one line per measurement.
 pub fn run_bench(options: &BenchOptions, mut progress: impl FnMut(&str)) -> BenchResults {
+    let started = std::time::SystemTime::now();
     let max = options
         .max_bodies
         .unwrap_or(if options.quick { 10_000 } else { 1_000_000 });
@@ -235,10 +245,21 @@ pub fn run_bench(options: &BenchOptions, mut progress: impl FnMut(&str)) -> Benc
         if options.quick { 3 } else { 21 },
         &mut progress,
     );
+    let csv_bodies = if options.quick { 10_000 } else { 100_000 };
+    progress(&format!("trajectory CSV of {csv_bodies} bodies"));
+    let csv = csv::measure(csv_bodies, 10, 3)
+        .map_err(|e| eprintln!("the CSV measurement failed: {e}"))
+        .into_iter()
+        .collect();
     let mut results = BenchResults {
-        schema: 1,
+        schema: 2,
         pool_threads: pool_threads(),
         kernel_path: tumble_core::kernel_path().to_string(),
+        widest_kernel_path: KernelPath::available()
+            .last()
+            .map_or("portable".to_owned(), |p| p.to_string()),
+        cpu: cpu_name(),
+        date: humantime::format_rfc3339_seconds(started).to_string(),
         bandwidth_gb_s: bandwidth,
         bytes_per_body_step: bytes_per_body_step(),
         rows,
@@ -247,10 +268,23 @@ pub fn run_bench(options: &BenchOptions, mut progress: impl FnMut(&str)) -> Benc
         springs,
         exact,
         rollback,
+        csv,
         targets: Vec::new(),
     };
     results.targets = output::targets(&results);
     results
+}
+
+/// The CPU's model name from `/proc/cpuinfo` (Linux), or `unknown CPU`.
+fn cpu_name() -> String {
+    std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|info| {
+            info.lines()
+                .find_map(|l| l.strip_prefix("model name")?.split_once(':'))
+                .map(|(_, name)| name.trim().to_owned())
+        })
+        .unwrap_or_else(|| "unknown CPU".to_owned())
 }
 
 /// Both the raw loop and the ECS really moved the bodies, to the same place bit for bit (the
@@ -292,11 +326,18 @@ pub fn run_and_write(options: &BenchOptions) -> Result<(), Box<dyn std::error::E
     let results = run_bench(options, |line| eprintln!("… {line}"));
     let table = output::markdown(&results);
     println!("{table}");
+    // A run on the widest path writes `bench.md`; one forced onto a narrower path writes
+    // `bench-<path>.md` and its own README section, so both stay on record side by side.
+    let name = if results.kernel_path == results.widest_kernel_path {
+        "bench".to_owned()
+    } else {
+        format!("bench-{}", results.kernel_path)
+    };
     if let Some(dir) = &options.out {
         create_directory(dir)?;
-        write_atomically(&dir.join("bench.md"), table.as_bytes(), &[])?;
+        write_atomically(&dir.join(format!("{name}.md")), table.as_bytes(), &[])?;
         write_atomically(
-            &dir.join("bench.json"),
+            &dir.join(format!("{name}.json")),
             (serde_json::to_string_pretty(&results)? + "\n").as_bytes(),
             &[],
         )?;
@@ -304,12 +345,13 @@ pub fn run_and_write(options: &BenchOptions) -> Result<(), Box<dyn std::error::E
     if let Some(readme) = &options.readme {
         let text = std::fs::read_to_string(readme).map_err(|e| OutputError::io(readme, e))?;
         let section = output::readme_section(&results);
-        let updated = output::replace_between_markers(&text, &section).ok_or_else(|| {
-            format!(
-                "{}: no <!-- bench:begin --> … <!-- bench:end --> markers",
-                path_for_terminal(readme)
-            )
-        })?;
+        let updated = tumble_scene::text::replace_between_markers(&text, &name, &section)
+            .ok_or_else(|| {
+                format!(
+                    "{}: no <!-- {name}:begin --> … <!-- {name}:end --> markers",
+                    path_for_terminal(readme)
+                )
+            })?;
         write_atomically(readme, updated.as_bytes(), &[])?;
     }
     Ok(())

@@ -6,7 +6,7 @@ use serde::Serialize;
 use std::num::NonZeroU32;
 use tumble_core::math::{Real, Vec3, to_f64};
 use tumble_core::{BodyState, Integrator};
-use tumble_ecs::prelude::{PhysicsSettings, SpringSolver};
+use tumble_ecs::prelude::{Parallelism, PhysicsSettings, SpringSolver};
 use tumble_rapier::presets::{ChainStart, spring_chain};
 use tumble_rapier::{ComparisonScene, Load, TumbleScene};
 
@@ -99,6 +99,13 @@ impl SpringWorld {
         }
     }
 
+    /// The same world stepped under `parallelism`.
+    pub fn with_parallelism(mut self, parallelism: Parallelism) -> Self {
+        self.tumble.world_mut().insert_resource(parallelism);
+        self.tumble.replan();
+        self
+    }
+
     /// The world (for the rollback measurements).
     pub fn world_mut(&mut self) -> &mut bevy_ecs::world::World {
         self.tumble.world_mut()
@@ -145,7 +152,9 @@ pub struct ThroughputRow {
     pub mode: String,
     /// Nominal `√(k/μ)Δt`.
     pub omega_dt: f64,
-    /// Median ns per spring-step.
+    /// Threads that stepped the world.
+    pub threads: usize,
+    /// Median ns per spring-step (chains of ten: one spring per body, so also per body-step).
     pub ns_per_spring_step: f64,
 }
 
@@ -182,6 +191,15 @@ pub struct SpringResults {
 }
 
 impl SpringResults {
+    /// ns per spring-step of the loaded chains with `springs` springs stepped as `mode` (a
+    /// `ThroughputRow::mode`) on one thread.
+    pub fn throughput_one_thread(&self, springs: usize, mode: &str) -> Option<f64> {
+        self.throughput
+            .iter()
+            .find(|r| r.springs == springs && r.mode == mode && r.threads == 1)
+            .map(|r| r.ns_per_spring_step)
+    }
+
     /// µs per step of the explicit step on the relaxed chain at ωΔt = 0.5, the reference of
     /// the cost targets.
     pub fn explicit_reference(&self) -> Option<f64> {
@@ -245,13 +263,19 @@ pub fn run(quick: bool, mut progress: impl FnMut(&str)) -> SpringResults {
     };
     for &springs in sizes {
         let chains = springs / 10;
-        for (mode, omega_dt) in [
-            (SpringSolver::Explicit, 0.5),
-            (SpringSolver::Implicit, 0.5),
-            (SpringSolver::Implicit, 10.0),
-        ] {
+        // One thread, as the free-body rows they are compared with; the explicit step again on
+        // every pool thread, to show what the threaded path gains with springs.
+        let threaded = Parallelism::default();
+        let runs = [
+            (SpringSolver::Explicit, 0.5, Parallelism::SINGLE_THREAD),
+            (SpringSolver::Explicit, 0.5, threaded),
+            (SpringSolver::Implicit, 0.5, Parallelism::SINGLE_THREAD),
+            (SpringSolver::Implicit, 10.0, Parallelism::SINGLE_THREAD),
+        ];
+        for (mode, omega_dt, parallelism) in runs {
+            let threads = parallelism.threads_for(springs);
             progress(&format!(
-                "{springs} springs, {} at ωΔt {omega_dt}",
+                "{springs} springs, {} at ωΔt {omega_dt}, {threads} thread(s)",
                 mode_name(mode)
             ));
             let mut world = SpringWorld::new(
@@ -260,12 +284,14 @@ pub fn run(quick: bool, mut progress: impl FnMut(&str)) -> SpringResults {
                 ChainStart::Relaxed,
                 mode,
                 Loads::GravityForcesDamping,
-            );
+            )
+            .with_parallelism(parallelism);
             let ns = compare(&mut [&mut world], springs, &effort)[0];
             throughput.push(ThroughputRow {
                 springs,
                 mode: mode_name(mode).to_owned(),
                 omega_dt: to_f64(omega_dt),
+                threads,
                 ns_per_spring_step: ns,
             });
         }
@@ -284,6 +310,7 @@ pub fn run(quick: bool, mut progress: impl FnMut(&str)) -> SpringResults {
             springs,
             mode: RAPIER_JOINT.to_owned(),
             omega_dt: 0.5,
+            threads: 1,
             ns_per_spring_step: ns,
         });
     }

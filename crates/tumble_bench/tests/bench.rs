@@ -37,11 +37,25 @@ fn small_run_measures_every_engine_and_writes_json() {
     );
     assert!(!results.targets.iter().any(|t| t.name.contains("1e5")));
     let json: serde_json::Value = serde_json::to_value(&results).unwrap();
-    assert_eq!(json["schema"], 1);
+    assert_eq!(json["schema"], 2);
+    // Where, when and on which kernel path it ran.
+    assert!(json["cpu"].as_str().is_some_and(|c| !c.is_empty()));
+    assert!(
+        json["date"]
+            .as_str()
+            .is_some_and(|d| d.len() == 20 && d.ends_with('Z'))
+    );
+    assert!(json["widest_kernel_path"].is_string());
+    // The trajectory CSV: every body at every recorded step, at a finite rate.
+    let csv = &results.csv[0];
+    assert_eq!(csv.rows, csv.bodies as u64 * csv.recorded_steps);
+    assert!(csv.megabytes_per_second.is_finite() && csv.megabytes_per_second > 0.0);
+    assert!((40.0..200.0).contains(&csv.bytes_per_row), "{csv:?}");
     assert!(json["rows"][0]["ecs_1t"].is_number());
     assert!(json["rows"][0]["rapier"].is_number());
     let table = output::markdown(&results);
     assert!(table.contains("| bodies |") && table.contains("splitting"));
+    assert!(table.contains("**trajectory CSV**") && table.contains("rapier SpringJoint"));
 }
 
 #[test]

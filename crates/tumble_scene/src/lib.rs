@@ -15,8 +15,10 @@ mod error;
 mod format;
 mod json;
 mod json_locate;
+pub mod many;
 pub mod output;
 pub mod text;
+mod tool;
 mod trajectory;
 mod validate;
 

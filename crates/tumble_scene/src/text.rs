@@ -73,33 +73,6 @@ pub fn terminal_safe_within(text: &str, max: usize) -> Cow<'_, str> {
     Cow::Owned(out)
 }
 
-/// The `main` of a tool binary (`tumble-bench`, `tumble-report`): parses the command line into
-/// `$options` (a `clap::Args`, with `--version`, and the doc comments given as the tool's
-/// about), runs `$run(&options)`, and exits with success, or prints `error: …` and fails. The
-/// calling crate needs `clap` with its `derive` feature.
-#[macro_export]
-macro_rules! tool_main {
-    ($(#[$about:meta])* $options:ty, $run:expr) => {
-        $(#[$about])*
-        #[derive(clap::Parser)]
-        #[command(version)]
-        struct Args {
-            #[command(flatten)]
-            options: $options,
-        }
-
-        fn main() -> std::process::ExitCode {
-            match ($run)(&<Args as clap::Parser>::parse().options) {
-                Ok(()) => std::process::ExitCode::SUCCESS,
-                Err(e) => {
-                    eprintln!("error: {e}");
-                    std::process::ExitCode::FAILURE
-                }
-            }
-        }
-    };
-}
-
 /// A path made safe to print (see [`terminal_safe`]); non-UTF-8 bytes are shown as `�`.
 pub fn path_for_terminal(path: &std::path::Path) -> String {
     terminal_safe(&path.to_string_lossy()).into_owned()

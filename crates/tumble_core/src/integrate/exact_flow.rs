@@ -204,34 +204,32 @@ impl Polhode {
         let big_r = d12 * s2 + d13 * s3;
         let d = d12 * s1 - d23 * s3;
         let (sign1, sign3) = (sign(s.x), sign(s.z));
-        if d > 0.0 {
-            Self {
-                about_smallest: true,
-                coeff: DVec3::new(
-                    sign1 * (p / d13).sqrt(),
-                    sign1 * sign3 * (big_r / d12).sqrt(),
-                    sign3 * (big_r / d13).sqrt(),
-                ),
-                lambda: (p * d12).sqrt(),
-                m: big_r * d23 / (p * d12),
-                m1: d13 * d / (p * d12),
-                kappa: d13 / d12,
-                nu: d23 / d12,
-            }
+        // The two cases are one formula with the roles of `(P, d₁₂)` and `(R, d₂₃)` exchanged
+        // (`λ² = a d_a`, `m = b d_b / λ²`, `m₁ = d₁₃ |D| / λ²`); only the phase rate's `κ`, `ν`
+        // take different forms.
+        let about_smallest = d > 0.0;
+        let (a, da, b, db, gap) = if about_smallest {
+            (p, d12, big_r, d23, d)
         } else {
-            Self {
-                about_smallest: false,
-                coeff: DVec3::new(
-                    sign1 * (p / d13).sqrt(),
-                    sign1 * sign3 * (p / d23).sqrt(),
-                    sign3 * (big_r / d13).sqrt(),
-                ),
-                lambda: (big_r * d23).sqrt(),
-                m: p * d12 / (big_r * d23),
-                m1: d13 * -d / (big_r * d23),
-                kappa: p * d13 / (big_r * d23),
-                nu: p / big_r,
-            }
+            (big_r, d23, p, d12, -d)
+        };
+        let (kappa, nu) = if about_smallest {
+            (d13 / d12, d23 / d12)
+        } else {
+            (p * d13 / (big_r * d23), p / big_r)
+        };
+        Self {
+            about_smallest,
+            coeff: DVec3::new(
+                sign1 * (p / d13).sqrt(),
+                sign1 * sign3 * (b / da).sqrt(),
+                sign3 * (big_r / d13).sqrt(),
+            ),
+            lambda: (a * da).sqrt(),
+            m: b * db / (a * da),
+            m1: d13 * gap / (a * da),
+            kappa,
+            nu,
         }
     }
 

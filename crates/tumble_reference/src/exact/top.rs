@@ -238,34 +238,26 @@ impl TorqueFreeTop {
             .map(|k| i[k] * w[k])
             .fold(0.0f64, |acc, x| acc.hypot(x));
 
-        let (about_smallest, coeff, lambda, m, m1);
-        if d > 0.0 || separatrix {
-            about_smallest = false;
-            let (s1, s3) = (sign(w[0]), sign(w[2]));
-            coeff = [
-                s1 * (m_plus / (i1 * (i3 - i1))).sqrt(),
-                s1 * s3 * (m_plus / (i2 * (i3 - i2))).sqrt(),
-                s3 * (m_minus / (i3 * (i3 - i1))).sqrt(),
-            ];
-            lambda = ((i3 - i2) * m_minus / (i1 * i2 * i3)).sqrt();
-            if separatrix {
-                (m, m1) = (1.0, 0.0);
-            } else {
-                m = (i2 - i1) * m_plus / ((i3 - i2) * m_minus);
-                m1 = (i3 - i1) * d / ((i3 - i2) * m_minus);
-            }
+        // The two cases (momentum about the largest or the smallest axis) are one formula with
+        // the roles of `(M² − 2EI₁, I₃ − I₂)` and `(2EI₃ − M², I₂ − I₁)` exchanged.
+        let about_smallest = !(d > 0.0 || separatrix);
+        let (a, gap_a, b, gap_b, d_signed) = if about_smallest {
+            (m_plus, i2 - i1, m_minus, i3 - i2, -d)
         } else {
-            about_smallest = true;
-            let (s1, s3) = (sign(w[0]), sign(w[2]));
-            coeff = [
-                s1 * (m_plus / (i1 * (i3 - i1))).sqrt(),
-                s1 * s3 * (m_minus / (i2 * (i2 - i1))).sqrt(),
-                s3 * (m_minus / (i3 * (i3 - i1))).sqrt(),
-            ];
-            lambda = ((i2 - i1) * m_plus / (i1 * i2 * i3)).sqrt();
-            m = (i3 - i2) * m_minus / ((i2 - i1) * m_plus);
-            m1 = (i3 - i1) * (-d) / ((i2 - i1) * m_plus);
-        }
+            (m_minus, i3 - i2, m_plus, i2 - i1, d)
+        };
+        let (s1, s3) = (sign(w[0]), sign(w[2]));
+        let coeff = [
+            s1 * (m_plus / (i1 * (i3 - i1))).sqrt(),
+            s1 * s3 * (b / (i2 * gap_a)).sqrt(),
+            s3 * (m_minus / (i3 * (i3 - i1))).sqrt(),
+        ];
+        let lambda = (gap_a * a / (i1 * i2 * i3)).sqrt();
+        let (m, m1) = if separatrix {
+            (1.0, 0.0)
+        } else {
+            (gap_b * b / (gap_a * a), (i3 - i1) * d_signed / (gap_a * a))
+        };
         // Euler axes (a, b, c) = sorted (2, 3, 1) in both cases: the cyclic relabelling
         // x → y → z → x is the rotation by 120° about (1, 1, 1).
         let cyclic = DQuat::from_axis_angle(DVec3::ONE.normalize(), 2.0 * FRAC_PI_3);
