@@ -274,6 +274,10 @@ pub fn run(quick: bool, mut progress: impl FnMut(&str)) -> SpringResults {
         ];
         for (mode, omega_dt, parallelism) in runs {
             let threads = parallelism.threads_for(springs);
+            if threads == 1 && parallelism != Parallelism::SINGLE_THREAD {
+                // Too small a world for the pool: the one-thread row already says it all.
+                continue;
+            }
             progress(&format!(
                 "{springs} springs, {} at ωΔt {omega_dt}, {threads} thread(s)",
                 mode_name(mode)

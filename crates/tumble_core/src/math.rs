@@ -103,14 +103,16 @@ impl Narrow for f64 {
 }
 
 /// [`Widen`] and [`Narrow`] between a glam type of [`Real`]s and its `f64` counterpart, one
-/// component at a time (trait impls for several types: a function cannot write them).
+/// named component at a time (trait impls for several types: a function cannot write them;
+/// the components are spelled out rather than mapped over an array, which the batch loops'
+/// code generation does not see through as well).
 macro_rules! widen_and_narrow {
-    ($($real:ty => $wide:ty),*) => {$(
+    ($($real:ident => $wide:ident via $make:ident ($($c:ident),*)),*) => {$(
         impl Widen for $real {
             type Wide = $wide;
             #[inline(always)]
             fn widen(self) -> $wide {
-                <$wide>::from_array(self.to_array().map(Widen::widen))
+                $wide::$make($(self.$c.widen()),*)
             }
         }
 
@@ -118,13 +120,13 @@ macro_rules! widen_and_narrow {
             type Narrow = $real;
             #[inline(always)]
             fn narrow(self) -> $real {
-                <$real>::from_array(self.to_array().map(Narrow::narrow))
+                $real::$make($(self.$c.narrow()),*)
             }
         }
     )*};
 }
 
-widen_and_narrow!(Vec3 => DVec3, Quat => DQuat);
+widen_and_narrow!(Vec3 => DVec3 via new(x, y, z), Quat => DQuat via from_xyzw(x, y, z, w));
 
 #[cfg(test)]
 mod tests {
