@@ -181,14 +181,6 @@ impl Scene {
         Self::validate(file, &source, parsed)
     }
 
-    /// Parses and validates scene text in the given syntax (see [`SceneSyntax::of`]).
-    pub fn parse_as(syntax: SceneSyntax, file: &str, text: &str) -> Result<Self, SceneError> {
-        match syntax {
-            SceneSyntax::Toml => Self::parse(file, text),
-            SceneSyntax::Json => Self::parse_json(file, text),
-        }
-    }
-
     /// Parses and validates JSON read from `input` as a stream, without holding its text;
     /// `source` is read again only to locate an error.
     pub(crate) fn read_json(
@@ -242,7 +234,6 @@ impl Scene {
             validate_body(&ck, i, b)?;
         }
         let forces = validate_forces(&ck, &parsed.forces, &names)?;
-        drop(names);
         Ok(Self {
             file: parsed,
             settings: world.settings,
@@ -313,15 +304,8 @@ impl Scene {
 
     /// The bodies in engine form, converted from the file model as they were when checked.
     fn valid_bodies(&self) -> impl Iterator<Item = ValidBody> + '_ {
-        let ck = Checker {
-            file: &self.file.name,
-            locate: &NoText,
-        };
-        self.file.bodies.iter().enumerate().map(move |(i, b)| {
-            validate_body(&ck, i, b).unwrap_or_else(|e| {
-                unreachable!("body {i} passed this check when the scene was parsed: {e}")
-            })
-        })
+        let file = &self.file.name;
+        (self.file.bodies.iter().enumerate()).map(move |(i, b)| checked_body(file, i, b))
     }
 
     /// The scene as TOML (loading it gives the same scene).
@@ -352,16 +336,10 @@ impl Scene {
         // its pages back (a large allocation is shrunk in place).
         defs.reverse();
         let release_every = (n / 8).max(1 << 16);
-        let ck = Checker {
-            file: &self.file.name,
-            locate: &NoText,
-        };
         let mut bodies = Vec::with_capacity(n);
         let mut i = 0;
         while let Some(def) = defs.pop() {
-            let body = validate_body(&ck, i, &def).unwrap_or_else(|e| {
-                unreachable!("body {i} passed this check when the scene was parsed: {e}")
-            });
+            let body = checked_body(&self.file.name, i, &def);
             bodies.push((def.name, spawn_body(&mut world, &body)));
             i += 1;
             if i % release_every == 0 {
@@ -434,6 +412,18 @@ impl Scene {
             bodies,
         }
     }
+}
+
+/// Body `i` of a scene in engine form: [`validate_body`] again, which cannot fail on a body
+/// that passed it when the scene was parsed (a `Scene`'s model is not changed in place).
+fn checked_body(file: &str, i: usize, def: &BodyDef) -> ValidBody {
+    let ck = Checker {
+        file,
+        locate: &NoText,
+    };
+    validate_body(&ck, i, def).unwrap_or_else(|e| {
+        unreachable!("body {i} passed this check when the scene was parsed: {e}")
+    })
 }
 
 /// Spawns one body with only the components it needs.
