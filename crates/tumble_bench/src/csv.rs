@@ -40,13 +40,23 @@ fn tumbling(n: usize) -> Scene {
 }
 
 /// Writes the trajectory of `n` bodies over `steps` steps (every step recorded) into a
-/// temporary file; returns the median of `repetitions` runs by throughput.
-pub fn measure(n: usize, steps: u64, repetitions: usize) -> std::io::Result<CsvRow> {
+/// temporary file in `dir` (the system's temporary folder if `None`: it may be a small RAM disk,
+/// so the bench passes its output folder); returns the median of `repetitions` runs by
+/// throughput.
+pub fn measure(
+    n: usize,
+    steps: u64,
+    repetitions: usize,
+    dir: Option<&std::path::Path>,
+) -> std::io::Result<CsvRow> {
     let scene = tumbling(n);
     let mut runs = Vec::new();
     for _ in 0..repetitions.max(1) {
         let mut built = scene.build();
-        let file = tempfile::tempfile()?;
+        let file = match dir {
+            Some(dir) => tempfile::tempfile_in(dir)?,
+            None => tempfile::tempfile()?,
+        };
         let stats = tumble_scene::write_trajectory(
             &mut built,
             steps,

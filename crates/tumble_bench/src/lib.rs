@@ -247,7 +247,7 @@ pub fn run_bench(options: &BenchOptions, mut progress: impl FnMut(&str)) -> Benc
     );
     let csv_bodies = if options.quick { 10_000 } else { 100_000 };
     progress(&format!("trajectory CSV of {csv_bodies} bodies"));
-    let csv = csv::measure(csv_bodies, 10, 3)
+    let csv = csv::measure(csv_bodies, 10, 3, options.out.as_deref())
         .map_err(|e| eprintln!("the CSV measurement failed: {e}"))
         .into_iter()
         .collect();

@@ -2,7 +2,9 @@
 
 mod common;
 
-use common::{scene_path, scratch, scratch_file, stdout, tumble, tumble_out, tumble_run};
+use common::{
+    scene_path, scratch, scratch_dir, scratch_file, stdout, tumble, tumble_out, tumble_run,
+};
 use tumble_core::math::Real;
 use tumble_ecs::prelude::*;
 use tumble_scene::{CSV_HEADER, load_scene};
@@ -198,7 +200,7 @@ fn compare_accepts_springs_and_names_the_rapier_spring_mode() {
 
 #[test]
 fn gen_many_writes_a_valid_scene() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = scratch_dir();
     let out = dir.path().join("many.toml");
     let status = tumble()
         .args(["gen", "many", "--n", "1000", "--steps", "5", "--out"])

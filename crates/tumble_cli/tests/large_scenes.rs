@@ -1,19 +1,10 @@
 //! Large scenes: `gen many` in JSON, JSON scenes run like TOML ones, and trajectories cut down
 //! with `--every` and `--bodies`.
 
-use std::process::{Command, Output};
+mod common;
 
+use common::{scratch_dir, stderr, tumble};
 use tumble_scene::{CSV_HEADER, load_scene};
-
-fn tumble() -> Command {
-    let mut command = Command::new(env!("CARGO_BIN_EXE_tumble"));
-    command.env_remove("RUST_LOG");
-    command
-}
-
-fn stderr(output: &Output) -> String {
-    String::from_utf8_lossy(&output.stderr).into_owned()
-}
 
 fn gen_many(dir: &std::path::Path, file: &str, n: &str, extra: &[&str]) -> std::path::PathBuf {
     let path = dir.join(file);
@@ -30,7 +21,7 @@ fn gen_many(dir: &std::path::Path, file: &str, n: &str, extra: &[&str]) -> std::
 
 #[test]
 fn gen_many_writes_json_by_the_extension_and_it_is_the_toml_scene() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = scratch_dir();
     let json = gen_many(dir.path(), "many.json", "2000", &[]);
     let toml = gen_many(dir.path(), "many.toml", "2000", &[]);
     let text = std::fs::read_to_string(&json).unwrap();
@@ -94,7 +85,7 @@ fn body_caps_follow_the_format() {
 
 #[test]
 fn a_json_scene_runs_with_overrides_and_records_only_the_chosen_bodies() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = scratch_dir();
     let scene = gen_many(dir.path(), "many.json", "300", &[]);
     let csv = dir.path().join("few.csv");
     let out = tumble()
@@ -138,7 +129,7 @@ fn a_json_scene_runs_with_overrides_and_records_only_the_chosen_bodies() {
 
 #[test]
 fn bad_body_filters_are_refused_before_the_run() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = scratch_dir();
     let scene = gen_many(dir.path(), "many.json", "20", &[]);
     let csv = dir.path().join("none.csv");
     for (filter, expected) in [
@@ -176,7 +167,7 @@ fn bad_body_filters_are_refused_before_the_run() {
 
 #[test]
 fn a_json_scene_error_names_the_file_line_and_field() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = scratch_dir();
     let scene = gen_many(dir.path(), "many.json", "50", &[]);
     let text = std::fs::read_to_string(&scene).unwrap().replace(
         "{\"name\":\"b7\",\"mass\":1.14",

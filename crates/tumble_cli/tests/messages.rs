@@ -8,8 +8,8 @@ use std::path::Path;
 use std::process::Command;
 
 use common::{
-    BadValues, bad_value_runs, error_line, failure, last_error_line, scratch, scratch_file, stderr,
-    tumble, tumble_out, tumble_run,
+    BadValues, bad_value_runs, error_line, failure, last_error_line, scratch, scratch_dir,
+    scratch_file, stderr, tumble, tumble_out, tumble_run,
 };
 use tumble_scene::CSV_HEADER;
 
@@ -64,7 +64,7 @@ fn usage_errors_are_one_line_with_exit_code_2() {
 fn non_utf8_arguments_are_named_and_non_utf8_paths_work() {
     use std::ffi::OsString;
     use std::os::unix::ffi::OsStringExt;
-    let dir = tempfile::tempdir().unwrap();
+    let dir = scratch_dir();
     let bad = |prefix: &str, suffix: &str| {
         let mut bytes = prefix.as_bytes().to_vec();
         bytes.push(0xff);

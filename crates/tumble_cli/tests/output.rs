@@ -9,8 +9,8 @@ use std::process::{Child, Command, ExitStatus, Output, Stdio};
 use std::time::{Duration, Instant};
 
 use common::{
-    BadValues, bad_value_runs, error_line, failure, scene_path, scratch, scratch_file, stderr,
-    tumble, tumble_out, tumble_run,
+    BadValues, bad_value_runs, error_line, failure, scene_path, scratch, scratch_dir, scratch_file,
+    stderr, tumble, tumble_out, tumble_run,
 };
 use tumble_scene::{CSV_HEADER, MAX_SCENE_BYTES};
 
@@ -55,7 +55,7 @@ fn run_to(out: &Path, extra: &[&str]) -> Output {
 #[test]
 fn devices_fifos_and_directories_are_refused_and_left_alone() {
     use std::os::unix::fs::FileTypeExt;
-    let dir = tempfile::tempdir().unwrap();
+    let dir = scratch_dir();
     let fifo = dir.path().join("fifo.csv");
     assert!(
         Command::new("mkfifo")
@@ -136,7 +136,7 @@ fn nothing_planted_beside_the_output_is_followed_and_a_symlink_out_keeps_its_lin
 
 #[test]
 fn the_scene_file_is_never_the_output() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = scratch_dir();
     let scene = dir.path().join("chain.toml");
     let text = std::fs::read_to_string(scene_path("spring_chain")).unwrap();
     std::fs::write(&scene, &text).unwrap();
@@ -190,7 +190,7 @@ fn a_read_only_output_is_an_error_and_a_writable_one_keeps_its_mode() {
 
 #[test]
 fn names_up_to_255_bytes_work() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = scratch_dir();
     let name = format!("{}.csv", "n".repeat(251));
     assert_eq!(name.len(), 255);
     let out = dir.path().join(&name);
@@ -201,7 +201,7 @@ fn names_up_to_255_bytes_work() {
 
 #[test]
 fn errors_name_the_given_path_escaped_on_one_line() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = scratch_dir();
     let out = dir.path().join("no such dir").join("a\u{1b}[2Jb\nc.csv");
     let output = run_to(&out, &[]);
     let line = failure(&output, 1);
@@ -216,7 +216,7 @@ fn errors_name_the_given_path_escaped_on_one_line() {
 }
 
 /// A run of 1e9 steps: 3e9 rows with `--every 1` (over 700 GB: refused without `--force`),
-/// 3e6 rows with `--every 1000`.
+/// 3e4 rows (at most 8 MB) with `--every 100000`.
 const LONG_RUN: [&str; 4] = ["run", "spring_chain", "--steps", "1000000000"];
 
 /// Starts a long run writing to `out` and waits until its temporary file exists.
@@ -245,9 +245,9 @@ fn start_long_run(dir: &Path, out: &Path, extra: &[&str]) -> Child {
 #[test]
 fn sigint_and_sigterm_remove_the_temporary_file_and_exit_130() {
     for signal in ["-INT", "-TERM"] {
-        let dir = tempfile::tempdir().unwrap();
+        let dir = scratch_dir();
         let out = dir.path().join("long.csv");
-        let mut child = start_long_run(dir.path(), &out, &["--every", "1000"]);
+        let mut child = start_long_run(dir.path(), &out, &["--every", "100000"]);
         assert!(
             Command::new("kill")
                 .arg(signal)
@@ -271,9 +271,9 @@ fn sigint_and_sigterm_remove_the_temporary_file_and_exit_130() {
 
 #[test]
 fn two_concurrent_runs_never_mix_their_files() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = scratch_dir();
     let out = dir.path().join("shared.csv");
-    let args = |scene: &'static str| ["run", scene, "--steps", "40000"];
+    let args = |scene: &'static str| ["run", scene, "--steps", "8000"];
     // Each run alone, for reference.
     let mut alone = Vec::new();
     for scene in ["spring_chain", "principal_spins"] {
@@ -350,7 +350,7 @@ fn a_trajectory_bigger_than_the_free_space_is_refused_before_the_run() {
 #[cfg(unix)]
 #[test]
 fn force_skips_the_free_space_check() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = scratch_dir();
     let out = dir.path().join("forced.csv");
     let refused = tumble()
         .args(LONG_RUN)

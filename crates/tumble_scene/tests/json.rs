@@ -31,7 +31,7 @@ fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
 
 #[test]
 fn every_bundled_scene_reads_the_same_from_json() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = tempfile::tempdir_in(env!("CARGO_TARGET_TMPDIR")).unwrap();
     for (name, text) in bundled() {
         let toml = Scene::parse(&name, &text).unwrap();
         let json = serde_json::to_string_pretty(toml.file()).unwrap();
@@ -215,7 +215,7 @@ fn parse_errors_name_the_line_and_the_field() {
 
 #[test]
 fn a_json_file_is_read_as_a_stream_and_errors_are_located_in_it() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = tempfile::tempdir_in(env!("CARGO_TARGET_TMPDIR")).unwrap();
     let mut model = chain();
     model.bodies[2].mass = Some(0.0);
     let json = serde_json::to_string_pretty(&model).unwrap();

@@ -77,8 +77,8 @@ fn bad_scene_files_name_file_line_and_field() {
 
 #[test]
 fn oversized_and_missing_files_are_rejected_before_reading() {
-    let dir = std::env::temp_dir().join(format!("tumble-scene-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let scratch = tempfile::tempdir_in(env!("CARGO_TARGET_TMPDIR")).unwrap();
+    let dir = scratch.path();
     let big = dir.join("big.toml");
     let f = std::fs::File::create(&big).unwrap();
     f.set_len(100 * 1024 * 1024).unwrap(); // a sparse 100 MB file
@@ -93,7 +93,6 @@ fn oversized_and_missing_files_are_rejected_before_reading() {
             .starts_with(&format!("{}: file: cannot be read", missing.display())),
         "{e}"
     );
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]

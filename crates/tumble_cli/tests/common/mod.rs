@@ -21,9 +21,16 @@ pub fn scene_path(name: &str) -> String {
     format!("{}/../../scenes/{name}.toml", env!("CARGO_MANIFEST_DIR"))
 }
 
+/// A fresh temporary directory under the build's own scratch folder (`CARGO_TARGET_TMPDIR`),
+/// not the system's: `/tmp` may be a small RAM disk, and a test about files must not fail
+/// because the runner gave `/tmp` a few megabytes.
+pub fn scratch_dir() -> tempfile::TempDir {
+    tempfile::tempdir_in(env!("CARGO_TARGET_TMPDIR")).unwrap()
+}
+
 /// A fresh temporary directory and the path `name` in it (not created).
 pub fn scratch(name: &str) -> (tempfile::TempDir, PathBuf) {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = scratch_dir();
     let path = dir.path().join(name);
     (dir, path)
 }
