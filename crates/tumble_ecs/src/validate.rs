@@ -93,10 +93,13 @@ pub fn check_body(
     velocity: &Velocity,
     forces: Option<&ForceAccumulator>,
 ) -> Result<(), BodyErrorKind> {
-    let finite = transform.translation.is_finite()
-        && velocity.linear.is_finite()
-        && velocity.angular.is_finite()
-        && forces.is_none_or(|acc| acc.force.is_finite() && acc.torque.is_finite());
+    // Branch-free, as `BodyState::is_finite`: `0 · x` is 0 for finite x and NaN otherwise, and
+    // one NaN makes the sum NaN. (The rotation's finiteness is part of the unit test below.)
+    let mut zeros = transform.translation * 0.0 + velocity.linear * 0.0 + velocity.angular * 0.0;
+    if let Some(acc) = forces {
+        zeros += acc.force * 0.0 + acc.torque * 0.0;
+    }
+    let finite = zeros.x + zeros.y + zeros.z == 0.0;
     // The squared norm needs no square root: `|q|² − 1 = (|q| − 1)(|q| + 1)`, so
     // `||q|² − 1| ≤ tol` implies `||q| − 1| ≤ tol`; the rare quaternion in between goes
     // through the exact test in the detailed checks. NaN or Inf makes this false as well.

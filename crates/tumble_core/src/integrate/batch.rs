@@ -19,9 +19,7 @@ use super::Integrator;
 use super::exact_flow::{rotate_exactly, rotate_exactly_pair};
 use super::simd::{Kernel, LANES};
 use super::splitting::{drift_kick_drift_translation, free_rotation_span};
-use super::symmetric_kernel::{
-    LaneInputs, SymmetricInput, rotate_symmetric_lanes, rotate_symmetric_one,
-};
+use super::symmetric_kernel::{LaneInputs, rotate_symmetric_lanes, rotate_symmetric_one};
 use crate::mass::MassProperties;
 use crate::prefetch::prefetch;
 use crate::rotation::rotate_exact;
@@ -122,12 +120,13 @@ fn commit(bodies: &mut impl BodyBatch, i: usize, next: &BodyState) {
 }
 
 /// Bodies waiting for their free rotation over the same `h`, flushed [`LANES`] at a time: each
-/// body's translated state and its kernel inputs, the latter component by component so that the
-/// kernel loads them as vectors. (`h` is written once, not per body: scalar stores read back at
-/// once by a vector load stall store forwarding.)
+/// body's translated position and velocity, and its kernel inputs component by component so
+/// that the kernel loads them as vectors. (`h` is written once, not per body: scalar stores
+/// read back at once by a vector load stall store forwarding.)
 struct PendingRotations {
     index: [usize; LANES],
-    state: [BodyState; LANES],
+    /// Each queued body's `(position, linear_velocity)`: the rest of its state is the kernel's.
+    translated: [(Vec3, Vec3); LANES],
     input: LaneInputs,
     h: [Real; LANES],
     len: usize,
@@ -139,7 +138,7 @@ impl PendingRotations {
     fn new(h: Real, kernel: Kernel) -> Self {
         Self {
             index: [0; LANES],
-            state: [BodyState::ZEROED; LANES],
+            translated: [(Vec3::ZERO, Vec3::ZERO); LANES],
             input: LaneInputs::default(),
             h: [h; LANES],
             len: 0,
@@ -152,10 +151,10 @@ impl PendingRotations {
     #[inline(always)]
     fn queue(&mut self, index: usize, state: &BodyState, mass: &MassProperties) -> bool {
         let lane = self.len;
-        let input = SymmetricInput::new(state.rotation, state.angular_velocity, mass);
-        self.input.set(lane, &input);
+        self.input
+            .set(lane, state.rotation, state.angular_velocity, mass);
         self.index[lane] = index;
-        self.state[lane] = *state;
+        self.translated[lane] = (state.position, state.linear_velocity);
         self.len = lane + 1;
         self.len == LANES
     }
@@ -189,11 +188,11 @@ impl PendingRotations {
         // A fresh value rather than an update of the queued one in place: stores of the new
         // fields followed by the wide loads of `is_finite` across field boundaries would stall
         // store forwarding.
-        let queued = &self.state[lane];
+        let (position, linear_velocity) = self.translated[lane];
         let next = BodyState {
-            position: queued.position,
+            position,
             rotation,
-            linear_velocity: queued.linear_velocity,
+            linear_velocity,
             angular_velocity: omega,
         };
         commit(bodies, self.index[lane], &next);

@@ -118,7 +118,7 @@ impl<T: Lane> Free<T> {
 }
 
 /// Inputs of the kernel for one body (`T = f64`) or a run of bodies (a [`Run`] type).
-#[derive(Debug, Clone, Copy, Default)]
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct SymmetricInput<T = f64> {
     /// Body orientation `q`.
     pub rotation: Quat4<T>,
@@ -138,22 +138,36 @@ const RELABEL: [[f64; 4]; 3] = [
     [0.5, 0.5, 0.5, 0.5],
     [-0.5, -0.5, -0.5, 0.5],
 ];
+/// [`RELABEL`] in the engine precision (exact).
+const RELABEL_REAL: [[Real; 4]; 3] = [
+    [0.0, 0.0, 0.0, 1.0],
+    [0.5, 0.5, 0.5, 0.5],
+    [-0.5, -0.5, -0.5, 0.5],
+];
+
+/// The relabelling of a body: its odd axis `a` (the pair of axes with the closest reciprocal
+/// moments is the symmetric pair) and its principal moments relabelled `(a, a+1, a+2) → (x, y,
+/// z)`.
+#[inline(always)]
+fn relabelled(mass: &MassProperties) -> (usize, [Real; 3]) {
+    let r = mass.inv_principal_inertia();
+    let gaps = [(r.y - r.z).abs(), (r.x - r.z).abs(), (r.x - r.y).abs()];
+    let i = mass.principal_inertia();
+    if gaps[0] <= gaps[1] && gaps[0] <= gaps[2] {
+        (0, [i.x, i.y, i.z])
+    } else if gaps[1] <= gaps[2] {
+        (1, [i.y, i.z, i.x])
+    } else {
+        (2, [i.z, i.x, i.y])
+    }
+}
 
 impl SymmetricInput {
-    /// Builds the inputs for one body: picks the odd axis `a` (the pair of axes with the closest
-    /// reciprocal moments is the symmetric pair) and relabels `(a, a+1, a+2) → (x, y, z)`.
+    /// Builds the inputs for one body, relabelled so that its odd axis is `x` (see the module
+    /// documentation).
     #[inline]
     pub fn new(rotation: Quat, omega: Vec3, mass: &MassProperties) -> Self {
-        let r = mass.inv_principal_inertia();
-        let gaps = [(r.y - r.z).abs(), (r.x - r.z).abs(), (r.x - r.y).abs()];
-        let i = mass.principal_inertia().widen();
-        let (a, inertia) = if gaps[0] <= gaps[1] && gaps[0] <= gaps[2] {
-            (0, [i.x, i.y, i.z])
-        } else if gaps[1] <= gaps[2] {
-            (1, [i.y, i.z, i.x])
-        } else {
-            (2, [i.z, i.x, i.y])
-        };
+        let (a, inertia) = relabelled(mass);
         let f = mass.principal_frame().widen();
         let (q, w) = (rotation.widen(), omega.widen());
         Self {
@@ -161,27 +175,44 @@ impl SymmetricInput {
             omega: [w.x, w.y, w.z],
             frame: [f.x, f.y, f.z, f.w],
             relabel: RELABEL[a],
-            inertia,
+            inertia: inertia.map(Widen::widen),
         }
     }
 }
 
 /// The inputs of [`LANES`] bodies, component by component (`rotation[k][i]` is component `k` of
-/// body `i`), so that the kernel loads each component of all bodies with one vector load.
-pub type LaneInputs = SymmetricInput<[f64; LANES]>;
+/// body `i`), in the engine precision: the kernel loads each component of all bodies with one
+/// vector load and widens it with one vector conversion (every value is exact in `Real`, the
+/// relabelling's `0, ±½, 1` included).
+pub type LaneInputs = SymmetricInput<[Real; LANES]>;
 
 impl LaneInputs {
-    /// Puts one body's inputs into lane `lane`.
+    /// Puts one body's inputs into lane `lane` (what [`SymmetricInput::new`] makes of them).
     #[inline(always)]
-    pub fn set(&mut self, lane: usize, input: &SymmetricInput) {
-        for k in 0..4 {
-            self.rotation[k][lane] = input.rotation[k];
-            self.frame[k][lane] = input.frame[k];
-            self.relabel[k][lane] = input.relabel[k];
+    pub fn set(&mut self, lane: usize, rotation: Quat, omega: Vec3, mass: &MassProperties) {
+        let (a, inertia) = relabelled(mass);
+        let frame = mass.principal_frame();
+        let relabel = RELABEL_REAL[a];
+        for (k, (q, (f, p))) in [rotation.x, rotation.y, rotation.z, rotation.w]
+            .into_iter()
+            .zip(
+                [frame.x, frame.y, frame.z, frame.w]
+                    .into_iter()
+                    .zip(relabel),
+            )
+            .enumerate()
+        {
+            self.rotation[k][lane] = q;
+            self.frame[k][lane] = f;
+            self.relabel[k][lane] = p;
         }
-        for k in 0..3 {
-            self.omega[k][lane] = input.omega[k];
-            self.inertia[k][lane] = input.inertia[k];
+        for (k, (w, i)) in [omega.x, omega.y, omega.z]
+            .into_iter()
+            .zip(inertia)
+            .enumerate()
+        {
+            self.omega[k][lane] = w;
+            self.inertia[k][lane] = i;
         }
     }
 
@@ -189,11 +220,11 @@ impl LaneInputs {
     #[inline(always)]
     pub fn get(&self, lane: usize) -> SymmetricInput {
         SymmetricInput {
-            rotation: self.rotation.map(|c| c[lane]),
-            omega: self.omega.map(|c| c[lane]),
-            frame: self.frame.map(|c| c[lane]),
-            relabel: self.relabel.map(|c| c[lane]),
-            inertia: self.inertia.map(|c| c[lane]),
+            rotation: self.rotation.map(|c| c[lane].widen()),
+            omega: self.omega.map(|c| c[lane].widen()),
+            frame: self.frame.map(|c| c[lane].widen()),
+            relabel: self.relabel.map(|c| c[lane].widen()),
+            inertia: self.inertia.map(|c| c[lane].widen()),
         }
     }
 
@@ -201,7 +232,7 @@ impl LaneInputs {
     /// independent, so any valid input will do).
     #[inline(always)]
     pub fn fill_from_first(&mut self, from: usize) {
-        let fill = |c: &mut [f64; LANES]| {
+        let fill = |c: &mut [Real; LANES]| {
             let first = c[0];
             c[from..].fill(first);
         };
@@ -384,11 +415,6 @@ fn rotate_symmetric_lanes_in<T: Lane>(
     inputs: &LaneInputs,
     h: [Real; LANES],
 ) -> RotatedLanes {
-    let mut wide_h = [0.0; LANES];
-    for (wide, h) in wide_h.iter_mut().zip(h) {
-        *wide = h.widen();
-    }
-    let h = wide_h;
     let mut out = RotatedLanes {
         rotation: [[0.0; LANES]; 4],
         omega: [[0.0; LANES]; 3],
@@ -409,7 +435,7 @@ fn rotate_symmetric_lanes_in<T: Lane>(
 fn rotate_run<T: Lane>(
     cpu: T::Cpu,
     inputs: &LaneInputs,
-    h: &[f64; LANES],
+    h: &[Real; LANES],
     start: usize,
     out: &mut RotatedLanes,
 ) {
@@ -422,28 +448,21 @@ fn rotate_run<T: Lane>(
         inertia: [zero; 3],
     };
     for k in 0..4 {
-        input.rotation[k] = T::load(cpu, &inputs.rotation[k][start..]);
-        input.frame[k] = T::load(cpu, &inputs.frame[k][start..]);
-        input.relabel[k] = T::load(cpu, &inputs.relabel[k][start..]);
+        input.rotation[k] = T::load_real(cpu, &inputs.rotation[k][start..]);
+        input.frame[k] = T::load_real(cpu, &inputs.frame[k][start..]);
+        input.relabel[k] = T::load_real(cpu, &inputs.relabel[k][start..]);
     }
     for k in 0..3 {
-        input.omega[k] = T::load(cpu, &inputs.omega[k][start..]);
-        input.inertia[k] = T::load(cpu, &inputs.inertia[k][start..]);
+        input.omega[k] = T::load_real(cpu, &inputs.omega[k][start..]);
+        input.inertia[k] = T::load_real(cpu, &inputs.inertia[k][start..]);
     }
-    let (q, w) = symmetric_rotation::<T>(&input, T::load(cpu, &h[start..]));
-    // Rounded lane-wise, exactly as `to_real` rounds one body (one conversion per value).
-    let mut wide = [0.0; LANES];
+    let (q, w) = symmetric_rotation::<T>(&input, T::load_real(cpu, &h[start..]));
+    // Rounded lane-wise, exactly as `to_real` rounds one body.
     for k in 0..4 {
-        q[k].store(&mut wide);
-        for i in 0..T::WIDTH {
-            out.rotation[k][start + i] = wide[i].narrow();
-        }
+        q[k].store_real(&mut out.rotation[k][start..]);
     }
     for k in 0..3 {
-        w[k].store(&mut wide);
-        for i in 0..T::WIDTH {
-            out.omega[k][start + i] = wide[i].narrow();
-        }
+        w[k].store_real(&mut out.omega[k][start..]);
     }
 }
 
@@ -469,13 +488,17 @@ mod tests {
             (Vec3::new(1.0, 29.0, 30.0), Vec3::new(1e8, -3e7, 2e7)),
             (Vec3::new(5.0, 0.5, 4.6), Vec3::new(7.0, 0.1, -7.0)),
         ];
-        let owned: [SymmetricInput; LANES] = std::array::from_fn(|i| {
+        let bodies_in: [(Quat, Vec3, MassProperties); LANES] = std::array::from_fn(|i| {
             let (inertia, omega) = bodies[i];
             let mass = MassProperties::new(Mass::new(1.0).unwrap(), inertia)
                 .unwrap()
                 .with_principal_frame(Quat::from_rotation_x(0.2 * i as Real))
                 .unwrap();
-            SymmetricInput::new(Quat::from_rotation_y(i as Real), omega, &mass)
+            (Quat::from_rotation_y(i as Real), omega, mass)
+        });
+        let owned: [SymmetricInput; LANES] = std::array::from_fn(|i| {
+            let (rotation, omega, mass) = bodies_in[i];
+            SymmetricInput::new(rotation, omega, &mass)
         });
         let h = [
             1.0 / 60.0,
@@ -501,8 +524,9 @@ mod tests {
                 .collect()
         };
         let mut inputs = LaneInputs::default();
-        for (lane, input) in owned.iter().enumerate() {
-            inputs.set(lane, input);
+        for (lane, &(rotation, omega, mass)) in bodies_in.iter().enumerate() {
+            inputs.set(lane, rotation, omega, &mass);
+            assert_eq!(inputs.get(lane), owned[lane], "lane {lane}");
         }
         let inputs = &inputs;
         let lanes = |r: RotatedLanes| (0..LANES).map(|i| r.lane(i)).collect::<Vec<_>>();

@@ -53,6 +53,10 @@ impl Lane for Avx4 {
         splat: _mm256_set1_pd,
         load: _mm256_loadu_pd,
         store: _mm256_storeu_pd,
+        load_f32: _mm_loadu_ps,
+        widen: _mm256_cvtps_pd,
+        narrow: _mm256_cvtpd_ps,
+        store_f32: _mm_storeu_ps,
         sqrt: _mm256_sqrt_pd,
     );
     #[inline(always)]

@@ -50,6 +50,10 @@ impl Lane for Avx8 {
         splat: _mm512_set1_pd,
         load: _mm512_loadu_pd,
         store: _mm512_storeu_pd,
+        load_f32: _mm256_loadu_ps,
+        widen: _mm512_cvtps_pd,
+        narrow: _mm512_cvtpd_ps,
+        store_f32: _mm256_storeu_ps,
         sqrt: _mm512_sqrt_pd,
     );
     #[inline(always)]

@@ -44,6 +44,8 @@ pub(crate) use sin_cos::sin_cos;
 
 use std::ops::{Add, Div, Mul, Neg, Sub};
 
+use crate::math::Real;
+
 /// Number of bodies a batch kernel steps at once: one AVX-512 register of f64, or two runs of
 /// four.
 pub(crate) const LANES: usize = 8;
@@ -71,6 +73,12 @@ pub(crate) trait Lane:
     fn load(cpu: Self::Cpu, values: &[f64]) -> Self;
     /// Writes the lanes to the first `WIDTH` values of `out` (panics if there are fewer).
     fn store(self, out: &mut [f64]);
+    /// Lanes from the first `WIDTH` values of `values`, widened exactly from the engine
+    /// precision (one vector conversion, not one per value).
+    fn load_real(cpu: Self::Cpu, values: &[Real]) -> Self;
+    /// Writes the lanes, rounded to the engine precision (to nearest, as `f64 as f32`), to
+    /// the first `WIDTH` values of `out`.
+    fn store_real(self, out: &mut [Real]);
     /// The proof this value was built with.
     fn cpu(self) -> Self::Cpu;
     /// Lane-wise square root (correctly rounded).
@@ -146,8 +154,10 @@ pub(crate) use lane_ops;
 
 /// The members of [`Lane`] that both intrinsic backends write the same way around their own
 /// instructions: `Cpu`, `WIDTH`, `splat`, `load` and `store` (unaligned, `WIDTH` values),
-/// `cpu`, and `sqrt` (correctly rounded, as `f64::sqrt`). For a lane type `{ v, cpu }` whose
-/// `cpu` token proves the feature the intrinsics need.
+/// `load_real` and `store_real` (in an `f32` build: `WIDTH` f32 loaded with `load_f32` and
+/// widened by `widen`, or rounded by `narrow` and stored by `store_f32`), `cpu`, and `sqrt`
+/// (correctly rounded, as `f64::sqrt`). For a lane type `{ v, cpu }` whose `cpu` token proves
+/// the feature the intrinsics need.
 macro_rules! intrinsic_lane_members {
     (
         cpu: $cpu:ident,
@@ -155,6 +165,10 @@ macro_rules! intrinsic_lane_members {
         splat: $splat:path,
         load: $load:path,
         store: $store:path,
+        load_f32: $load_f32:path,
+        widen: $widen:path,
+        narrow: $narrow:path,
+        store_f32: $store_f32:path,
         sqrt: $sqrt:path $(,)?
     ) => {
         type Cpu = $cpu;
@@ -179,6 +193,34 @@ macro_rules! intrinsic_lane_members {
             // SAFETY: the `cpu` token proves the feature; `out` holds the `WIDTH` f64 the
             // store writes.
             unsafe { $store(out.as_mut_ptr(), self.v) };
+        }
+        #[inline(always)]
+        fn load_real(cpu: $cpu, values: &[$crate::math::Real]) -> Self {
+            let values = &values[..$width];
+            // SAFETY: the `cpu` token proves the feature; `values` holds the `WIDTH` values
+            // the load reads. Widening f32 to f64 is exact.
+            #[cfg(not(feature = "f64"))]
+            let v = unsafe { $widen($load_f32(values.as_ptr())) };
+            // SAFETY: as for `load`.
+            #[cfg(feature = "f64")]
+            let v = unsafe { $load(values.as_ptr()) };
+            Self { v, cpu }
+        }
+        #[inline(always)]
+        fn store_real(self, out: &mut [$crate::math::Real]) {
+            let out = &mut out[..$width];
+            // SAFETY: the `cpu` token proves the feature; `out` holds the `WIDTH` values the
+            // store writes. The conversion rounds by the MXCSR mode, round-to-nearest-even as
+            // Rust leaves it: the scalar `as f32`'s rounding.
+            #[cfg(not(feature = "f64"))]
+            unsafe {
+                $store_f32(out.as_mut_ptr(), $narrow(self.v))
+            };
+            // SAFETY: as for `store`.
+            #[cfg(feature = "f64")]
+            unsafe {
+                $store(out.as_mut_ptr(), self.v)
+            };
         }
         #[inline(always)]
         fn cpu(self) -> $cpu {

@@ -4,6 +4,7 @@
 use std::ops::{Add, Div, Mul, Sub};
 
 use super::{Lane, lane_ops};
+use crate::math::{Narrow, Real, Widen};
 
 /// Proof that the CPU runs the portable lanes: every CPU does, so anyone may make one.
 #[derive(Debug, Clone, Copy, Default)]
@@ -24,6 +25,14 @@ impl Lane for f64 {
     #[inline(always)]
     fn store(self, out: &mut [f64]) {
         out[0] = self;
+    }
+    #[inline(always)]
+    fn load_real(_: Portable, values: &[Real]) -> Self {
+        values[0].widen()
+    }
+    #[inline(always)]
+    fn store_real(self, out: &mut [Real]) {
+        out[0] = self.narrow();
     }
     #[inline(always)]
     fn cpu(self) -> Portable {
@@ -92,6 +101,16 @@ impl Lane for F64x4 {
     #[inline(always)]
     fn store(self, out: &mut [f64]) {
         out[..4].copy_from_slice(&self.v.to_array());
+    }
+    #[inline(always)]
+    fn load_real(cpu: Portable, values: &[Real]) -> Self {
+        let v = [values[0], values[1], values[2], values[3]];
+        Self::load(cpu, &v.map(Widen::widen))
+    }
+    #[inline(always)]
+    fn store_real(self, out: &mut [Real]) {
+        let v = self.v.to_array();
+        out[..4].copy_from_slice(&v.map(Narrow::narrow));
     }
     #[inline(always)]
     fn cpu(self) -> Portable {
