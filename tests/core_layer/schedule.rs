@@ -110,8 +110,8 @@ fn static_and_kinematic_bodies_are_never_integrated() {
     let plan = PhysicsPlan::for_world(&mut world);
     assert_eq!(
         plan.to_string(),
-        "audit_energy_start → begin_stage → apply_gravity → apply_springs → \
-         audit_external_loads → integrate_with_forces → discard_fixed_body_forces → audit_energy"
+        "audit_energy_start → begin_stage → apply_gravity → audit_external_loads → \
+         apply_springs → integrate_with_forces → discard_fixed_body_forces → audit_energy"
     );
     let mut schedule = plan.build_schedule();
     for _ in 0..100 {
@@ -288,8 +288,8 @@ fn damper_stages_only_with_a_damped_spring() {
     physics.step(&mut world);
     assert_eq!(
         physics.plan().to_string(),
-        "audit_energy_start → damp_springs_start → begin_stage → apply_springs → \
-         audit_external_loads → integrate_with_forces → damp_springs_end → audit_energy"
+        "audit_energy_start → damp_springs_start → begin_stage → audit_external_loads → \
+         apply_springs → integrate_with_forces → damp_springs_end → audit_energy"
     );
     assert_eq!(physics.replans(), 1);
     world.get_mut::<Spring>(undamped).unwrap().damping = 0.0;

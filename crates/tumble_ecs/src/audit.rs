@@ -65,11 +65,12 @@
 //! [`EnergyAudit::Always`] to have such a run audited as well (the `tumble` CLI does when it runs
 //! a world despite a warning). [`EnergyAudit::Never`] turns the audit off.
 //!
-//! The audit costs one pass over the bodies and the springs at the start of the step, one
-//! before the integration (to separate spring forces from the other loads) and one at the end:
-//! two kinetic and two elastic energies per body and spring, serial, so in a loaded spring
-//! world it is the largest single part of the step (`cargo bench --bench audit` measures the
-//! ratio on a 10⁴-body chain). Bodies are found by
+//! The audit costs one pass over the bodies and the springs at the start of the step, one over
+//! the bodies' accumulators before the springs add to them (the plan runs the springs right
+//! after it, so the other loads are read as they are, not recomputed as the sum less every
+//! spring's force), and one at the end: two kinetic and two elastic energies per body and
+//! spring, serial, so in a loaded spring world it is the largest single part of the step
+//! (`cargo bench --bench audit` measures the ratio on a 10⁴-body chain). Bodies are found by
 //! entity index in a table the ledger keeps, not by hashing; it allocates only when the world
 //! grows.
 //!
@@ -84,7 +85,7 @@ use crate::components::{
     ForceAccumulator, Gravity, GravityScale, Kinematic, MassProps, PhysicsSettings, RigidBody,
     Static, Transform, Velocity, kinetic_energy_f64,
 };
-use crate::forces::{Spring, SpringEnd, spring_force};
+use crate::forces::{Spring, SpringEnd};
 use crate::stages::StageCursor;
 use crate::systems::Dynamic;
 use crate::validate::{BodyError, BodyErrorKind, Rejected, reject};
@@ -126,13 +127,8 @@ const ROUND_OFF_ULPS: f64 = 64.0;
 struct Audited {
     entity: Entity,
     start: (Transform, Velocity),
-    /// Pose the force systems saw (before the integration), then at the end of the step (for
-    /// the springs' energy).
+    /// Pose at the end of the step (for the springs' energy).
     end: Transform,
-    /// Centre of mass in the body frame, for the torque arms of the springs' forces.
-    local_com: Vec3,
-    /// `end` holds the pose the force systems saw (the body was still audited then).
-    at_forces: bool,
     /// Every load except the springs: force and torque (world frame).
     load: (Vec3, Vec3),
     /// Mass (kg), for the springs' reduced mass.
@@ -158,8 +154,6 @@ enum End {
 #[derive(Debug, Clone, Copy)]
 struct Link {
     spring: Spring,
-    /// Stepped by the implicit step: its force is not in the accumulators.
-    implicit: bool,
     a: End,
     b: End,
 }
@@ -388,7 +382,7 @@ pub fn audit_energy_start(
     mut ledger: ResMut<EnergyLedger>,
     bodies: Query<(Entity, &Transform, &Velocity, &MassProps), Dynamic>,
     ends: Ends,
-    springs: Query<(&Spring, Has<crate::stiff::ImplicitSpring>)>,
+    springs: Query<&Spring>,
 ) {
     let ledger = &mut *ledger;
     if !cursor.span(&settings).opens_step {
@@ -406,8 +400,6 @@ pub fn audit_energy_start(
             entity,
             start: (*t, *v),
             end: *t,
-            local_com: m.local_center_of_mass(),
-            at_forces: false,
             load: (Vec3::ZERO, Vec3::ZERO),
             mass: m.mass().widen(),
             parent: i,
@@ -420,7 +412,7 @@ pub fn audit_energy_start(
         });
     }
     ledger.links.clear();
-    for (spring, implicit) in &springs {
+    for spring in &springs {
         let a = end_of(ledger, &ends, spring.a, spring.anchor_a);
         let b = match spring.b {
             SpringEnd::World(p) => End::Fixed(p),
@@ -431,7 +423,6 @@ pub fn audit_energy_start(
         }
         ledger.links.push(Link {
             spring: *spring,
-            implicit,
             a,
             b,
         });
@@ -479,11 +470,12 @@ pub fn audit_energy_start(
     }
 }
 
-/// Before the integration (after every force system): records each audited body's load
-/// without the springs, `F = ΣF − F_springs`, `τ = Στ − τ_springs`, with the springs' elastic
-/// forces evaluated exactly as [`apply_springs`](crate::forces::apply_springs) did on the same
-/// state. (Spring dampers are not forces in the accumulators: they are the velocity flow of
-/// [`crate::damping`], an energy loss the balance sees and never flags.)
+/// Before the integration, after every force system but the springs (the plan runs
+/// [`apply_springs`](crate::forces::apply_springs) right after this system in audited worlds):
+/// records each audited body's load without the springs, `F`, `τ`, as the accumulators hold it
+/// now. (Spring dampers are not forces in the accumulators: they are the velocity flow of
+/// [`crate::damping`], an energy loss the balance sees and never flags. Implicit springs never
+/// write to the accumulators.)
 pub fn audit_external_loads(
     settings: Res<PhysicsSettings>,
     cursor: Res<StageCursor>,
@@ -492,7 +484,7 @@ pub fn audit_external_loads(
         (
             Entity,
             &Transform,
-            Option<&ForceAccumulator>,
+            &ForceAccumulator,
             Option<&crate::stiff::ImplicitBody>,
         ),
         Dynamic,
@@ -507,70 +499,23 @@ pub fn audit_external_loads(
     } else {
         Some(span.h / settings.dt())
     };
-    if !span.opens_step {
-        // A later stage of the step: only the bodies still audited now get a pose below.
-        for body in &mut ledger.bodies {
-            body.at_forces = false;
-        }
-    }
-    // One pass in storage order: the pose the force systems saw (for the springs below, which
-    // then read the audit's own array instead of querying the world per spring end), and the
-    // loads.
     for (entity, t, acc, implicit) in &bodies {
-        if let Some(i) = ledger.slot(entity) {
-            let body = &mut ledger.bodies[i];
-            body.end = *t;
-            body.at_forces = true;
-            let Some(acc) = acc else {
-                continue;
-            };
-            // The torque of the forces at points an implicit body's solve takes at mid-step,
-            // credited here at the pose the forces were sampled at.
-            let torque = acc.torque + implicit.map_or(Vec3::ZERO, |b| b.point_torque(t.rotation));
-            let load = &mut body.load;
-            match share {
-                None => *load = (acc.force, torque),
-                Some(w) => {
-                    if span.opens_step {
-                        *load = (Vec3::ZERO, Vec3::ZERO);
-                    }
-                    load.0 += w * acc.force;
-                    load.1 += w * torque;
-                }
-            }
-        }
-    }
-    // Anchor point and the centre of mass, on the (half-drifted) state the force systems saw.
-    let anchor = |end: End, ledger: &EnergyLedger| match end {
-        End::Audited(i, local) => {
-            let body = &ledger.bodies[i];
-            body.at_forces.then(|| {
-                let t = body.end;
-                (t.transform_point(local), t.transform_point(body.local_com))
-            })
-        }
-        End::Fixed(p) => Some((p, p)),
-        End::Kinematic | End::Inactive => None,
-    };
-    for k in 0..ledger.links.len() {
-        let link = ledger.links[k];
-        if link.implicit {
-            continue;
-        }
-        let (Some((pa, ca)), Some((pb, cb))) = (anchor(link.a, ledger), anchor(link.b, ledger))
-        else {
+        let Some(i) = ledger.slot(entity) else {
             continue;
         };
-        let f = share.unwrap_or(1.0) * spring_force(&link.spring, pa - pb);
-        if let End::Audited(i, _) = link.a {
-            let load = &mut ledger.bodies[i].load;
-            load.0 -= f;
-            load.1 -= (pa - ca).cross(f);
-        }
-        if let End::Audited(i, _) = link.b {
-            let load = &mut ledger.bodies[i].load;
-            load.0 += f;
-            load.1 += (pb - cb).cross(f);
+        // The torque of the forces at points an implicit body's solve takes at mid-step,
+        // credited here at the pose the forces were sampled at.
+        let torque = acc.torque + implicit.map_or(Vec3::ZERO, |b| b.point_torque(t.rotation));
+        let load = &mut ledger.bodies[i].load;
+        match share {
+            None => *load = (acc.force, torque),
+            Some(w) => {
+                if span.opens_step {
+                    *load = (Vec3::ZERO, Vec3::ZERO);
+                }
+                load.0 += w * acc.force;
+                load.1 += w * torque;
+            }
         }
     }
 }

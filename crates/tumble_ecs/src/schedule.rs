@@ -16,15 +16,17 @@
 //!    exists.
 //! 2. [`PhysicsSet::Forces`] — force generators that exist in the world (constant forces,
 //!    torques, springs), and any game system placed in this set (it runs after the half drift,
-//!    on the state the forces are sampled at).
+//!    on the state the forces are sampled at). In an audited world the springs move to the
+//!    start of the next set, right after the audit has read every other load.
 //! 3. [`PhysicsSet::Integrate`] — the selected integrator. It *consumes* each accumulator (reads
 //!    and zeroes it in the same pass, so there is no separate "clear forces" pass and a force
 //!    added before a step is applied exactly once) and renormalizes each quaternion as part of
 //!    the rotation update (so there is no separate "renormalize" pass either), with the
 //!    [`Damping`] flow for half a step after (and, for a whole step, before). Then, with damped
 //!    springs, the second half-step of the spring dampers' flow (`damp_springs_end`, the springs
-//!    in reverse order). In audited worlds the audit reads the loads just before the integration
-//!    and closes the energy balance at the very end of the step. In a plan of several stages,
+//!    in reverse order). In audited worlds the audit reads the loads (all but the springs')
+//!    first, then the springs add theirs, and the audit closes the energy balance at the very
+//!    end of the step. In a plan of several stages,
 //!    `next_stage` moves the stage cursor on, last.
 //!
 //! Damping is thus a flow of its own, split symmetrically around the conservative step,
@@ -73,7 +75,8 @@ pub enum PhysicsSet {
     /// Force generators and user force systems.
     Forces,
     /// Integration (consumes accumulators, renormalizes rotations), the second half of the
-    /// damping flows, the audit's balance.
+    /// damping flows, the audit's balance. In audited worlds it opens with the audit's reading
+    /// of the loads and then the springs (see [`crate::audit`]).
     Integrate,
 }
 
@@ -125,8 +128,8 @@ impl Stage {
         Stage::Gravity,
         Stage::ConstantForces,
         Stage::ConstantTorques,
-        Stage::Springs,
         Stage::AuditExternalLoads,
+        Stage::Springs,
         Stage::SolveImplicitSprings,
         Stage::IntegrateWithForces,
         Stage::IntegrateWithoutForces,
@@ -306,7 +309,9 @@ impl PhysicsPlan {
                 .copied()
                 .unwrap_or_default()
                 .applies(c.springs);
-        // Whether each stage is needed, in the order a step runs them (`Stage::ALL`'s).
+        // Whether each stage is needed, in the order a step runs them (`Stage::ALL`'s). The
+        // springs come last among the forces, after the audit has read the others' loads, so
+        // that the audit needs no second evaluation of every spring to take theirs out again.
         let loaded = c.dynamic_with_accumulator || c.implicit_bodies;
         let needed = [
             (Stage::HoldGameLoads, staged && loaded),
@@ -319,8 +324,8 @@ impl PhysicsPlan {
             ),
             (Stage::ConstantForces, c.constant_forces),
             (Stage::ConstantTorques, c.constant_torques),
-            (Stage::Springs, c.explicit_springs),
             (Stage::AuditExternalLoads, audit && loaded),
+            (Stage::Springs, c.explicit_springs),
             (Stage::SolveImplicitSprings, c.implicit_bodies),
             (Stage::IntegrateWithForces, c.dynamic_with_accumulator),
             (Stage::IntegrateWithoutForces, c.dynamic_without_accumulator),
@@ -406,6 +411,9 @@ impl PhysicsPlan {
                 | Stage::DiscardFixedBodyForces
                 | Stage::DampSpringsEnd
                 | Stage::NextStage => PhysicsSet::Integrate,
+                // After the audit's reading of the loads when there is one (see
+                // `from_contents`), so in its set.
+                Stage::Springs if self.contains(Stage::AuditExternalLoads) => PhysicsSet::Integrate,
                 _ => PhysicsSet::Forces,
             };
             add_stage(&mut schedule, stage, set, previous);
