@@ -115,6 +115,41 @@ pub struct MassProperties {
     inv_principal_inertia: Vec3,
     principal_frame: Quat,
     local_center_of_mass: Vec3,
+    /// What the batched step asks of every body on every step, decided once when the moments
+    /// or the centre of mass are set (it fits in the struct's padding in `f32`).
+    hints: StepHints,
+}
+
+/// What the batched step asks of every body on every step, decided once.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct StepHints {
+    /// All three moments equal (no axis locked): see [`MassProperties::is_spherical`].
+    spherical: bool,
+    /// The `splitting` kernel's odd axis: see [`MassProperties::odd_axis`].
+    odd_axis: u8,
+    /// The centre of mass is not the body origin: see
+    /// [`MassProperties::has_center_of_mass_offset`].
+    offset: bool,
+}
+
+impl StepHints {
+    fn of(principal_inertia: Vec3, inv_principal_inertia: Vec3, center_of_mass: Vec3) -> Self {
+        let i = principal_inertia;
+        let r = inv_principal_inertia;
+        let gaps = [(r.y - r.z).abs(), (r.x - r.z).abs(), (r.x - r.y).abs()];
+        let odd_axis = if gaps[0] <= gaps[1] && gaps[0] <= gaps[2] {
+            0
+        } else if gaps[1] <= gaps[2] {
+            1
+        } else {
+            2
+        };
+        Self {
+            spherical: i.x > 0.0 && i.x == i.y && i.y == i.z,
+            odd_axis,
+            offset: center_of_mass != Vec3::ZERO,
+        }
+    }
 }
 
 /// Reciprocal of a principal moment, with `0` for a locked (zero-moment) axis.
@@ -139,6 +174,11 @@ impl MassProperties {
             inv_principal_inertia,
             principal_frame,
             local_center_of_mass,
+            hints: StepHints::of(
+                principal_inertia,
+                inv_principal_inertia,
+                local_center_of_mass,
+            ),
         }
     }
 
@@ -182,16 +222,18 @@ impl MassProperties {
                 return Err(InvalidInput::TriangleInequality { moments, axis });
             }
         }
+        let inv_principal_inertia = Vec3::new(
+            locked_reciprocal(principal_inertia.x),
+            locked_reciprocal(principal_inertia.y),
+            locked_reciprocal(principal_inertia.z),
+        );
         Ok(Self {
             inv_mass: 1.0 / mass.get(),
             principal_inertia,
-            inv_principal_inertia: Vec3::new(
-                locked_reciprocal(principal_inertia.x),
-                locked_reciprocal(principal_inertia.y),
-                locked_reciprocal(principal_inertia.z),
-            ),
+            inv_principal_inertia,
             principal_frame: Quat::IDENTITY,
             local_center_of_mass: Vec3::ZERO,
+            hints: StepHints::of(principal_inertia, inv_principal_inertia, Vec3::ZERO),
         })
     }
 
@@ -223,6 +265,7 @@ impl MassProperties {
     pub fn with_center_of_mass(mut self, local_center_of_mass: Vec3) -> Result<Self, InvalidInput> {
         check_finite_vec3("centre of mass", local_center_of_mass)?;
         self.local_center_of_mass = local_center_of_mass;
+        self.hints.offset = local_center_of_mass != Vec3::ZERO;
         Ok(self)
     }
 
@@ -262,12 +305,27 @@ impl MassProperties {
         self.local_center_of_mass
     }
 
+    /// True when the centre of mass is not the body origin (`c ≠ 0`; `−0` counts as 0), so
+    /// that poses and centre-of-mass positions differ by `R c`. Decided when the centre is set.
+    #[inline]
+    pub fn has_center_of_mass_offset(&self) -> bool {
+        self.hints.offset
+    }
+
     /// True when all three principal moments are equal (and no axis is locked), so `ω × Iω = 0`
     /// for every `ω` and the gyroscopic term can be skipped exactly.
     #[inline]
     pub fn is_spherical(&self) -> bool {
-        let i = self.principal_inertia;
-        i.x > 0.0 && i.x == i.y && i.y == i.z
+        self.hints.spherical
+    }
+
+    /// The axis (0, 1, 2 for x, y, z) whose reciprocal moment stands apart from the other
+    /// two, so that those two are the most nearly symmetric pair: the `splitting` kernel
+    /// relabels the axes to make it `x` (see `integrate::symmetric_kernel`). Decided once, when
+    /// the moments are set: the batched step asks it of every body on every step.
+    #[inline]
+    pub(crate) fn odd_axis(&self) -> usize {
+        usize::from(self.hints.odd_axis)
     }
 
     /// True when some principal moment is zero: rotation about that axis is locked (its angular
@@ -313,6 +371,44 @@ impl MassProperties {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The hints the batched step reads instead of recomputing them per body and step follow
+    /// the moments and the centre of mass through every way of setting them.
+    #[test]
+    fn step_hints_follow_the_moments_and_the_centre_of_mass() {
+        let m = Mass::new(2.0).unwrap();
+        for (moments, odd) in [
+            (Vec3::new(0.01, 1.0, 1.0), 0),
+            (Vec3::new(1.0, 0.01, 1.0), 1),
+            (Vec3::new(1.0, 1.0, 0.01), 2),
+            (Vec3::new(1.0, 2.0, 3.0), 0),
+            (Vec3::new(3.0, 2.0, 1.2), 2),
+            (Vec3::new(0.0, 1.0, 1.5), 0),
+        ] {
+            let props = MassProperties::new(m, moments).unwrap();
+            assert_eq!(props.odd_axis(), odd, "{moments}");
+            assert!(!props.is_spherical());
+        }
+        assert!(
+            MassProperties::new(m, Vec3::splat(0.4))
+                .unwrap()
+                .is_spherical()
+        );
+        let body = MassProperties::new(m, Vec3::new(1.0, 2.0, 3.0)).unwrap();
+        assert!(!body.has_center_of_mass_offset());
+        let shifted = body.with_center_of_mass(Vec3::new(0.0, 0.1, 0.0)).unwrap();
+        assert!(shifted.has_center_of_mass_offset());
+        let negative_zero = shifted
+            .with_center_of_mass(Vec3::new(-0.0, 0.0, -0.0))
+            .unwrap();
+        assert!(!negative_zero.has_center_of_mass_offset());
+        assert!(
+            shifted
+                .with_principal_frame(Quat::from_rotation_z(0.3))
+                .unwrap()
+                .has_center_of_mass_offset()
+        );
+    }
 
     fn one() -> Mass {
         Mass::new(1.0).unwrap()

@@ -420,14 +420,12 @@ impl Default for PhysicsSettings {
 /// bits sit there; when they happen to be a subnormal float pattern every such add takes a
 /// microcode assist (over twenty times the cost of the add).
 ///
-/// The test is `c == 0` on the bits with the sign bits shifted out (so `−0` is zero, as for
-/// `==`, and NaN is not): a few integer instructions instead of three ordered float compares
-/// with their NaN branches, on every read and write of every body.
+/// The test is the flag the mass properties keep ([`MassProperties::has_center_of_mass_offset`]),
+/// not three float compares on every read and write of every body.
 #[inline]
 fn com_offset(rotation: Quat, mass: &MassProps) -> Option<Vec3> {
-    let c = mass.local_center_of_mass();
-    let magnitude_bits = (c.x.to_bits() | c.y.to_bits() | c.z.to_bits()) << 1;
-    (magnitude_bits != 0).then(|| quat_rotate(rotation, c))
+    mass.has_center_of_mass_offset()
+        .then(|| quat_rotate(rotation, mass.local_center_of_mass()))
 }
 
 /// Kinetic energy `½ m |v|² + ½ ωᵀ I ω` (J) of a body, in `f64` (energy balances sum many

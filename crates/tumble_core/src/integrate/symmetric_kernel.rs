@@ -145,20 +145,16 @@ const RELABEL_REAL: [[Real; 4]; 3] = [
     [-0.5, -0.5, -0.5, 0.5],
 ];
 
-/// The relabelling of a body: its odd axis `a` (the pair of axes with the closest reciprocal
-/// moments is the symmetric pair) and its principal moments relabelled `(a, a+1, a+2) → (x, y,
-/// z)`.
+/// The relabelling of a body: its odd axis `a` ([`MassProperties::odd_axis`]: the pair of axes
+/// with the closest reciprocal moments is the symmetric pair) and its principal moments
+/// relabelled `(a, a+1, a+2) → (x, y, z)`.
 #[inline(always)]
 fn relabelled(mass: &MassProperties) -> (usize, [Real; 3]) {
-    let r = mass.inv_principal_inertia();
-    let gaps = [(r.y - r.z).abs(), (r.x - r.z).abs(), (r.x - r.y).abs()];
     let i = mass.principal_inertia();
-    if gaps[0] <= gaps[1] && gaps[0] <= gaps[2] {
-        (0, [i.x, i.y, i.z])
-    } else if gaps[1] <= gaps[2] {
-        (1, [i.y, i.z, i.x])
-    } else {
-        (2, [i.z, i.x, i.y])
+    match mass.odd_axis() {
+        0 => (0, [i.x, i.y, i.z]),
+        1 => (1, [i.y, i.z, i.x]),
+        _ => (2, [i.z, i.x, i.y]),
     }
 }
 
