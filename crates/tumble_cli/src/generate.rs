@@ -26,10 +26,13 @@ pub const MAX_JSON_BODIES: i64 = 10_000_000;
 /// value in (0, 6) is at most 17 significant digits, the point, and a few leading zeros).
 const RECORD_BYTES_BOUND: u64 = 128 + 9 + 3 * 4 + 7 * 25;
 
-/// The same bound for a JSON record: 180 bytes of keys, brackets, the default rotation, gravity
-/// scale and zeros (156 bytes besides the name and the 9 numbers), the name, and 9
-/// numbers of at most 24 characters (`ryu`'s shortest `f64`, exponent included).
-const JSON_RECORD_BYTES_BOUND: u64 = 180 + 9 + 9 * 24;
+/// The same bound for a JSON record (one line, [`many_body`] serialized with its default fields
+/// left out): 99 bytes of keys, brackets, commas and the line break, the name, six numbers of
+/// at most 24 characters (`ryu`'s shortest `f64`, exponent included: the mass, two moments, a
+/// velocity and two rates) and seven of at most 5 (the grid coordinates, at most `430.0` at
+/// [`MAX_JSON_BODIES`], and the constants `1.0`, `0.0`, `0.3`). A test checks it on records
+/// across the whole range.
+const JSON_RECORD_BYTES_BOUND: u64 = 99 + 9 + 6 * 24 + 7 * 5;
 
 const _: () = assert!(MAX_BODIES as u64 * RECORD_BYTES_BOUND + 256 <= MAX_SCENE_BYTES);
 const _: () =
@@ -212,5 +215,28 @@ pub fn syntax_name(syntax: SceneSyntax) -> &'static str {
     match syntax {
         SceneSyntax::Toml => "toml",
         SceneSyntax::Json => "json",
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every record `gen many` writes fits the per-record bound the body cap is derived from,
+    /// at the largest scene and at small ones (whose fractions `i/n` differ).
+    #[test]
+    fn json_records_fit_their_bound() {
+        let mut longest = 0;
+        for n in [1, 2, 3, 7, 1000, 999_983, MAX_JSON_BODIES as u64] {
+            let step = (n / 5000).max(1);
+            for i in (0..n).step_by(step as usize).chain([n - 1]) {
+                let record = serde_json::to_vec(&many_body(i, n)).unwrap();
+                // `,\n` before every record but the first.
+                longest = longest.max(record.len() as u64 + 2);
+            }
+        }
+        assert!(longest <= JSON_RECORD_BYTES_BOUND, "{longest}");
+        // The bound is not loose by more than the spread of the numbers' lengths.
+        assert!(JSON_RECORD_BYTES_BOUND - longest < 100, "{longest}");
     }
 }

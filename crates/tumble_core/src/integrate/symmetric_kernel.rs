@@ -132,14 +132,8 @@ pub struct SymmetricInput<T = f64> {
     pub inertia: Vec3L<T>,
 }
 
-/// The relabellings: `x' = a`, for the odd axis `a` = x, y, z.
-const RELABEL: [[f64; 4]; 3] = [
-    [0.0, 0.0, 0.0, 1.0],
-    [0.5, 0.5, 0.5, 0.5],
-    [-0.5, -0.5, -0.5, 0.5],
-];
-/// [`RELABEL`] in the engine precision (exact).
-const RELABEL_REAL: [[Real; 4]; 3] = [
+/// The relabellings `P`: `x' = a`, for the odd axis `a` = x, y, z (exact in any precision).
+const RELABEL: [[Real; 4]; 3] = [
     [0.0, 0.0, 0.0, 1.0],
     [0.5, 0.5, 0.5, 0.5],
     [-0.5, -0.5, -0.5, 0.5],
@@ -170,7 +164,7 @@ impl SymmetricInput {
             rotation: [q.x, q.y, q.z, q.w],
             omega: [w.x, w.y, w.z],
             frame: [f.x, f.y, f.z, f.w],
-            relabel: RELABEL[a],
+            relabel: RELABEL[a].map(Widen::widen),
             inertia: inertia.map(Widen::widen),
         }
     }
@@ -188,7 +182,7 @@ impl LaneInputs {
     pub fn set(&mut self, lane: usize, rotation: Quat, omega: Vec3, mass: &MassProperties) {
         let (a, inertia) = relabelled(mass);
         let frame = mass.principal_frame();
-        let relabel = RELABEL_REAL[a];
+        let relabel = RELABEL[a];
         for (k, (q, (f, p))) in [rotation.x, rotation.y, rotation.z, rotation.w]
             .into_iter()
             .zip(
