@@ -265,7 +265,11 @@ impl MassProperties {
     pub fn with_center_of_mass(mut self, local_center_of_mass: Vec3) -> Result<Self, InvalidInput> {
         check_finite_vec3("centre of mass", local_center_of_mass)?;
         self.local_center_of_mass = local_center_of_mass;
-        self.hints.offset = local_center_of_mass != Vec3::ZERO;
+        self.hints = StepHints::of(
+            self.principal_inertia,
+            self.inv_principal_inertia,
+            local_center_of_mass,
+        );
         Ok(self)
     }
 

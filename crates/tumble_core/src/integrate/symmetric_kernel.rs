@@ -139,16 +139,16 @@ const RELABEL: [[Real; 4]; 3] = [
     [-0.5, -0.5, -0.5, 0.5],
 ];
 
-/// The relabelling of a body: its odd axis `a` ([`MassProperties::odd_axis`]: the pair of axes
-/// with the closest reciprocal moments is the symmetric pair) and its principal moments
-/// relabelled `(a, a+1, a+2) → (x, y, z)`.
+/// A body's principal moments relabelled `(a, a+1, a+2) → (x, y, z)` for its odd axis `a`
+/// ([`MassProperties::odd_axis`]: the pair of axes with the closest reciprocal moments is the
+/// symmetric pair).
 #[inline(always)]
-fn relabelled(mass: &MassProperties) -> (usize, [Real; 3]) {
+fn relabelled_inertia(mass: &MassProperties) -> [Real; 3] {
     let i = mass.principal_inertia();
     match mass.odd_axis() {
-        0 => (0, [i.x, i.y, i.z]),
-        1 => (1, [i.y, i.z, i.x]),
-        _ => (2, [i.z, i.x, i.y]),
+        0 => [i.x, i.y, i.z],
+        1 => [i.y, i.z, i.x],
+        _ => [i.z, i.x, i.y],
     }
 }
 
@@ -157,15 +157,14 @@ impl SymmetricInput {
     /// documentation).
     #[inline]
     pub fn new(rotation: Quat, omega: Vec3, mass: &MassProperties) -> Self {
-        let (a, inertia) = relabelled(mass);
         let f = mass.principal_frame().widen();
         let (q, w) = (rotation.widen(), omega.widen());
         Self {
             rotation: [q.x, q.y, q.z, q.w],
             omega: [w.x, w.y, w.z],
             frame: [f.x, f.y, f.z, f.w],
-            relabel: RELABEL[a].map(Widen::widen),
-            inertia: inertia.map(Widen::widen),
+            relabel: RELABEL[mass.odd_axis()].map(Widen::widen),
+            inertia: relabelled_inertia(mass).map(Widen::widen),
         }
     }
 }
@@ -180,9 +179,9 @@ impl LaneInputs {
     /// Puts one body's inputs into lane `lane` (what [`SymmetricInput::new`] makes of them).
     #[inline(always)]
     pub fn set(&mut self, lane: usize, rotation: Quat, omega: Vec3, mass: &MassProperties) {
-        let (a, inertia) = relabelled(mass);
+        let inertia = relabelled_inertia(mass);
         let frame = mass.principal_frame();
-        let relabel = RELABEL[a];
+        let relabel = RELABEL[mass.odd_axis()];
         for (k, (q, (f, p))) in [rotation.x, rotation.y, rotation.z, rotation.w]
             .into_iter()
             .zip(
