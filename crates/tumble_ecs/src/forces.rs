@@ -214,24 +214,28 @@ pub fn apply_constant_forces(
     mut bodies: ForceTargets,
     mut implicit: Query<&mut ImplicitBody>,
 ) {
+    // Looked up only where some body is in an implicit group: a lookup per force otherwise.
+    let any_implicit = !implicit.is_empty();
     for gen_force in &generators {
         let Ok((transform, _, mass, mut acc)) = bodies.get_mut(gen_force.body) else {
             continue;
         };
-        match (gen_force.local_point, implicit.get_mut(gen_force.body)) {
-            (None, _) => acc.add_force(gen_force.force),
+        let Some(local) = gen_force.local_point else {
+            acc.add_force(gen_force.force);
+            continue;
+        };
+        if any_implicit && let Ok(mut implicit) = implicit.get_mut(gen_force.body) {
             // The implicit step takes the torque of a force at a point at mid-step (it turns
             // with the body): the force goes to the accumulator, its point to the solve.
-            (Some(local), Ok(mut implicit)) => {
-                acc.add_force(gen_force.force);
-                implicit.add_point_force(local - mass.local_center_of_mass(), gen_force.force);
-            }
-            (Some(local), Err(_)) => acc.add_force_at_point(
-                gen_force.force,
-                transform.transform_point(local),
-                transform.center_of_mass(mass),
-            ),
+            acc.add_force(gen_force.force);
+            implicit.add_point_force(local - mass.local_center_of_mass(), gen_force.force);
+            continue;
         }
+        acc.add_force_at_point(
+            gen_force.force,
+            transform.transform_point(local),
+            transform.center_of_mass(mass),
+        );
     }
 }
 

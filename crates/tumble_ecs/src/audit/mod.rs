@@ -68,14 +68,18 @@
 //! The audit costs one pass over the bodies and the springs at the start of the step, one over
 //! the bodies' accumulators before the springs add to them (the plan runs the springs right
 //! after it, so the other loads are read as they are, not recomputed as the sum less every
-//! spring's force), and one at the end: two kinetic and two elastic energies per body and
-//! spring, serial, so in a loaded spring world it is the largest single part of the step
+//! spring's force), and one at the end. The end pass measures one kinetic and one elastic
+//! energy per body and spring; the start pass reuses them where the body or spring is, bit for
+//! bit, as that pass left it (`memo`), and measures afresh only what game code changed. All
+//! serial, so in a loaded spring world it is the largest single part of the step
 //! (`cargo bench --bench audit` measures the ratio on a 10⁴-body chain). Bodies are found by
 //! entity index in a table the ledger keeps, not by hashing; it allocates only when the world
 //! grows.
 //!
 //! Not audited: a group holding a [`Kinematic`] body (game code moves it and does work the
 //! audit cannot see). [`Static`] bodies are fixed anchors.
+
+mod memo;
 
 use bevy_ecs::entity::EntityHashMap;
 use bevy_ecs::prelude::*;
@@ -89,6 +93,7 @@ use crate::forces::{Spring, SpringEnd};
 use crate::stages::StageCursor;
 use crate::systems::Dynamic;
 use crate::validate::{BodyError, BodyErrorKind, Rejected, reject};
+use memo::{BodyMemo, EndKey, SpringKey, SpringMemo};
 
 /// Whether a world's steps are audited for energy created by the integrator (see the module
 /// docs). Insert it as a resource to override the default, [`EnergyAudit::Auto`].
@@ -135,6 +140,8 @@ struct Audited {
     mass: f64,
     /// Union–find parent.
     parent: usize,
+    /// Unchanged since the end of the last step (bit for bit, [`memo`]).
+    still: bool,
 }
 
 /// One end of a spring as the audit sees it.
@@ -156,6 +163,24 @@ struct Link {
     spring: Spring,
     a: End,
     b: End,
+}
+
+impl Link {
+    /// What its elastic energy depends on besides its audited bodies' poses.
+    fn key(&self) -> SpringKey {
+        let end = |end: End| -> EndKey {
+            match end {
+                End::Audited(i, local) => Some((Some(i), [local.x, local.y, local.z])),
+                End::Fixed(p) => Some((None, [p.x, p.y, p.z])),
+                End::Kinematic | End::Inactive => None,
+            }
+        };
+        SpringKey {
+            stiffness: self.spring.stiffness,
+            rest_length: self.spring.rest_length,
+            ends: [end(self.a), end(self.b)],
+        }
+    }
 }
 
 /// One group's running account, keyed by its smallest entity.
@@ -208,6 +233,12 @@ pub struct EnergyLedger {
     /// Accounts were restored under some member of their group, not necessarily its smallest
     /// entity (entity ids change when a world is restored): re-key them at the next audit.
     restored: bool,
+    /// End passes so far: what the last one measured carries its number.
+    end_passes: u64,
+    /// The last end pass's kinetic energies, by body index, with their inputs ([`memo`]).
+    measured_bodies: Vec<Option<BodyMemo>>,
+    /// The last end pass's elastic energies, by link index, with their inputs.
+    measured_springs: Vec<Option<SpringMemo>>,
 }
 
 /// One group's running account as a snapshot saves it: a member of the group (any), the group's
@@ -352,6 +383,29 @@ impl EnergyLedger {
         let pb = self.anchor(link.b, pose)?;
         Some(link.spring.elastic_energy(pa, pb))
     }
+
+    /// Link `k`'s elastic energy at the start of the step: the one the last step ended with
+    /// when its inputs are the same bit for bit, else measured afresh.
+    fn start_elastic(&self, k: usize, link: &Link) -> Option<f64> {
+        if let Some(Some(memo)) = self.measured_springs.get(k)
+            && memo.pass == self.end_passes
+        {
+            let key = link.key();
+            // Its bodies are still, so their memos are from the same pass as the spring's.
+            if memo.key.same(&key) && key.bodies().all(|i| self.bodies[i].still) {
+                return memo.elastic;
+            }
+        }
+        self.elastic(link, |b| b.start.0)
+    }
+
+    /// Forgets what the last step measured: the next start measures every energy afresh.
+    /// (For tests that compare the reuse with fresh measurements.)
+    #[cfg(test)]
+    pub(crate) fn forget_measurements(&mut self) {
+        self.measured_bodies.clear();
+        self.measured_springs.clear();
+    }
 }
 
 /// Rigid bodies that are not quarantined, whatever their kind (spring ends may be static or
@@ -395,6 +449,13 @@ pub fn audit_energy_start(
     ledger.groups.clear();
     for (entity, t, v, m) in &bodies {
         let i = ledger.bodies.len();
+        let remembered = match ledger.measured_bodies.get(i) {
+            Some(Some(memo)) if memo.pass == ledger.end_passes && memo.still(entity, t, v, m) => {
+                Some(memo.kinetic())
+            }
+            _ => None,
+        };
+        let energy = remembered.unwrap_or_else(|| kinetic_energy_f64(t, v, m));
         ledger.set_slot(entity, i);
         ledger.bodies.push(Audited {
             entity,
@@ -403,8 +464,8 @@ pub fn audit_energy_start(
             load: (Vec3::ZERO, Vec3::ZERO),
             mass: m.mass().widen(),
             parent: i,
+            still: remembered.is_some(),
         });
-        let energy = kinetic_energy_f64(t, v, m);
         ledger.groups.push(GroupStep {
             start: energy,
             magnitude: energy,
@@ -458,7 +519,7 @@ pub fn audit_energy_start(
             ma * mb / (ma + mb)
         };
         let omega_dt = (link.spring.stiffness.widen() / reduced).sqrt() * ledger.stability_span;
-        let elastic = ledger.elastic(&link, |b| b.start.0);
+        let elastic = ledger.start_elastic(k, &link);
         let g = &mut ledger.groups[root];
         g.springs += 1;
         g.kinematic |= kinematic;
@@ -547,6 +608,13 @@ pub fn audit_energy(
     }
     let dt = ledger.dt;
     let gravity = gravity.map(|g| g.0);
+    // Only what this pass measures may be reused (a body it does not see keeps an older memo,
+    // which its number rules out): a spring's memo is reused only with its bodies' poses
+    // measured in the same pass.
+    ledger.end_passes += 1;
+    let pass = ledger.end_passes;
+    ledger.measured_bodies.resize(ledger.bodies.len(), None);
+    ledger.measured_springs.resize(ledger.links.len(), None);
     for (entity, t, v, m, scale, has_accumulator) in &bodies {
         let Some(i) = ledger.slot(entity) else {
             continue;
@@ -563,7 +631,9 @@ pub fn audit_energy(
         let v_mean = 0.5 * (v0.linear.widen() + v.linear.widen());
         let w_mean = 0.5 * (v0.angular.widen() + v.angular.widen());
         let work = dt * (force.widen().dot(v_mean) + torque.widen().dot(w_mean));
-        let energy = kinetic_energy_f64(t, v, m);
+        let measured = BodyMemo::measure(pass, entity, t, v, m);
+        let energy = measured.kinetic();
+        ledger.measured_bodies[i] = Some(measured);
         let g = &mut ledger.groups[root];
         g.end += energy;
         g.work += work;
@@ -574,7 +644,13 @@ pub fn audit_energy(
         let Some(root) = ledger.root_of(&link) else {
             continue;
         };
-        if let Some(v) = ledger.elastic(&link, |b| b.end) {
+        let elastic = ledger.elastic(&link, |b| b.end);
+        ledger.measured_springs[k] = Some(SpringMemo {
+            pass,
+            key: link.key(),
+            elastic,
+        });
+        if let Some(v) = elastic {
             ledger.groups[root].end += v;
             ledger.groups[root].magnitude += v;
         }
@@ -659,3 +735,6 @@ pub fn audit_energy(
     }
     ledger.accounts.retain(|_, a| a.seen);
 }
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,140 @@
+//! What the end of an audited step measured, kept for the start of the next one.
+//!
+//! The start of a step measures `T + V` of the state the previous step ended with, unless game
+//! code changed something in between. So the end pass keeps each body's kinetic energy and each
+//! spring's elastic energy together with *every input* they were computed from, and the next
+//! start reuses a value only when those inputs are the same bit for bit: a memo of two pure
+//! functions, so a reused value is the value a fresh evaluation would give. No change ticks are
+//! involved; whatever changed a body (game code, a quarantine putting it back, a rollback) shows
+//! in its bits.
+
+use bevy_ecs::entity::Entity;
+use tumble_core::math::{Quat, Real, Vec3};
+
+use crate::components::{MassProps, Transform, Velocity, kinetic_energy_f64};
+
+/// The bits of `values`: equal bits are equal inputs to the energy functions (`==` on floats
+/// would call `−0` and `+0` equal and a NaN unequal to itself).
+#[inline(always)]
+fn same_bits<const N: usize>(a: [Real; N], b: [Real; N]) -> bool {
+    a.iter().zip(&b).all(|(x, y)| x.to_bits() == y.to_bits())
+}
+
+#[inline(always)]
+fn vec3(v: Vec3) -> [Real; 3] {
+    [v.x, v.y, v.z]
+}
+
+#[inline(always)]
+fn quat(q: Quat) -> [Real; 4] {
+    [q.x, q.y, q.z, q.w]
+}
+
+/// A body as the end of the last step measured it.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct BodyMemo {
+    /// The end pass that measured it.
+    pub(super) pass: u64,
+    entity: Entity,
+    pose: Transform,
+    velocity: Velocity,
+    /// What [`kinetic_energy_f64`] reads of the mass properties: mass, principal moments and
+    /// frame.
+    inertia: (Real, Vec3, Quat),
+    kinetic: f64,
+}
+
+impl BodyMemo {
+    /// The body `entity` at `pose`, moving at `velocity`, and its kinetic energy, measured by
+    /// end pass `pass`.
+    pub(super) fn measure(
+        pass: u64,
+        entity: Entity,
+        pose: &Transform,
+        velocity: &Velocity,
+        mass: &MassProps,
+    ) -> Self {
+        Self {
+            pass,
+            entity,
+            pose: *pose,
+            velocity: *velocity,
+            inertia: (
+                mass.mass(),
+                mass.principal_inertia(),
+                mass.principal_frame(),
+            ),
+            kinetic: kinetic_energy_f64(pose, velocity, mass),
+        }
+    }
+
+    /// The kinetic energy.
+    pub(super) fn kinetic(&self) -> f64 {
+        self.kinetic
+    }
+
+    /// True when `entity` is this body and `pose`, `velocity` and `mass` are what it was
+    /// measured with, bit for bit: its kinetic energy and its springs' anchors are unchanged.
+    #[inline]
+    pub(super) fn still(
+        &self,
+        entity: Entity,
+        pose: &Transform,
+        velocity: &Velocity,
+        mass: &MassProps,
+    ) -> bool {
+        let (m, inertia, frame) = self.inertia;
+        self.entity == entity
+            && same_bits(vec3(self.pose.translation), vec3(pose.translation))
+            && same_bits(quat(self.pose.rotation), quat(pose.rotation))
+            && same_bits(vec3(self.velocity.linear), vec3(velocity.linear))
+            && same_bits(vec3(self.velocity.angular), vec3(velocity.angular))
+            && same_bits([m], [mass.mass()])
+            && same_bits(vec3(inertia), vec3(mass.principal_inertia()))
+            && same_bits(quat(frame), quat(mass.principal_frame()))
+    }
+}
+
+/// A spring's end as [`elastic_key`] sees it: the audited body's index and its anchor, or a
+/// fixed point; `None` when the spring has no energy this step.
+pub(super) type EndKey = Option<(Option<usize>, [Real; 3])>;
+
+/// Everything a spring's elastic energy depends on besides its audited bodies' poses:
+/// stiffness, rest length and both ends.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct SpringKey {
+    pub(super) stiffness: Real,
+    pub(super) rest_length: Real,
+    pub(super) ends: [EndKey; 2],
+}
+
+impl SpringKey {
+    /// The same inputs, bit for bit.
+    #[inline]
+    pub(super) fn same(&self, other: &SpringKey) -> bool {
+        let end = |a: &EndKey, b: &EndKey| match (a, b) {
+            (None, None) => true,
+            (Some((i, p)), Some((j, q))) => i == j && same_bits(*p, *q),
+            _ => false,
+        };
+        same_bits(
+            [self.stiffness, self.rest_length],
+            [other.stiffness, other.rest_length],
+        ) && end(&self.ends[0], &other.ends[0])
+            && end(&self.ends[1], &other.ends[1])
+    }
+
+    /// The audited bodies at the ends.
+    pub(super) fn bodies(&self) -> impl Iterator<Item = usize> + '_ {
+        self.ends.iter().filter_map(|end| end.and_then(|(i, _)| i))
+    }
+}
+
+/// A spring as the end of the last step measured it.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct SpringMemo {
+    /// The end pass that measured it.
+    pub(super) pass: u64,
+    pub(super) key: SpringKey,
+    pub(super) elastic: Option<f64>,
+}

@@ -1,0 +1,179 @@
+//! The start of a step reuses the energies the last step ended with only where nothing changed:
+//! a world that reuses them and one that measures every energy afresh keep the same accounts,
+//! bit for bit, whatever game code changes between the steps.
+
+use bevy_ecs::prelude::*;
+
+use super::EnergyLedger;
+use crate::prelude::*;
+
+const DT: Real = 1.0 / 60.0;
+
+/// An audited spring world: a chain of five asymmetric bodies tied to the world and, at its
+/// far end, to a static post; a free body; gravity. Returns the chain's bodies, the free body
+/// and the springs.
+fn spring_world() -> (World, Vec<Entity>, Entity, Vec<Entity>) {
+    let mut world = World::new();
+    world.insert_resource(
+        PhysicsSettings::new(DT, Integrator::Splitting)
+            .unwrap()
+            .with_springs(SpringSolver::Explicit),
+    );
+    world.insert_resource(Parallelism::SINGLE_THREAD);
+    world.insert_resource(EnergyAudit::Always);
+    world.insert_resource(Gravity(Vec3::new(0.0, -9.81, 0.0)));
+    let mass = |m: Real| {
+        let inertia = Vec3::new(0.02, 0.03, 0.04) * m;
+        MassProps(MassProperties::new(Mass::new(m).unwrap(), inertia).unwrap())
+    };
+    let spawn = |world: &mut World, x: Real, m: Real| {
+        world
+            .spawn((
+                RigidBody,
+                mass(m),
+                Transform {
+                    translation: Vec3::new(x, 0.0, 0.0),
+                    rotation: Quat::from_rotation_z(0.3 * x),
+                },
+                Velocity {
+                    linear: Vec3::ZERO,
+                    angular: Vec3::new(0.1, 0.2, 0.3),
+                },
+            ))
+            .id()
+    };
+    let bodies: Vec<Entity> = (0..5).map(|i| spawn(&mut world, i as Real, 1.0)).collect();
+    let free = spawn(&mut world, 10.0, 2.0);
+    let post = world
+        .spawn((
+            RigidBody,
+            Static,
+            mass(1.0),
+            Transform {
+                translation: Vec3::new(5.5, 0.5, 0.0),
+                rotation: Quat::from_rotation_x(0.4),
+            },
+            Velocity::default(),
+        ))
+        .id();
+    // ωΔt ≈ 0.5 for a body–body spring: stable but far from exact, so the integrator's energy
+    // error, the account the audit keeps, is large enough for a stale start energy to show.
+    let k = 0.5 * (0.5 / DT).powi(2);
+    let mut springs = vec![
+        world
+            .spawn(Spring::new(
+                bodies[0],
+                Vec3::new(-0.1, 0.05, 0.0),
+                SpringEnd::World(Vec3::new(-1.0, 0.1, 0.0)),
+                k,
+                0.8,
+            ))
+            .id(),
+    ];
+    for pair in bodies.windows(2) {
+        let end = SpringEnd::on_body(pair[1], Vec3::new(-0.1, 0.0, 0.05));
+        springs.push(
+            world
+                .spawn(Spring::new(pair[0], Vec3::new(0.1, 0.05, 0.0), end, k, 0.7))
+                .id(),
+        );
+    }
+    let end = SpringEnd::on_body(post, Vec3::new(0.0, -0.2, 0.1));
+    springs.push(
+        world
+            .spawn(Spring::new(bodies[4], Vec3::ZERO, end, k, 1.4))
+            .id(),
+    );
+    (world, bodies, free, springs)
+}
+
+/// What game code does before step `step`: kicks, pushes, turns, re-weighs, retunes, and a
+/// change undone before the step (the same bits as before: nothing to measure again).
+fn game_code(world: &mut World, step: usize, bodies: &[Entity], free: Entity, springs: &[Entity]) {
+    match step % 40 {
+        3 => world.get_mut::<Velocity>(bodies[2]).unwrap().linear += Vec3::new(0.0, 3.0, 0.0),
+        7 => world.get_mut::<Velocity>(free).unwrap().angular *= 1.5,
+        11 => world.get_mut::<Transform>(bodies[1]).unwrap().translation.x += 0.05,
+        13 => {
+            let mut t = world.get_mut::<Transform>(bodies[3]).unwrap();
+            t.rotation = (t.rotation * Quat::from_rotation_y(0.2)).normalize();
+        }
+        17 => {
+            let m = world.get::<MassProps>(bodies[0]).unwrap().0;
+            // Heavier, the same moments: only the mass shows the change.
+            let heavier =
+                MassProperties::new(Mass::new(1.5 * m.mass()).unwrap(), m.principal_inertia())
+                    .unwrap();
+            world.entity_mut(bodies[0]).insert(MassProps(heavier));
+        }
+        19 => world.get_mut::<Spring>(springs[2]).unwrap().stiffness *= 0.5,
+        23 => world.get_mut::<Spring>(springs[3]).unwrap().rest_length += 0.1,
+        29 => world.get_mut::<Spring>(springs[5]).unwrap().anchor_a.y += 0.05,
+        31 => {
+            let mut v = world.get_mut::<Velocity>(bodies[4]).unwrap();
+            let before = *v;
+            v.linear.z += 1.0;
+            *v = before;
+        }
+        37 => world.get_mut::<Transform>(bodies[4]).unwrap().translation.y -= 0.02,
+        _ => {}
+    }
+}
+
+#[test]
+fn reused_start_energies_are_the_energies_measured_afresh() {
+    let (mut reusing, bodies, free, springs) = spring_world();
+    let (mut fresh, ..) = spring_world();
+    let (plan_r, plan_f) = (
+        PhysicsPlan::for_world(&mut reusing),
+        PhysicsPlan::for_world(&mut fresh),
+    );
+    let (mut schedule_r, mut schedule_f) = (plan_r.build_schedule(), plan_f.build_schedule());
+    let mut quiet_steps_reused = 0;
+    for step in 0..400 {
+        game_code(&mut reusing, step, &bodies, free, &springs);
+        game_code(&mut fresh, step, &bodies, free, &springs);
+        fresh.resource_mut::<EnergyLedger>().forget_measurements();
+        plan_r.run_step(&mut schedule_r, &mut reusing);
+        plan_f.run_step(&mut schedule_f, &mut fresh);
+        let ledger = reusing.resource::<EnergyLedger>();
+        let accounts = ledger.saved_accounts();
+        assert_eq!(accounts.len(), 2, "the chain and the free body");
+        for (r, f) in accounts
+            .iter()
+            .zip(fresh.resource::<EnergyLedger>().saved_accounts())
+        {
+            assert_eq!(
+                r.created.to_bits(),
+                f.created.to_bits(),
+                "step {step}: {r:?} against {f:?}"
+            );
+        }
+        if step > 0 && step % 40 == 0 {
+            // No game code ran before this step: every body's energy was reused.
+            assert!(ledger.bodies.iter().all(|b| b.still), "step {step}");
+            quiet_steps_reused += 1;
+        }
+        if step % 40 == 3 {
+            let kicked = ledger.slot(bodies[2]).unwrap();
+            assert!(
+                !ledger.bodies[kicked].still,
+                "step {step}: the kick was seen"
+            );
+        }
+        reusing.clear_trackers();
+        fresh.clear_trackers();
+    }
+    assert_eq!(quiet_steps_reused, 9);
+    assert!(
+        reusing
+            .get_resource::<PhysicsErrors>()
+            .is_none_or(|e| e.0.is_empty()),
+        "a stable chain is never flagged"
+    );
+    let created = reusing.resource::<EnergyLedger>().saved_accounts();
+    assert!(
+        created.iter().any(|a| a.created.abs() > 1e-6),
+        "the accounts are not trivially zero: {created:?}"
+    );
+}
