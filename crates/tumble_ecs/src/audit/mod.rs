@@ -70,8 +70,11 @@
 //! after it, so the other loads are read as they are, not recomputed as the sum less every
 //! spring's force), and one at the end. The end pass measures one kinetic and one elastic
 //! energy per body and spring; the start pass reuses them where the body or spring is, bit for
-//! bit, as that pass left it (`memo`), and measures afresh only what game code changed. All
-//! serial, so in a loaded spring world it is the largest single part of the step
+//! bit, as that pass left it (`memo`), and measures afresh only what game code changed. When
+//! nothing changed at all (the same bodies, states, masses and springs), the start keeps the
+//! last step's groups and takes each group's `T + V` from the sum its end pass closed with
+//! (`EnergyLedger::restart`): the same number, added in the same order. All serial, so in a
+//! loaded spring world it is the largest single part of the step
 //! (`cargo bench --bench audit` measures the ratio on a 10⁴-body chain). Bodies are found by
 //! entity index in a table the ledger keeps, not by hashing; it allocates only when the world
 //! grows.
@@ -140,6 +143,8 @@ struct Audited {
     mass: f64,
     /// Union–find parent.
     parent: usize,
+    /// The group's root, once the start pass has joined every spring's ends.
+    root: usize,
     /// Unchanged since the end of the last step (bit for bit, [`memo`]).
     still: bool,
 }
@@ -239,6 +244,12 @@ pub struct EnergyLedger {
     measured_bodies: Vec<Option<BodyMemo>>,
     /// The last end pass's elastic energies, by link index, with their inputs.
     measured_springs: Vec<Option<SpringMemo>>,
+    /// The groups were closed by an end pass since the last start: their end sums are the
+    /// energies the bodies stand at now, if nothing changed ([`EnergyLedger::restart`]).
+    closed: bool,
+    /// Starts that took the unchanged world's shortcut (for tests).
+    #[cfg(test)]
+    restarts: usize,
 }
 
 /// One group's running account as a snapshot saves it: a member of the group (any), the group's
@@ -361,9 +372,9 @@ impl EnergyLedger {
     }
 
     /// The group (root index) a link belongs to, if it touches an audited body.
-    fn root_of(&mut self, link: &Link) -> Option<usize> {
+    fn root_of(&self, link: &Link) -> Option<usize> {
         match (link.a, link.b) {
-            (End::Audited(i, _), _) | (_, End::Audited(i, _)) => Some(self.find(i)),
+            (End::Audited(i, _), _) | (_, End::Audited(i, _)) => Some(self.bodies[i].root),
             _ => None,
         }
     }
@@ -399,6 +410,72 @@ impl EnergyLedger {
         self.elastic(link, |b| b.start.0)
     }
 
+    /// The start of a step when the world is, bit for bit, as the last step left it: the same
+    /// audited bodies in the same order with the same state and mass, the same springs with
+    /// the same ends. Then the groups, links and union–find of the last step hold, and each
+    /// group's `T + V` is the sum its end pass closed with: the start pass would add the same
+    /// energies (reused from the [`memo`]s) in the same order. Returns false as soon as
+    /// anything differs, having changed only what the full start pass rebuilds.
+    fn restart(&mut self, bodies: &AuditedBodies, ends: &Ends, springs: &Query<&Spring>) -> bool {
+        let mut n = 0;
+        for (entity, t, v, m) in bodies {
+            let Some(Some(memo)) = self.measured_bodies.get(n) else {
+                return false;
+            };
+            let unchanged = memo.pass == self.end_passes
+                && memo.still(entity, t, v, m)
+                && self.bodies.get(n).is_some_and(|b| b.entity == entity);
+            if !unchanged {
+                return false;
+            }
+            let body = &mut self.bodies[n];
+            body.start = (*t, *v);
+            body.end = *t;
+            body.load = (Vec3::ZERO, Vec3::ZERO);
+            body.still = true;
+            n += 1;
+        }
+        if n != self.bodies.len() {
+            return false;
+        }
+        let mut k = 0;
+        for spring in springs {
+            let Some(link) = self.links.get(k) else {
+                return false;
+            };
+            if !same_spring(&link.spring, spring) {
+                return false;
+            }
+            // An end that is not an audited body may have moved (a static body) or changed
+            // kind since: resolve it again.
+            let a = match link.a {
+                End::Audited(..) => link.a,
+                _ => end_of(self, ends, spring.a, spring.anchor_a),
+            };
+            let b = match (link.b, spring.b) {
+                (End::Audited(..), _) => link.b,
+                (_, SpringEnd::World(p)) => End::Fixed(p),
+                (_, SpringEnd::Body { body, anchor }) => end_of(self, ends, body, anchor),
+            };
+            if !(same_end(a, link.a) && same_end(b, link.b)) {
+                return false;
+            }
+            k += 1;
+        }
+        if k != self.links.len() {
+            return false;
+        }
+        for g in &mut self.groups {
+            (g.start, g.magnitude) = (g.end, g.end);
+            (g.end, g.work) = (0.0, 0.0);
+        }
+        #[cfg(test)]
+        {
+            self.restarts += 1;
+        }
+        true
+    }
+
     /// Forgets what the last step measured: the next start measures every energy afresh.
     /// (For tests that compare the reuse with fresh measurements.)
     #[cfg(test)]
@@ -428,13 +505,54 @@ fn end_of(ledger: &EnergyLedger, ends: &Ends, body: Entity, anchor: Vec3) -> End
     }
 }
 
+/// The same spring, bit for bit.
+fn same_spring(a: &Spring, b: &Spring) -> bool {
+    let bits = |s: &Spring| {
+        let (end, anchor_b) = match s.b {
+            SpringEnd::World(p) => (None, p),
+            SpringEnd::Body { body, anchor } => (Some(body), anchor),
+        };
+        let [x, y, z] = s.anchor_a.to_array();
+        let [bx, by, bz] = anchor_b.to_array();
+        (
+            (s.a, end),
+            [x, y, z, bx, by, bz, s.stiffness, s.damping, s.rest_length].map(Real::to_bits),
+        )
+    };
+    bits(a) == bits(b)
+}
+
+/// The same end, bit for bit.
+fn same_end(a: End, b: End) -> bool {
+    let bits = |p: Vec3| p.to_array().map(Real::to_bits);
+    match (a, b) {
+        (End::Audited(i, p), End::Audited(j, q)) => i == j && bits(p) == bits(q),
+        (End::Fixed(p), End::Fixed(q)) => bits(p) == bits(q),
+        (End::Kinematic, End::Kinematic) | (End::Inactive, End::Inactive) => true,
+        _ => false,
+    }
+}
+
+/// The bodies the audit watches, as its start pass reads them.
+type AuditedBodies<'w, 's> = Query<
+    'w,
+    's,
+    (
+        Entity,
+        &'static Transform,
+        &'static Velocity,
+        &'static MassProps,
+    ),
+    Dynamic,
+>;
+
 /// Start of an audited step (first in the plan): remembers each dynamic body's state, resolves
 /// the springs' ends, forms the spring groups and measures each group's `T + V`.
 pub fn audit_energy_start(
     settings: Res<PhysicsSettings>,
     cursor: Res<StageCursor>,
     mut ledger: ResMut<EnergyLedger>,
-    bodies: Query<(Entity, &Transform, &Velocity, &MassProps), Dynamic>,
+    bodies: AuditedBodies,
     ends: Ends,
     springs: Query<&Spring>,
 ) {
@@ -443,8 +561,13 @@ pub fn audit_energy_start(
         return;
     }
     ledger.dt = settings.dt().widen();
-    ledger.stability_span = settings.stages().stability_span(settings.dt()).widen();
+    let stability_span = settings.stages().stability_span(settings.dt()).widen();
+    let same_span = stability_span.to_bits() == ledger.stability_span.to_bits();
+    ledger.stability_span = stability_span;
     ledger.midpoint = settings.integrator.samples_forces_at_midpoint();
+    if std::mem::take(&mut ledger.closed) && same_span && ledger.restart(&bodies, &ends, &springs) {
+        return;
+    }
     ledger.bodies.clear();
     ledger.groups.clear();
     for (entity, t, v, m) in &bodies {
@@ -464,6 +587,7 @@ pub fn audit_energy_start(
             load: (Vec3::ZERO, Vec3::ZERO),
             mass: m.mass().widen(),
             parent: i,
+            root: i,
             still: remembered.is_some(),
         });
         ledger.groups.push(GroupStep {
@@ -491,6 +615,7 @@ pub fn audit_energy_start(
     // Move each body's energy to its group's root (roots are final now).
     for i in 0..ledger.bodies.len() {
         let root = ledger.find(i);
+        ledger.bodies[i].root = root;
         let entity = ledger.bodies[i].entity;
         let energy = std::mem::take(&mut ledger.groups[i].start);
         ledger.groups[i].magnitude = 0.0;
@@ -619,8 +744,8 @@ pub fn audit_energy(
         let Some(i) = ledger.slot(entity) else {
             continue;
         };
-        let root = ledger.find(i);
         let body = &mut ledger.bodies[i];
+        let root = body.root;
         body.end = *t;
         let (force, torque) = match gravity {
             // Bodies without an accumulator take gravity inside the integration.
@@ -658,8 +783,7 @@ pub fn audit_energy(
     if std::mem::take(&mut ledger.restored) {
         // Move each restored account to its group's key (the smallest entity of the group).
         for i in 0..ledger.bodies.len() {
-            let entity = ledger.bodies[i].entity;
-            let root = ledger.find(i);
+            let Audited { entity, root, .. } = ledger.bodies[i];
             if let Some(key) = ledger.groups[root].key
                 && key != entity
                 && let Some(account) = ledger.accounts.remove(&entity)
@@ -673,8 +797,11 @@ pub fn audit_energy(
     }
     let eps = ROUND_OFF_ULPS * Real::EPSILON.widen();
     for root in 0..ledger.groups.len() {
+        // Only roots have a key: look before copying the group.
+        let Some(key) = ledger.groups[root].key else {
+            continue;
+        };
         let g = ledger.groups[root];
-        let Some(key) = g.key else { continue };
         if g.kinematic {
             continue;
         }
@@ -714,7 +841,7 @@ pub fn audit_energy(
         }
         account.created = before;
         for i in 0..ledger.bodies.len() {
-            if ledger.find(i) != root {
+            if ledger.bodies[i].root != root {
                 continue;
             }
             let body = ledger.bodies[i];
@@ -734,6 +861,7 @@ pub fn audit_energy(
         }
     }
     ledger.accounts.retain(|_, a| a.seen);
+    ledger.closed = true;
 }
 
 #[cfg(test)]
