@@ -92,10 +92,14 @@ impl Transform {
         }
     }
 
-    /// World position of the centre of mass: `x = t + R c`.
+    /// World position of the centre of mass: `x = t + R c` (`t` itself when `c = 0`, as in
+    /// [`body_state`]: the rotation of a zero vector adds only a signed zero).
     #[inline]
     pub fn center_of_mass(&self, mass: &MassProps) -> Vec3 {
-        self.translation + quat_rotate(self.rotation, mass.local_center_of_mass())
+        match com_offset(self.rotation, mass) {
+            Some(offset) => self.translation + offset,
+            None => self.translation,
+        }
     }
 
     /// Maps a body-local point to world coordinates: `t + R p`.

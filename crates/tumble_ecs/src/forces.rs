@@ -8,11 +8,9 @@ use bevy_ecs::prelude::*;
 use bevy_ecs::world::DeferredWorld;
 use tumble_core::math::{Real, Vec3, Widen};
 
-use crate::components::{
-    ForceAccumulator, Gravity, GravityScale, MassProps, RigidBody, Transform, Velocity,
-};
+use crate::components::{ForceAccumulator, Gravity, GravityScale, MassProps, Transform, Velocity};
 use crate::stiff::ImplicitBody;
-use crate::validate::Rejected;
+use crate::targets::{TargetRows, Targets};
 
 /// A constant world-frame force on `body`, through a body-local point (or the centre of mass).
 #[derive(Component, Debug, Clone, Copy, PartialEq)]
@@ -177,18 +175,7 @@ fn ensure_accumulators(mut world: DeferredWorld, ctx: HookContext) {
     }
 }
 
-/// The bodies force generators write to: valid rigid bodies with an accumulator.
-pub type ForceTargets<'w, 's> = Query<
-    'w,
-    's,
-    (
-        &'static Transform,
-        &'static Velocity,
-        &'static MassProps,
-        &'static mut ForceAccumulator,
-    ),
-    (With<RigidBody>, Without<Rejected>),
->;
+pub use crate::targets::ForceTargets;
 
 /// Adds `m g s` to every dynamic body with an accumulator (`s` = [`GravityScale`], default 1).
 /// Only in the schedule when a [`Gravity`] resource exists.
@@ -212,39 +199,45 @@ pub fn apply_gravity(
 pub fn apply_constant_forces(
     generators: Query<&ConstantForce>,
     mut bodies: ForceTargets,
+    mut rows: Local<TargetRows>,
     mut implicit: Query<&mut ImplicitBody>,
 ) {
+    let mut targets = Targets::of(&mut bodies, &mut rows);
     // Looked up only where some body is in an implicit group: a lookup per force otherwise.
     let any_implicit = !implicit.is_empty();
     for gen_force in &generators {
-        let Ok((transform, _, mass, mut acc)) = bodies.get_mut(gen_force.body) else {
+        let (body, force) = (gen_force.body, gen_force.force);
+        let Some((transform, mass)) = targets.body(body) else {
             continue;
         };
         let Some(local) = gen_force.local_point else {
-            acc.add_force(gen_force.force);
+            targets.push(body, |acc| acc.add_force(force));
             continue;
         };
-        if any_implicit && let Ok(mut implicit) = implicit.get_mut(gen_force.body) {
+        if any_implicit && let Ok(mut implicit) = implicit.get_mut(body) {
             // The implicit step takes the torque of a force at a point at mid-step (it turns
             // with the body): the force goes to the accumulator, its point to the solve.
-            acc.add_force(gen_force.force);
-            implicit.add_point_force(local - mass.local_center_of_mass(), gen_force.force);
+            implicit.add_point_force(local - mass.local_center_of_mass(), force);
+            targets.push(body, |acc| acc.add_force(force));
             continue;
         }
-        acc.add_force_at_point(
-            gen_force.force,
+        let (point, center) = (
             transform.transform_point(local),
             transform.center_of_mass(mass),
         );
+        targets.push(body, |acc| acc.add_force_at_point(force, point, center));
     }
 }
 
 /// Applies every [`ConstantTorque`].
-pub fn apply_constant_torques(generators: Query<&ConstantTorque>, mut bodies: ForceTargets) {
+pub fn apply_constant_torques(
+    generators: Query<&ConstantTorque>,
+    mut bodies: ForceTargets,
+    mut rows: Local<TargetRows>,
+) {
+    let mut targets = Targets::of(&mut bodies, &mut rows);
     for gen_torque in &generators {
-        if let Ok((_, _, _, mut acc)) = bodies.get_mut(gen_torque.body) {
-            acc.add_torque(gen_torque.torque);
-        }
+        targets.push(gen_torque.body, |acc| acc.add_torque(gen_torque.torque));
     }
 }
 
@@ -275,28 +268,32 @@ pub fn spring_force(spring: &Spring, d: Vec3) -> Vec3 {
 pub fn apply_springs(
     springs: Query<&Spring, Without<crate::stiff::ImplicitSpring>>,
     mut bodies: ForceTargets,
+    mut rows: Local<TargetRows>,
 ) {
+    let mut targets = Targets::of(&mut bodies, &mut rows);
     for spring in &springs {
+        let Some((ta, ma)) = targets.body(spring.a) else {
+            continue;
+        };
+        let (pa, com_a) = anchor_point(ta, ma, spring.anchor_a);
         match spring.b {
             SpringEnd::World(anchor_b) => {
-                let Ok((t, _, m, mut acc)) = bodies.get_mut(spring.a) else {
-                    continue;
-                };
-                let (pa, com) = anchor_point(t, m, spring.anchor_a);
                 let f = spring_force(spring, pa - anchor_b);
-                acc.add_force_at_point(f, pa, com);
+                targets.push(spring.a, |acc| acc.add_force_at_point(f, pa, com_a));
             }
             SpringEnd::Body { body, anchor } => {
-                let Ok([(ta, _, ma, mut acc_a), (tb, _, mb, mut acc_b)]) =
-                    bodies.get_many_mut([spring.a, body])
-                else {
+                // A spring from a body to its own points exerts nothing: its two forces cancel,
+                // and so do their torques (the force is along `pa − pb`).
+                if body == spring.a {
+                    continue;
+                }
+                let Some((tb, mb)) = targets.body(body) else {
                     continue;
                 };
-                let (pa, com_a) = anchor_point(ta, ma, spring.anchor_a);
                 let (pb, com_b) = anchor_point(tb, mb, anchor);
                 let f = spring_force(spring, pa - pb);
-                acc_a.add_force_at_point(f, pa, com_a);
-                acc_b.add_force_at_point(-f, pb, com_b);
+                targets.push(spring.a, |acc| acc.add_force_at_point(f, pa, com_a));
+                targets.push(body, |acc| acc.add_force_at_point(-f, pb, com_b));
             }
         }
     }

@@ -31,6 +31,7 @@ pub mod stepper;
 pub mod stiff;
 pub mod systems;
 mod table;
+mod targets;
 pub mod validate;
 
 /// Everything a game loop needs, in one import.

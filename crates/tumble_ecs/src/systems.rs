@@ -176,6 +176,6 @@ pub fn integrate_without_forces(
 
 /// The physics queries hold only table components and archetype filters, so they are always
 /// dense (contiguously iterable).
-fn dense<I>(iter: Result<I, bevy_ecs::query::QueryNotDenseError>) -> I {
+pub(crate) fn dense<I>(iter: Result<I, bevy_ecs::query::QueryNotDenseError>) -> I {
     iter.expect("physics queries use table storage and archetype filters only")
 }
