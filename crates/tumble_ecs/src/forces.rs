@@ -9,7 +9,9 @@ use bevy_ecs::world::DeferredWorld;
 use tumble_core::math::{Real, Vec3, Widen};
 
 use crate::components::{ForceAccumulator, Gravity, GravityScale, MassProps, Transform, Velocity};
+use crate::parallel::{Parallelism, scope};
 use crate::stiff::ImplicitBody;
+use crate::systems::dense;
 use crate::targets::{TargetRows, Targets};
 
 /// A constant world-frame force on `body`, through a body-local point (or the centre of mass).
@@ -263,38 +265,137 @@ pub fn spring_force(spring: &Spring, d: Vec3) -> Vec3 {
     -(spring.stiffness * (length - spring.rest_length)) * n
 }
 
-/// Applies every [`Spring`]'s elastic force, for the springs stepped explicitly (the implicit
-/// step of [`crate::stiff`] handles the others; every damper is [`crate::damping`]'s).
-pub fn apply_springs(
-    springs: Query<&Spring, Without<crate::stiff::ImplicitSpring>>,
-    mut bodies: ForceTargets,
-    mut rows: Local<TargetRows>,
-) {
-    let mut targets = Targets::of(&mut bodies, &mut rows);
-    for spring in &springs {
+/// What one spring pushes: its force and the anchor points it acts at, with each end's centre
+/// of mass (the torque's pivot). Computed from the bodies' poses alone, so many springs can be
+/// computed at once; applied in spring order, so the sums are the same whatever computed them.
+#[derive(Debug, Clone, Copy, Default)]
+enum SpringPush {
+    /// An end is missing (or both are one body): nothing.
+    #[default]
+    Nothing,
+    /// `f` on `a` at `pa`; the other end is a world point.
+    OnA { f: Vec3, pa: Vec3, com_a: Vec3 },
+    /// `f` on `a` at `pa`, `−f` on `b` at `pb`.
+    OnBoth {
+        f: Vec3,
+        pa: Vec3,
+        com_a: Vec3,
+        pb: Vec3,
+        com_b: Vec3,
+    },
+}
+
+impl SpringPush {
+    /// The push of `spring` on the bodies as `targets` holds them.
+    #[inline]
+    fn of(spring: &Spring, targets: &Targets) -> Self {
         let Some((ta, ma)) = targets.body(spring.a) else {
-            continue;
+            return Self::Nothing;
         };
         let (pa, com_a) = anchor_point(ta, ma, spring.anchor_a);
         match spring.b {
-            SpringEnd::World(anchor_b) => {
-                let f = spring_force(spring, pa - anchor_b);
-                targets.push(spring.a, |acc| acc.add_force_at_point(f, pa, com_a));
-            }
+            SpringEnd::World(anchor_b) => Self::OnA {
+                f: spring_force(spring, pa - anchor_b),
+                pa,
+                com_a,
+            },
+            // A spring from a body to its own points exerts nothing: its two forces cancel, and
+            // so do their torques (the force is along `pa − pb`).
+            SpringEnd::Body { body, .. } if body == spring.a => Self::Nothing,
             SpringEnd::Body { body, anchor } => {
-                // A spring from a body to its own points exerts nothing: its two forces cancel,
-                // and so do their torques (the force is along `pa − pb`).
-                if body == spring.a {
-                    continue;
-                }
                 let Some((tb, mb)) = targets.body(body) else {
-                    continue;
+                    return Self::Nothing;
                 };
                 let (pb, com_b) = anchor_point(tb, mb, anchor);
-                let f = spring_force(spring, pa - pb);
+                Self::OnBoth {
+                    f: spring_force(spring, pa - pb),
+                    pa,
+                    com_a,
+                    pb,
+                    com_b,
+                }
+            }
+        }
+    }
+
+    /// Adds the push to the accumulators of `spring`'s bodies.
+    #[inline]
+    fn apply(self, spring: &Spring, targets: &mut Targets) {
+        match self {
+            Self::Nothing => {}
+            Self::OnA { f, pa, com_a } => {
+                targets.push(spring.a, |acc| acc.add_force_at_point(f, pa, com_a));
+            }
+            Self::OnBoth {
+                f,
+                pa,
+                com_a,
+                pb,
+                com_b,
+            } => {
+                let SpringEnd::Body { body, .. } = spring.b else {
+                    return;
+                };
                 targets.push(spring.a, |acc| acc.add_force_at_point(f, pa, com_a));
                 targets.push(body, |acc| acc.add_force_at_point(-f, pb, com_b));
             }
         }
+    }
+}
+
+/// The springs' pushes of one run of [`apply_springs`] on the compute pool, kept between steps
+/// so that a step does not allocate.
+#[derive(Debug, Default)]
+pub struct SpringPushes(Vec<SpringPush>);
+
+/// Applies every [`Spring`]'s elastic force, for the springs stepped explicitly (the implicit
+/// step of [`crate::stiff`] handles the others; every damper is [`crate::damping`]'s).
+///
+/// With [`Parallelism`] and enough springs, the pushes are computed on the compute pool's
+/// threads (each spring reads only its two bodies) into a buffer kept between steps, then added
+/// to the accumulators on this thread in spring order: a spring system writes to bodies in any
+/// order, and this keeps the threads busy without letting two of them add to one accumulator.
+/// The sums are the same bits for any thread count.
+pub fn apply_springs(
+    springs: Query<&Spring, Without<crate::stiff::ImplicitSpring>>,
+    mut bodies: ForceTargets,
+    mut rows: Local<TargetRows>,
+    mut pushes: Local<SpringPushes>,
+    parallelism: Option<Res<Parallelism>>,
+) {
+    let mut targets = Targets::of(&mut bodies, &mut rows);
+    let parallelism = parallelism.map_or_else(Parallelism::default, |p| *p);
+    let threads = match targets {
+        Targets::Tables { .. } => parallelism.threads_for(springs.iter().len()),
+        // The query's own lookups are not shared between threads.
+        Targets::Query(_) => 1,
+    };
+    if threads <= 1 {
+        for spring in &springs {
+            SpringPush::of(spring, &targets).apply(spring, &mut targets);
+        }
+        return;
+    }
+    let pushes = &mut pushes.0;
+    pushes.clear();
+    pushes.resize(springs.iter().len(), SpringPush::Nothing);
+    let mut rest = pushes.as_mut_slice();
+    let shared = &targets;
+    for table in dense(springs.contiguous_iter()) {
+        let (out, tail) = rest.split_at_mut(table.len());
+        rest = tail;
+        let per = table.len().div_ceil(threads).max(1);
+        scope(|spawn| {
+            for (springs, out) in table.chunks(per).zip(out.chunks_mut(per)) {
+                spawn(Box::new(move || {
+                    for (spring, push) in springs.iter().zip(out) {
+                        *push = SpringPush::of(spring, shared);
+                    }
+                }));
+            }
+        });
+    }
+    for (spring, push) in springs.iter().zip(pushes.iter()) {
+        push.apply(spring, &mut targets);
     }
 }
