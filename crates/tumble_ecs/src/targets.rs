@@ -14,11 +14,12 @@
 use bevy_ecs::change_detection::ContiguousMut;
 use bevy_ecs::prelude::*;
 
-use crate::components::{ForceAccumulator, MassProps, RigidBody, Transform};
+use crate::components::{ForceAccumulator, MassProps, RigidBody, Transform, Velocity};
 use crate::systems::dense;
 use crate::validate::Rejected;
 
-/// The bodies force generators write to: valid rigid bodies with an accumulator.
+/// The bodies force generators write to: valid rigid bodies (with a velocity) that have an
+/// accumulator.
 pub type ForceTargets<'w, 's> = Query<
     'w,
     's,
@@ -28,7 +29,7 @@ pub type ForceTargets<'w, 's> = Query<
         &'static MassProps,
         &'static mut ForceAccumulator,
     ),
-    (With<RigidBody>, Without<Rejected>),
+    (With<RigidBody>, With<Velocity>, Without<Rejected>),
 >;
 
 /// Tables of targets a force system holds at once (on the stack: a step does not allocate).

@@ -19,14 +19,14 @@ struct Handles {
 
 /// An audited spring world: a chain of five asymmetric bodies tied to the world and, at its
 /// far end, to a static post; a free body; gravity.
-fn spring_world() -> (World, Handles) {
+fn spring_world(parallelism: Parallelism) -> (World, Handles) {
     let mut world = World::new();
     world.insert_resource(
         PhysicsSettings::new(DT, Integrator::Splitting)
             .unwrap()
             .with_springs(SpringSolver::Explicit),
     );
-    world.insert_resource(Parallelism::SINGLE_THREAD);
+    world.insert_resource(parallelism);
     world.insert_resource(EnergyAudit::Always);
     world.insert_resource(Gravity(Vec3::new(0.0, -9.81, 0.0)));
     let mass = |m: Real| {
@@ -167,10 +167,28 @@ fn game_code(world: &mut World, step: usize, handles: &Handles) {
     }
 }
 
+/// Every body and spring measured on its own, by as many threads as the pool has.
+const THREADED: Parallelism = Parallelism {
+    enabled: true,
+    min_bodies: 0,
+    min_batch: 1,
+};
+
 #[test]
 fn reused_start_energies_are_the_energies_measured_afresh() {
-    let (mut reusing, handles) = spring_world();
-    let (mut fresh, _) = spring_world();
+    compare_with_fresh(Parallelism::SINGLE_THREAD);
+}
+
+/// The same with the reusing world's end pass (and its steps) split over the thread pool (with
+/// the `parallel` feature), the fresh one on one thread: the accounts agree bit for bit.
+#[test]
+fn the_end_pass_gives_the_same_accounts_on_any_number_of_threads() {
+    compare_with_fresh(THREADED);
+}
+
+fn compare_with_fresh(parallelism: Parallelism) {
+    let (mut reusing, handles) = spring_world(parallelism);
+    let (mut fresh, _) = spring_world(Parallelism::SINGLE_THREAD);
     let (plan_r, plan_f) = (
         PhysicsPlan::for_world(&mut reusing),
         PhysicsPlan::for_world(&mut fresh),
