@@ -9,7 +9,7 @@
 //! in its bits.
 
 use bevy_ecs::entity::Entity;
-use tumble_core::math::{Quat, Real, Vec3};
+use tumble_core::math::Real;
 
 use crate::components::{MassProps, Transform, Velocity, kinetic_energy_f64};
 
@@ -17,17 +17,44 @@ use crate::components::{MassProps, Transform, Velocity, kinetic_energy_f64};
 /// would call `−0` and `+0` equal and a NaN unequal to itself).
 #[inline(always)]
 fn same_bits<const N: usize>(a: [Real; N], b: [Real; N]) -> bool {
-    a.iter().zip(&b).all(|(x, y)| x.to_bits() == y.to_bits())
+    a.map(Real::to_bits) == b.map(Real::to_bits)
 }
 
+/// Every input of a body's kinetic energy ([`kinetic_energy_f64`]: rotation, velocities,
+/// mass, principal moments and frame) and of its springs' anchors (translation, rotation).
+/// The inverse mass stands for the mass: one decides the other.
 #[inline(always)]
-fn vec3(v: Vec3) -> [Real; 3] {
-    [v.x, v.y, v.z]
-}
-
-#[inline(always)]
-fn quat(q: Quat) -> [Real; 4] {
-    [q.x, q.y, q.z, q.w]
+fn body_inputs(pose: &Transform, velocity: &Velocity, mass: &MassProps) -> [Real; 21] {
+    let (t, q, v, w) = (
+        pose.translation,
+        pose.rotation,
+        velocity.linear,
+        velocity.angular,
+    );
+    let (i, f) = (mass.principal_inertia(), mass.principal_frame());
+    [
+        t.x,
+        t.y,
+        t.z,
+        q.x,
+        q.y,
+        q.z,
+        q.w,
+        v.x,
+        v.y,
+        v.z,
+        w.x,
+        w.y,
+        w.z,
+        mass.inv_mass(),
+        i.x,
+        i.y,
+        i.z,
+        f.x,
+        f.y,
+        f.z,
+        f.w,
+    ]
 }
 
 /// A body as the end of the last step measured it.
@@ -36,11 +63,8 @@ pub(super) struct BodyMemo {
     /// The end pass that measured it.
     pub(super) pass: u64,
     entity: Entity,
-    pose: Transform,
-    velocity: Velocity,
-    /// What [`kinetic_energy_f64`] reads of the mass properties: mass, principal moments and
-    /// frame.
-    inertia: (Real, Vec3, Quat),
+    /// [`body_inputs`] at the measurement.
+    inputs: [Real; 21],
     kinetic: f64,
 }
 
@@ -57,13 +81,7 @@ impl BodyMemo {
         Self {
             pass,
             entity,
-            pose: *pose,
-            velocity: *velocity,
-            inertia: (
-                mass.mass(),
-                mass.principal_inertia(),
-                mass.principal_frame(),
-            ),
+            inputs: body_inputs(pose, velocity, mass),
             kinetic: kinetic_energy_f64(pose, velocity, mass),
         }
     }
@@ -83,19 +101,11 @@ impl BodyMemo {
         velocity: &Velocity,
         mass: &MassProps,
     ) -> bool {
-        let (m, inertia, frame) = self.inertia;
-        self.entity == entity
-            && same_bits(vec3(self.pose.translation), vec3(pose.translation))
-            && same_bits(quat(self.pose.rotation), quat(pose.rotation))
-            && same_bits(vec3(self.velocity.linear), vec3(velocity.linear))
-            && same_bits(vec3(self.velocity.angular), vec3(velocity.angular))
-            && same_bits([m], [mass.mass()])
-            && same_bits(vec3(inertia), vec3(mass.principal_inertia()))
-            && same_bits(quat(frame), quat(mass.principal_frame()))
+        self.entity == entity && same_bits(self.inputs, body_inputs(pose, velocity, mass))
     }
 }
 
-/// A spring's end as [`elastic_key`] sees it: the audited body's index and its anchor, or a
+/// A spring's end as a [`SpringKey`] sees it: the audited body's index and its anchor, or a
 /// fixed point; `None` when the spring has no energy this step.
 pub(super) type EndKey = Option<(Option<usize>, [Real; 3])>;
 
