@@ -71,9 +71,10 @@
 //! spring's force), and one at the end. The end pass measures one kinetic and one elastic
 //! energy per body and spring; the start pass reuses them where the body or spring is, bit for
 //! bit, as that pass left it (`memo`), and measures afresh only what game code changed. When
-//! nothing changed at all (the same bodies, states, masses and springs), the start keeps the
-//! last step's groups and takes each group's `T + V` from the sum its end pass closed with
-//! (`EnergyLedger::restart`): the same number, added in the same order. All serial, so in a
+//! the spring graph is as the last step left it (the same bodies, masses and springs), the
+//! start also keeps the last step's groups (`EnergyLedger::restart`); when nothing changed at
+//! all, it takes each group's `T + V` from the sum its end pass closed with: the same number,
+//! added in the same order. All serial, so in a
 //! loaded spring world it is the largest single part of the step
 //! (`cargo bench --bench audit` measures the ratio on a 10⁴-body chain). Bodies are found by
 //! entity index in a table the ledger keeps, not by hashing; it allocates only when the world
@@ -147,6 +148,8 @@ struct Audited {
     root: usize,
     /// Unchanged since the end of the last step (bit for bit, [`memo`]).
     still: bool,
+    /// Kinetic energy at the start of the step, when the start keeps the last step's groups.
+    start_energy: f64,
 }
 
 /// One end of a spring as the audit sees it.
@@ -250,6 +253,9 @@ pub struct EnergyLedger {
     /// Starts that took the unchanged world's shortcut (for tests).
     #[cfg(test)]
     restarts: usize,
+    /// Starts that kept the last step's groups and measured what changed (for tests).
+    #[cfg(test)]
+    partial_restarts: usize,
 }
 
 /// One group's running account as a snapshot saves it: a member of the group (any), the group's
@@ -410,29 +416,41 @@ impl EnergyLedger {
         self.elastic(link, |b| b.start.0)
     }
 
-    /// The start of a step when the world is, bit for bit, as the last step left it: the same
-    /// audited bodies in the same order with the same state and mass, the same springs with
-    /// the same ends. Then the groups, links and union–find of the last step hold, and each
-    /// group's `T + V` is the sum its end pass closed with: the start pass would add the same
-    /// energies (reused from the [`memo`]s) in the same order. Returns false as soon as
-    /// anything differs, having changed only what the full start pass rebuilds.
+    /// The start of a step when the world's spring graph is as the last step left it: the
+    /// same audited bodies in the same order with the same masses, the same springs (bit for
+    /// bit) with the same ends. Then the groups, links and union–find of the last step hold,
+    /// and only the energies need measuring, each reused from its [`memo`] where its inputs
+    /// are unchanged; when nothing changed at all, each group's `T + V` is the sum its end pass
+    /// closed with (the start pass would add the same energies in the same order). Either way
+    /// the sums are the full start pass's, bit for bit. Returns false as soon as the graph
+    /// differs, having changed only what the full start pass rebuilds.
     fn restart(&mut self, bodies: &AuditedBodies, ends: &Ends, springs: &Query<&Spring>) -> bool {
         let mut n = 0;
+        let mut all_still = true;
         for (entity, t, v, m) in bodies {
-            let Some(Some(memo)) = self.measured_bodies.get(n) else {
+            let Some(body) = self.bodies.get(n) else {
                 return false;
             };
-            let unchanged = memo.pass == self.end_passes
-                && memo.still(entity, t, v, m)
-                && self.bodies.get(n).is_some_and(|b| b.entity == entity);
-            if !unchanged {
+            if body.entity != entity {
+                return false;
+            }
+            let remembered = match self.measured_bodies.get(n) {
+                Some(Some(memo)) if memo.pass == self.end_passes && memo.still(entity, t, v, m) => {
+                    Some(memo.kinetic())
+                }
+                _ => None,
+            };
+            // A new mass changes the springs' reduced masses, so their stiffness bound: regroup.
+            if remembered.is_none() && m.mass().widen().to_bits() != body.mass.to_bits() {
                 return false;
             }
             let body = &mut self.bodies[n];
             body.start = (*t, *v);
             body.end = *t;
             body.load = (Vec3::ZERO, Vec3::ZERO);
-            body.still = true;
+            body.still = remembered.is_some();
+            body.start_energy = remembered.unwrap_or_else(|| kinetic_energy_f64(t, v, m));
+            all_still &= remembered.is_some();
             n += 1;
         }
         if n != self.bodies.len() {
@@ -465,13 +483,44 @@ impl EnergyLedger {
         if k != self.links.len() {
             return false;
         }
+        if all_still {
+            for g in &mut self.groups {
+                (g.start, g.magnitude) = (g.end, g.end);
+                (g.end, g.work) = (0.0, 0.0);
+            }
+            #[cfg(test)]
+            {
+                self.restarts += 1;
+            }
+            return true;
+        }
+        // The full start pass's sums, in its order: the bodies by index into their roots, then
+        // the springs.
         for g in &mut self.groups {
-            (g.start, g.magnitude) = (g.end, g.end);
-            (g.end, g.work) = (0.0, 0.0);
+            (g.start, g.magnitude, g.end, g.work) = (0.0, 0.0, 0.0, 0.0);
+        }
+        for i in 0..self.bodies.len() {
+            let Audited {
+                root, start_energy, ..
+            } = self.bodies[i];
+            let g = &mut self.groups[root];
+            g.start += start_energy;
+            g.magnitude += start_energy;
+        }
+        for k in 0..self.links.len() {
+            let link = self.links[k];
+            let Some(root) = self.root_of(&link) else {
+                continue;
+            };
+            if let Some(v) = self.start_elastic(k, &link) {
+                let g = &mut self.groups[root];
+                g.start += v;
+                g.magnitude += v;
+            }
         }
         #[cfg(test)]
         {
-            self.restarts += 1;
+            self.partial_restarts += 1;
         }
         true
     }
@@ -482,6 +531,7 @@ impl EnergyLedger {
     pub(crate) fn forget_measurements(&mut self) {
         self.measured_bodies.clear();
         self.measured_springs.clear();
+        self.closed = false;
     }
 }
 
@@ -589,6 +639,7 @@ pub fn audit_energy_start(
             parent: i,
             root: i,
             still: remembered.is_some(),
+            start_energy: energy,
         });
         ledger.groups.push(GroupStep {
             start: energy,

@@ -198,7 +198,10 @@ fn compare_with_fresh(parallelism: Parallelism) {
     for step in 0..400 {
         game_code(&mut reusing, step, &handles);
         game_code(&mut fresh, step, &handles);
-        let restarts = reusing.resource::<EnergyLedger>().restarts;
+        let (restarts, partial) = {
+            let ledger = reusing.resource::<EnergyLedger>();
+            (ledger.restarts, ledger.partial_restarts)
+        };
         fresh.resource_mut::<EnergyLedger>().forget_measurements();
         plan_r.run_step(&mut schedule_r, &mut reusing);
         plan_f.run_step(&mut schedule_f, &mut fresh);
@@ -225,6 +228,14 @@ fn compare_with_fresh(parallelism: Parallelism) {
         let post_moved = step % 40 == 5 && step < 330;
         if matches!(step % 40, 3 | 11 | 17 | 19) || matches!(step, 150 | 250 | 330) || post_moved {
             assert_eq!(ledger.restarts, restarts, "step {step}: a change was seen");
+        }
+        // A kicked, pushed or turned body keeps the groups: only its energy is measured again.
+        // A new mass, spring or anchor regroups.
+        if matches!(step % 40, 3 | 7 | 11 | 13 | 37) {
+            assert_eq!(ledger.partial_restarts, partial + 1, "step {step}");
+        }
+        if matches!(step % 40, 17 | 19 | 23 | 29) || matches!(step, 150 | 250 | 330) || post_moved {
+            assert_eq!(ledger.partial_restarts, partial, "step {step}: regrouped");
         }
         if step % 40 == 3 {
             let kicked = ledger.slot(handles.chain[2]).unwrap();
