@@ -275,8 +275,9 @@ enum SpringPush {
     Nothing,
     /// `f` on `a` at `pa`; the other end is a world point.
     OnA { f: Vec3, pa: Vec3, com_a: Vec3 },
-    /// `f` on `a` at `pa`, `−f` on `b` at `pb`.
+    /// `f` on `a` at `pa`, `−f` on body `b` at `pb`.
     OnBoth {
+        b: Entity,
         f: Vec3,
         pa: Vec3,
         com_a: Vec3,
@@ -308,6 +309,7 @@ impl SpringPush {
                 };
                 let (pb, com_b) = anchor_point(tb, mb, anchor);
                 Self::OnBoth {
+                    b: body,
                     f: spring_force(spring, pa - pb),
                     pa,
                     com_a,
@@ -327,17 +329,15 @@ impl SpringPush {
                 targets.push(spring.a, |acc| acc.add_force_at_point(f, pa, com_a));
             }
             Self::OnBoth {
+                b,
                 f,
                 pa,
                 com_a,
                 pb,
                 com_b,
             } => {
-                let SpringEnd::Body { body, .. } = spring.b else {
-                    return;
-                };
                 targets.push(spring.a, |acc| acc.add_force_at_point(f, pa, com_a));
-                targets.push(body, |acc| acc.add_force_at_point(-f, pb, com_b));
+                targets.push(b, |acc| acc.add_force_at_point(-f, pb, com_b));
             }
         }
     }

@@ -11,6 +11,7 @@
 use bevy_ecs::entity::Entity;
 use tumble_core::math::Real;
 
+use super::{Link, same_end};
 use crate::components::{MassProps, Transform, Velocity, kinetic_energy_f64};
 
 /// The bits of `values`: equal bits are equal inputs to the energy functions (`==` on floats
@@ -105,46 +106,25 @@ impl BodyMemo {
     }
 }
 
-/// A spring's end as a [`SpringKey`] sees it: the audited body's index and its anchor, or a
-/// fixed point; `None` when the spring has no energy this step.
-pub(super) type EndKey = Option<(Option<usize>, [Real; 3])>;
-
-/// Everything a spring's elastic energy depends on besides its audited bodies' poses:
-/// stiffness, rest length and both ends.
-#[derive(Debug, Clone, Copy)]
-pub(super) struct SpringKey {
-    pub(super) stiffness: Real,
-    pub(super) rest_length: Real,
-    pub(super) ends: [EndKey; 2],
-}
-
-impl SpringKey {
-    /// The same inputs, bit for bit.
-    #[inline]
-    pub(super) fn same(&self, other: &SpringKey) -> bool {
-        let end = |a: &EndKey, b: &EndKey| match (a, b) {
-            (None, None) => true,
-            (Some((i, p)), Some((j, q))) => i == j && same_bits(*p, *q),
-            _ => false,
-        };
-        same_bits(
-            [self.stiffness, self.rest_length],
-            [other.stiffness, other.rest_length],
-        ) && end(&self.ends[0], &other.ends[0])
-            && end(&self.ends[1], &other.ends[1])
-    }
-
-    /// The audited bodies at the ends.
-    pub(super) fn bodies(&self) -> impl Iterator<Item = usize> + '_ {
-        self.ends.iter().filter_map(|end| end.and_then(|(i, _)| i))
-    }
-}
-
-/// A spring as the end of the last step measured it.
+/// A spring as the end of the last step measured it: the link (its stiffness, rest length and
+/// resolved ends are the inputs of its elastic energy besides its audited bodies' poses) and
+/// that energy.
 #[derive(Debug, Clone, Copy)]
 pub(super) struct SpringMemo {
     /// The end pass that measured it.
     pub(super) pass: u64,
-    pub(super) key: SpringKey,
+    pub(super) link: Link,
     pub(super) elastic: Option<f64>,
+}
+
+impl SpringMemo {
+    /// True when `link` has the same inputs as the measured one, bit for bit, apart from its
+    /// audited bodies' poses (see [`BodyMemo::still`] for those).
+    #[inline]
+    pub(super) fn same_inputs(&self, link: &Link) -> bool {
+        let (a, b) = (&self.link.spring, &link.spring);
+        same_bits([a.stiffness, a.rest_length], [b.stiffness, b.rest_length])
+            && same_end(self.link.a, link.a)
+            && same_end(self.link.b, link.b)
+    }
 }

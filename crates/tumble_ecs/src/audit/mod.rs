@@ -97,7 +97,7 @@ use crate::forces::{Spring, SpringEnd};
 use crate::stages::StageCursor;
 use crate::systems::Dynamic;
 use crate::validate::{BodyError, BodyErrorKind, Rejected, reject};
-use memo::{BodyMemo, EndKey, SpringKey, SpringMemo};
+use memo::{BodyMemo, SpringMemo};
 
 /// Whether a world's steps are audited for energy created by the integrator (see the module
 /// docs). Insert it as a resource to override the default, [`EnergyAudit::Auto`].
@@ -148,7 +148,7 @@ struct Audited {
     root: usize,
     /// Unchanged since the end of the last step (bit for bit, [`memo`]).
     still: bool,
-    /// Kinetic energy at the start of the step, when the start keeps the last step's groups.
+    /// Kinetic energy at the start of the step.
     start_energy: f64,
 }
 
@@ -174,20 +174,12 @@ struct Link {
 }
 
 impl Link {
-    /// What its elastic energy depends on besides its audited bodies' poses.
-    fn key(&self) -> SpringKey {
-        let end = |end: End| -> EndKey {
-            match end {
-                End::Audited(i, local) => Some((Some(i), [local.x, local.y, local.z])),
-                End::Fixed(p) => Some((None, [p.x, p.y, p.z])),
-                End::Kinematic | End::Inactive => None,
-            }
-        };
-        SpringKey {
-            stiffness: self.spring.stiffness,
-            rest_length: self.spring.rest_length,
-            ends: [end(self.a), end(self.b)],
-        }
+    /// The audited bodies at its ends.
+    fn audited_bodies(&self) -> impl Iterator<Item = usize> {
+        [self.a, self.b].into_iter().filter_map(|end| match end {
+            End::Audited(i, _) => Some(i),
+            _ => None,
+        })
     }
 }
 
@@ -407,9 +399,8 @@ impl EnergyLedger {
         if let Some(Some(memo)) = self.measured_springs.get(k)
             && memo.pass == self.end_passes
         {
-            let key = link.key();
             // Its bodies are still, so their memos are from the same pass as the spring's.
-            if memo.key.same(&key) && key.bodies().all(|i| self.bodies[i].still) {
+            if memo.same_inputs(link) && link.audited_bodies().all(|i| self.bodies[i].still) {
                 return memo.elastic;
             }
         }
@@ -434,23 +425,17 @@ impl EnergyLedger {
             if body.entity != entity {
                 return false;
             }
-            let remembered = match self.measured_bodies.get(n) {
-                Some(Some(memo)) if memo.pass == self.end_passes && memo.still(entity, t, v, m) => {
-                    Some(memo.kinetic())
-                }
-                _ => None,
-            };
+            let (energy, still) = self.start_kinetic(n, (entity, t, v, m));
             // A new mass changes the springs' reduced masses, so their stiffness bound: regroup.
-            if remembered.is_none() && m.mass().widen().to_bits() != body.mass.to_bits() {
+            if !still && m.mass().widen().to_bits() != body.mass.to_bits() {
                 return false;
             }
             let body = &mut self.bodies[n];
             body.start = (*t, *v);
             body.end = *t;
             body.load = (Vec3::ZERO, Vec3::ZERO);
-            body.still = remembered.is_some();
-            body.start_energy = remembered.unwrap_or_else(|| kinetic_energy_f64(t, v, m));
-            all_still &= remembered.is_some();
+            (body.start_energy, body.still) = (energy, still);
+            all_still &= still;
             n += 1;
         }
         if n != self.bodies.len() {
@@ -494,8 +479,35 @@ impl EnergyLedger {
             }
             return true;
         }
-        // The full start pass's sums, in its order: the bodies by index into their roots, then
-        // the springs.
+        self.sum_start_energies();
+        #[cfg(test)]
+        {
+            self.partial_restarts += 1;
+        }
+        true
+    }
+
+    /// The kinetic energy at the start of the step of the body read at index `i`, and whether
+    /// it is still as the last end pass measured it there (bit for bit, [`memo`]): then the
+    /// energy is that measurement, else it is measured now.
+    fn start_kinetic(
+        &self,
+        i: usize,
+        (entity, t, v, m): (Entity, &Transform, &Velocity, &MassProps),
+    ) -> (f64, bool) {
+        match self.measured_bodies.get(i) {
+            Some(Some(memo)) if memo.pass == self.end_passes && memo.still(entity, t, v, m) => {
+                (memo.kinetic(), true)
+            }
+            _ => (kinetic_energy_f64(t, v, m), false),
+        }
+    }
+
+    /// Each group's `T + V` at the start of the step (and its magnitude for the round-off
+    /// allowance), from the bodies' `start_energy` and the springs' elastic energy
+    /// ([`start_elastic`](Self::start_elastic)): the bodies by index into their roots, then the
+    /// springs in order, so the sums do not depend on which start pass formed the groups.
+    fn sum_start_energies(&mut self) {
         for g in &mut self.groups {
             (g.start, g.magnitude, g.end, g.work) = (0.0, 0.0, 0.0, 0.0);
         }
@@ -518,11 +530,6 @@ impl EnergyLedger {
                 g.magnitude += v;
             }
         }
-        #[cfg(test)]
-        {
-            self.partial_restarts += 1;
-        }
-        true
     }
 
     /// Forgets what the last step measured: the next start measures every energy afresh.
@@ -622,13 +629,7 @@ pub fn audit_energy_start(
     ledger.groups.clear();
     for (entity, t, v, m) in &bodies {
         let i = ledger.bodies.len();
-        let remembered = match ledger.measured_bodies.get(i) {
-            Some(Some(memo)) if memo.pass == ledger.end_passes && memo.still(entity, t, v, m) => {
-                Some(memo.kinetic())
-            }
-            _ => None,
-        };
-        let energy = remembered.unwrap_or_else(|| kinetic_energy_f64(t, v, m));
+        let (energy, still) = ledger.start_kinetic(i, (entity, t, v, m));
         ledger.set_slot(entity, i);
         ledger.bodies.push(Audited {
             entity,
@@ -638,14 +639,10 @@ pub fn audit_energy_start(
             mass: m.mass().widen(),
             parent: i,
             root: i,
-            still: remembered.is_some(),
+            still,
             start_energy: energy,
         });
-        ledger.groups.push(GroupStep {
-            start: energy,
-            magnitude: energy,
-            ..GroupStep::default()
-        });
+        ledger.groups.push(GroupStep::default());
     }
     ledger.links.clear();
     for spring in &springs {
@@ -663,18 +660,14 @@ pub fn audit_energy_start(
             b,
         });
     }
-    // Move each body's energy to its group's root (roots are final now).
+    // Each body's group (roots are final now).
     for i in 0..ledger.bodies.len() {
         let root = ledger.find(i);
         ledger.bodies[i].root = root;
         let entity = ledger.bodies[i].entity;
-        let energy = std::mem::take(&mut ledger.groups[i].start);
-        ledger.groups[i].magnitude = 0.0;
         let g = &mut ledger.groups[root];
         g.members += 1;
         g.key = Some(g.key.map_or(entity, |k| k.min(entity)));
-        g.start += energy;
-        g.magnitude += energy;
     }
     for k in 0..ledger.links.len() {
         let link = ledger.links[k];
@@ -695,16 +688,12 @@ pub fn audit_energy_start(
             ma * mb / (ma + mb)
         };
         let omega_dt = (link.spring.stiffness.widen() / reduced).sqrt() * ledger.stability_span;
-        let elastic = ledger.start_elastic(k, &link);
         let g = &mut ledger.groups[root];
         g.springs += 1;
         g.kinematic |= kinematic;
         g.omega_dt = g.omega_dt.max(omega_dt);
-        if let Some(v) = elastic {
-            g.start += v;
-            g.magnitude += v;
-        }
     }
+    ledger.sum_start_energies();
 }
 
 /// Before the integration, after every force system but the springs (the plan runs
@@ -823,7 +812,7 @@ pub fn audit_energy(
         let elastic = ledger.elastic(&link, |b| b.end);
         ledger.measured_springs[k] = Some(SpringMemo {
             pass,
-            key: link.key(),
+            link,
             elastic,
         });
         if let Some(v) = elastic {
