@@ -13,6 +13,7 @@ pub mod bandwidth;
 pub mod csv;
 pub mod engines;
 pub mod exact;
+pub mod machines;
 pub mod measure;
 pub mod output;
 pub mod population;
@@ -22,7 +23,7 @@ pub mod springs;
 use std::path::PathBuf;
 use tumble_core::math::Vec3;
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use tumble_core::{Integrator, KernelPath};
 use tumble_ecs::parallel::{Parallelism, pool_threads};
 use tumble_scene::output::{OutputError, create_directory, write_atomically};
@@ -44,11 +45,15 @@ pub struct BenchOptions {
     /// minutes).
     #[arg(long, default_value_t = 100_000)]
     pub rapier_max_bodies: usize,
-    /// Write `bench.json` and `bench.md` into this directory.
+    /// Write this run's `<name>.json` and `<name>.md` into this directory, and
+    /// `bench-targets.md`, the targets of every run kept there (`<name>` is `bench-<widest>`
+    /// on the CPU's widest kernel path, `bench-<widest>-forced-<path>` when `TUMBLE_KERNEL`
+    /// forced another).
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// Also replace the ratios section of this markdown file (between `<!-- bench:begin -->`
-    /// and `<!-- bench:end -->`), e.g. README.md.
+    /// Also replace this run's section of this markdown file (between `<!-- <name>:begin -->`
+    /// and `<!-- <name>:end -->`) and the table of every run's targets (`bench-targets`),
+    /// e.g. README.md.
     #[arg(long)]
     pub readme: Option<PathBuf>,
 }
@@ -86,7 +91,7 @@ pub struct UnusedFeature {
 }
 
 /// A target of issue #7 and whether this run met it.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Target {
     /// What is measured.
     pub name: String,
@@ -326,13 +331,16 @@ pub fn run_and_write(options: &BenchOptions) -> Result<(), Box<dyn std::error::E
     let results = run_bench(options, |line| eprintln!("… {line}"));
     let table = output::markdown(&results);
     println!("{table}");
-    // A run on the widest path writes `bench.md`; one forced onto a narrower path writes
-    // `bench-<path>.md` and its own README section, so both stay on record side by side.
-    let name = if results.kernel_path == results.widest_kernel_path {
-        "bench".to_owned()
-    } else {
-        format!("bench-{}", results.kernel_path)
-    };
+    // Each machine class and forced path keeps its own files and README section, so a run on
+    // one machine never overwrites another's; the targets of all of them are tabulated after.
+    let name = machines::run_name(&results.kernel_path, &results.widest_kernel_path);
+    let mut summary = machines::targets_by_run(&[machines::RunSummary {
+        kernel_path: results.kernel_path.clone(),
+        widest_kernel_path: results.widest_kernel_path.clone(),
+        cpu: results.cpu.clone(),
+        date: results.date.clone(),
+        targets: results.targets.clone(),
+    }]);
     if let Some(dir) = &options.out {
         create_directory(dir)?;
         write_atomically(&dir.join(format!("{name}.md")), table.as_bytes(), &[])?;
@@ -341,17 +349,25 @@ pub fn run_and_write(options: &BenchOptions) -> Result<(), Box<dyn std::error::E
             (serde_json::to_string_pretty(&results)? + "\n").as_bytes(),
             &[],
         )?;
+        summary = machines::targets_by_run(&machines::read_runs(dir)?);
+        let summary_file = dir.join(format!("{}.md", machines::SUMMARY_NAME));
+        write_atomically(&summary_file, summary.as_bytes(), &[])?;
     }
     if let Some(readme) = &options.readme {
         let text = std::fs::read_to_string(readme).map_err(|e| OutputError::io(readme, e))?;
-        let section = output::readme_section(&results);
-        let updated = tumble_scene::text::replace_between_markers(&text, &name, &section)
-            .ok_or_else(|| {
-                format!(
-                    "{}: no <!-- {name}:begin --> … <!-- {name}:end --> markers",
-                    path_for_terminal(readme)
-                )
-            })?;
+        let mut updated = text;
+        for (section_name, section) in [
+            (name.as_str(), output::readme_section(&results)),
+            (machines::SUMMARY_NAME, summary),
+        ] {
+            updated = tumble_scene::text::replace_between_markers(&updated, section_name, &section)
+                .ok_or_else(|| {
+                    format!(
+                        "{}: no <!-- {section_name}:begin --> … <!-- {section_name}:end --> markers",
+                        path_for_terminal(readme)
+                    )
+                })?;
+        }
         write_atomically(readme, updated.as_bytes(), &[])?;
     }
     Ok(())

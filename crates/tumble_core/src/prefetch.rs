@@ -1,7 +1,7 @@
 //! A hint to the CPU to fetch memory that a loop will read soon.
 //!
 //! The one `unsafe` call here pays for itself where worlds outgrow the caches (the batch loops
-//! prefetch a few dozen bodies ahead; figures in `report/bench.md`); smaller worlds are
+//! prefetch a few dozen bodies ahead; figures in `report/bench-avx512.md`); smaller worlds are
 //! unchanged.
 #![expect(
     unsafe_code,
