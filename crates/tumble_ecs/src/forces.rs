@@ -365,8 +365,9 @@ pub fn apply_springs(
 ) {
     let mut targets = Targets::of(&mut bodies, &mut rows);
     let parallelism = parallelism.map_or_else(Parallelism::default, |p| *p);
+    let count = springs.iter().len();
     let threads = match targets {
-        Targets::Tables { .. } => parallelism.threads_for(springs.iter().len()),
+        Targets::Tables { .. } => parallelism.threads_for(count),
         // The query's own lookups are not shared between threads.
         Targets::Query(_) => 1,
     };
@@ -378,7 +379,7 @@ pub fn apply_springs(
     }
     let pushes = &mut pushes.0;
     pushes.clear();
-    pushes.resize(springs.iter().len(), SpringPush::Nothing);
+    pushes.resize(count, SpringPush::Nothing);
     let mut rest = pushes.as_mut_slice();
     let shared = &targets;
     for table in dense(springs.contiguous_iter()) {

@@ -15,9 +15,9 @@
 //!
 //! and the steps that follow are bit for bit the steps that followed frame `n`.
 //!
-//! **In place, not respawned.** Unlike the serde [`Snapshot`](crate::snapshot) (which spawns a
-//! saved world into another), a rollback snapshot writes back into the entities it was taken
-//! from: entity ids stay, no schedule is rebuilt (the [`PhysicsRunner`](crate::runner) re-plans
+//! **In place, not respawned.** Unlike the serde `Snapshot` (module `snapshot`, feature
+//! `serde`; it spawns a saved world into another), a rollback snapshot writes back into the
+//! entities it was taken from: entity ids stay, no schedule is rebuilt (the [`PhysicsRunner`](crate::runner) re-plans
 //! only when a plan input differs, e.g. a restore that removes gravity), and a restore of an
 //! unchanged archetype layout is one linear pass over the bodies. Components that were added or
 //! removed since the capture (an accumulator, damping, a quarantine) are put back as they were.

@@ -95,17 +95,12 @@ impl<'a, 'w, 's> Targets<'a, 'w, 's> {
         Targets::Tables { tables, rows }
     }
 
-    /// The table and row of `entity`, if it is a target.
+    /// Where `entity` was when the row table was built: `(table, row)`. The caller checks that
+    /// the table holds `entity` at that row (an entity index can be reused by another entity).
     #[inline]
-    fn locate(
-        tables: &[Option<TargetTable<'a>>; MAX_TABLES],
-        rows: &[(u32, u32)],
-        entity: Entity,
-    ) -> Option<(usize, usize)> {
+    fn slot(rows: &[(u32, u32)], entity: Entity) -> Option<(usize, usize)> {
         let &(t, row) = rows.get(entity.index_u32() as usize)?;
-        let (t, row) = (t as usize, row as usize);
-        let table = tables.get(t)?.as_ref()?;
-        (table.entities.get(row) == Some(&entity)).then_some((t, row))
+        Some((t as usize, row as usize))
     }
 
     /// The pose and mass of target `entity`.
@@ -113,9 +108,10 @@ impl<'a, 'w, 's> Targets<'a, 'w, 's> {
     pub(crate) fn body(&self, entity: Entity) -> Option<(&Transform, &MassProps)> {
         match self {
             Targets::Tables { tables, rows } => {
-                let (t, row) = Self::locate(tables, rows, entity)?;
-                let table = tables[t].as_ref()?;
-                Some((&table.transforms[row], &table.masses[row]))
+                let (t, row) = Self::slot(rows, entity)?;
+                let table = tables.get(t)?.as_ref()?;
+                (table.entities.get(row) == Some(&entity))
+                    .then(|| (&table.transforms[row], &table.masses[row]))
             }
             Targets::Query(query) => query.get(entity).ok().map(|(_, t, m, _)| (t, m)),
         }
@@ -126,8 +122,9 @@ impl<'a, 'w, 's> Targets<'a, 'w, 's> {
     pub(crate) fn push(&mut self, entity: Entity, add: impl FnOnce(&mut ForceAccumulator)) {
         match self {
             Targets::Tables { tables, rows } => {
-                if let Some((t, row)) = Self::locate(tables, rows, entity)
-                    && let Some(table) = tables[t].as_mut()
+                if let Some((t, row)) = Self::slot(rows, entity)
+                    && let Some(Some(table)) = tables.get_mut(t)
+                    && table.entities.get(row) == Some(&entity)
                 {
                     add(&mut table.accumulators[row]);
                 }
