@@ -334,13 +334,8 @@ pub fn run_and_write(options: &BenchOptions) -> Result<(), Box<dyn std::error::E
     // Each machine class and forced path keeps its own files and README section, so a run on
     // one machine never overwrites another's; the targets of all of them are tabulated after.
     let name = machines::run_name(&results.kernel_path, &results.widest_kernel_path);
-    let mut summary = machines::targets_by_run(&[machines::RunSummary {
-        kernel_path: results.kernel_path.clone(),
-        widest_kernel_path: results.widest_kernel_path.clone(),
-        cpu: results.cpu.clone(),
-        date: results.date.clone(),
-        targets: results.targets.clone(),
-    }]);
+    // Without an output directory there are no kept runs: the summary holds this one.
+    let mut summary = None;
     if let Some(dir) = &options.out {
         create_directory(dir)?;
         write_atomically(&dir.join(format!("{name}.md")), table.as_bytes(), &[])?;
@@ -349,16 +344,22 @@ pub fn run_and_write(options: &BenchOptions) -> Result<(), Box<dyn std::error::E
             (serde_json::to_string_pretty(&results)? + "\n").as_bytes(),
             &[],
         )?;
-        summary = machines::targets_by_run(&machines::read_runs(dir)?);
+        let table = machines::targets_by_run(&machines::read_runs(dir)?);
         let summary_file = dir.join(format!("{}.md", machines::SUMMARY_NAME));
-        write_atomically(&summary_file, summary.as_bytes(), &[])?;
+        write_atomically(&summary_file, table.as_bytes(), &[])?;
+        summary = Some(table);
     }
     if let Some(readme) = &options.readme {
         let text = std::fs::read_to_string(readme).map_err(|e| OutputError::io(readme, e))?;
         let mut updated = text;
         for (section_name, section) in [
             (name.as_str(), output::readme_section(&results)),
-            (machines::SUMMARY_NAME, summary),
+            (
+                machines::SUMMARY_NAME,
+                summary.unwrap_or_else(|| {
+                    machines::targets_by_run(&[machines::RunSummary::from(&results)])
+                }),
+            ),
         ] {
             updated = tumble_scene::text::replace_between_markers(&updated, section_name, &section)
                 .ok_or_else(|| {

@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 use serde::Deserialize;
 use tumble_scene::text::path_for_terminal;
 
-use crate::Target;
+use crate::{BenchResults, Target};
 
 /// The file stem of a run: `bench-<widest>` on the CPU's widest kernel path, and
 /// `bench-<widest>-forced-<path>` when `TUMBLE_KERNEL` forced a narrower one. The widest path
@@ -43,6 +43,19 @@ pub struct RunSummary {
     pub date: String,
     /// The targets and what the run measured for them.
     pub targets: Vec<Target>,
+}
+
+impl From<&BenchResults> for RunSummary {
+    /// The summary of a run still in memory (as its JSON would read back).
+    fn from(results: &BenchResults) -> Self {
+        Self {
+            kernel_path: results.kernel_path.clone(),
+            widest_kernel_path: results.widest_kernel_path.clone(),
+            cpu: results.cpu.clone(),
+            date: results.date.clone(),
+            targets: results.targets.clone(),
+        }
+    }
 }
 
 impl RunSummary {

@@ -462,12 +462,6 @@ pub fn targets_table(targets: &[Target]) -> String {
     s
 }
 
-/// Replaces the text between `<!-- bench:begin -->` and `<!-- bench:end -->`; `None` when the
-/// markers are missing.
-pub fn replace_between_markers(text: &str, section: &str) -> Option<String> {
-    tumble_scene::text::replace_between_markers(text, "bench", section)
-}
-
 /// The README's section: the latest ratios of the default integrator, and the targets.
 pub fn readme_section(results: &BenchResults) -> String {
     let mut s = String::new();

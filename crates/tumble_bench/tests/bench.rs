@@ -2,6 +2,7 @@
 //! engines agree bit for bit (checked inside the run), and the targets are evaluated.
 
 use tumble_bench::{BenchOptions, output, run_bench};
+use tumble_scene::text::replace_between_markers;
 
 fn small() -> BenchOptions {
     BenchOptions {
@@ -60,13 +61,16 @@ fn small_run_measures_every_engine_and_writes_json() {
 
 #[test]
 fn readme_section_replaces_only_between_markers() {
-    let text = "intro\n<!-- bench:begin -->\nold\n<!-- bench:end -->\noutro\n";
-    let new = output::replace_between_markers(text, "new\n").unwrap();
+    // The section a run on an AVX2-only CPU writes.
+    let name = tumble_bench::machines::run_name("avx2", "avx2");
+    let replace = |text, section| replace_between_markers(text, &name, section);
+    let text = "intro\n<!-- bench-avx2:begin -->\nold\n<!-- bench-avx2:end -->\noutro\n";
+    let new = replace(text, "new\n").unwrap();
     assert_eq!(
         new,
-        "intro\n<!-- bench:begin -->\nnew\n<!-- bench:end -->\noutro\n"
+        "intro\n<!-- bench-avx2:begin -->\nnew\n<!-- bench-avx2:end -->\noutro\n"
     );
-    assert!(output::replace_between_markers("no markers", "x").is_none());
+    assert!(replace("no markers", "x").is_none());
 }
 
 #[test]

@@ -17,9 +17,10 @@
 //!
 //! **In place, not respawned.** Unlike the serde `Snapshot` (module `snapshot`, feature
 //! `serde`; it spawns a saved world into another), a rollback snapshot writes back into the
-//! entities it was taken from: entity ids stay, no schedule is rebuilt (the [`PhysicsRunner`](crate::runner) re-plans
-//! only when a plan input differs, e.g. a restore that removes gravity), and a restore of an
-//! unchanged archetype layout is one linear pass over the bodies. Components that were added or
+//! entities it was taken from: entity ids stay, no schedule is rebuilt (the
+//! [`PhysicsRunner`](crate::runner) re-plans only when a plan input differs, e.g. a restore
+//! that removes gravity), and a restore of an unchanged archetype layout is one linear pass
+//! over the bodies. Components that were added or
 //! removed since the capture (an accumulator, damping, a quarantine) are put back as they were.
 //! Entities are the game's: a restore into a world whose bodies or generators are not the
 //! captured ones fails with a [`RollbackError`] and changes nothing.

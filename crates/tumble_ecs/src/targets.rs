@@ -49,6 +49,15 @@ pub(crate) struct TargetTable<'a> {
     accumulators: &'a mut [ForceAccumulator],
 }
 
+impl TargetTable<'_> {
+    /// True when `entity` sits at `row` (the row table is checked against the table itself:
+    /// an entity index can be reused by another entity).
+    #[inline]
+    fn holds(&self, row: usize, entity: Entity) -> bool {
+        self.entities.get(row) == Some(&entity)
+    }
+}
+
 /// A force system's targets: its tables and where each entity sits in them, or the query
 /// itself when they span too many tables.
 #[expect(
@@ -95,8 +104,8 @@ impl<'a, 'w, 's> Targets<'a, 'w, 's> {
         Targets::Tables { tables, rows }
     }
 
-    /// Where `entity` was when the row table was built: `(table, row)`. The caller checks that
-    /// the table holds `entity` at that row (an entity index can be reused by another entity).
+    /// Where `entity` was when the row table was built: `(table, row)`, to be confirmed with
+    /// [`TargetTable::holds`].
     #[inline]
     fn slot(rows: &[(u32, u32)], entity: Entity) -> Option<(usize, usize)> {
         let &(t, row) = rows.get(entity.index_u32() as usize)?;
@@ -110,7 +119,8 @@ impl<'a, 'w, 's> Targets<'a, 'w, 's> {
             Targets::Tables { tables, rows } => {
                 let (t, row) = Self::slot(rows, entity)?;
                 let table = tables.get(t)?.as_ref()?;
-                (table.entities.get(row) == Some(&entity))
+                table
+                    .holds(row, entity)
                     .then(|| (&table.transforms[row], &table.masses[row]))
             }
             Targets::Query(query) => query.get(entity).ok().map(|(_, t, m, _)| (t, m)),
@@ -124,7 +134,7 @@ impl<'a, 'w, 's> Targets<'a, 'w, 's> {
             Targets::Tables { tables, rows } => {
                 if let Some((t, row)) = Self::slot(rows, entity)
                     && let Some(Some(table)) = tables.get_mut(t)
-                    && table.entities.get(row) == Some(&entity)
+                    && table.holds(row, entity)
                 {
                     add(&mut table.accumulators[row]);
                 }

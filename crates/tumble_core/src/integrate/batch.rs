@@ -105,8 +105,8 @@ pub trait BodyBatch {
 }
 
 /// How many bodies ahead of the one being read the batch loops call [`BodyBatch::prefetch`]:
-/// it pays in worlds that outgrow the caches (see `report/bench-avx512.md`); smaller worlds, where the
-/// hardware prefetchers keep up, are unchanged.
+/// it pays in worlds that outgrow the caches (see `report/bench-avx512.md`); smaller worlds,
+/// where the hardware prefetchers keep up, are unchanged.
 const PREFETCH_AHEAD: usize = 32;
 
 /// Hands `next` to `bodies` as body `i`'s new state if it is valid, else reports divergence.
