@@ -6,7 +6,7 @@
 //! |---|---|---|---|
 //! | (one body) | `f64` | 1 | `portable` |
 //! | `portable` | [`F64x4`] (`wide`: SSE2 pairs) | 4 | `portable` |
-//! | `avx2` | `Avx4` (`__m256d`) | 4 | `avx2` |
+//! | `avx2` | `Avx4Pair` (two `__m256d`, side by side) | 8 | `avx2` |
 //! | `avx512` | `Avx8` (`__m512d`) | 8 | `avx512` |
 //!
 //! **Bit identity.** Every operation of a lane is lane-wise IEEE-754 arithmetic (`+ − × ÷ √`,
@@ -34,7 +34,7 @@ mod portable;
 mod sin_cos;
 
 #[cfg(target_arch = "x86_64")]
-pub(crate) use avx2::{Avx2, Avx4};
+pub(crate) use avx2::{Avx2, Avx4Pair};
 #[cfg(target_arch = "x86_64")]
 pub(crate) use avx512::{Avx8, Avx512};
 pub(crate) use path::Kernel;
@@ -46,8 +46,8 @@ use std::ops::{Add, Div, Mul, Neg, Sub};
 
 use crate::math::Real;
 
-/// Number of bodies a batch kernel steps at once: one AVX-512 register of f64, or two runs of
-/// four.
+/// Number of bodies a batch kernel steps at once: one AVX-512 register of f64, or two AVX2
+/// registers side by side.
 pub(crate) const LANES: usize = 8;
 
 /// f64 lanes: `f64` itself (one body), or a SIMD type holding a run of `WIDTH` consecutive

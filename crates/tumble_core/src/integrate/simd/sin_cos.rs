@@ -73,29 +73,31 @@ fn sin_cos_reduced_quadrant<T: Lane>(x: T) -> (T, T) {
 /// Below this magnitude `round(x · 2/π) = 0` (`0.78 · 2/π < 0.4966`): no reduction needed.
 const SMALL_ANGLE: f64 = 0.78;
 
-/// `(sin r, cos r)` for `|r| ≤ π/4`: `sin r = r (1 − z/3! + z²/5! − …)`,
-/// `cos r = 1 − z/2! + z²/4! − …` with `z = r²`, Horner in `z`.
+/// `(sin r, cos r)` for `|r| ≤ π/4`: `sin r = r − r z S(z)`, `cos r = 1 − z (½ − z C(z))` with
+/// `z = r²` and the Taylor tails `S(z) = 1/3! − z/5! + … + z⁶/15!`,
+/// `C(z) = 1/4! − z/6! + … + z⁶/16!`. Each tail is evaluated by Estrin's scheme,
+/// `(a₀ + a₁z) + z²(a₂ + a₃z) + z⁴((a₄ + a₅z) + z²a₆)`: three levels of independent
+/// multiply–adds instead of Horner's six in a row, which the kernel's chain of four
+/// rotations waits on.
 #[inline(always)]
 fn sin_cos_reduced<T: Lane>(r: T) -> (T, T) {
     let cpu = r.cpu();
     let z = r * r;
-    let sp = T::splat(cpu, -1.0 / 1_307_674_368_000.0);
-    let sp = T::splat(cpu, 1.0 / 6_227_020_800.0) + z * sp;
-    let sp = T::splat(cpu, -1.0 / 39_916_800.0) + z * sp;
-    let sp = T::splat(cpu, 1.0 / 362_880.0) + z * sp;
-    let sp = T::splat(cpu, -1.0 / 5_040.0) + z * sp;
-    let sp = T::splat(cpu, 1.0 / 120.0) + z * sp;
-    let sp = T::splat(cpu, 1.0 / 6.0) - z * sp;
+    let z2 = z * z;
+    let z4 = z2 * z2;
+    let s01 = T::splat(cpu, 1.0 / 6.0) - z * T::splat(cpu, 1.0 / 120.0);
+    let s23 = T::splat(cpu, 1.0 / 5_040.0) - z * T::splat(cpu, 1.0 / 362_880.0);
+    let s45 = T::splat(cpu, 1.0 / 39_916_800.0) - z * T::splat(cpu, 1.0 / 6_227_020_800.0);
+    let s6 = T::splat(cpu, 1.0 / 1_307_674_368_000.0);
+    let sp = (s01 + z2 * s23) + z4 * (s45 + z2 * s6);
     let s = r - (r * z) * sp;
-    let cp = T::splat(cpu, 1.0 / 20_922_789_888_000.0);
-    let cp = T::splat(cpu, -1.0 / 87_178_291_200.0) + z * cp;
-    let cp = T::splat(cpu, 1.0 / 479_001_600.0) + z * cp;
-    let cp = T::splat(cpu, -1.0 / 3_628_800.0) + z * cp;
-    let cp = T::splat(cpu, 1.0 / 40_320.0) + z * cp;
-    let cp = T::splat(cpu, -1.0 / 720.0) + z * cp;
-    let cp = T::splat(cpu, 1.0 / 24.0) + z * cp;
-    let c = T::splat(cpu, 1.0) - z * (T::splat(cpu, 0.5) - z * cp);
-    (s, c)
+    let c01 = T::splat(cpu, 1.0 / 24.0) - z * T::splat(cpu, 1.0 / 720.0);
+    let c23 = T::splat(cpu, 1.0 / 40_320.0) - z * T::splat(cpu, 1.0 / 3_628_800.0);
+    let c45 = T::splat(cpu, 1.0 / 479_001_600.0) - z * T::splat(cpu, 1.0 / 87_178_291_200.0);
+    let c6 = T::splat(cpu, 1.0 / 20_922_789_888_000.0);
+    let cp = (c01 + z2 * c23) + z4 * (c45 + z2 * c6);
+    let cos = T::splat(cpu, 1.0) - z * (T::splat(cpu, 0.5) - z * cp);
+    (s, cos)
 }
 
 /// `k mod 4` for an integral `k`, exactly: `floor(k/4) = round(k/4 − 3/8)`.
