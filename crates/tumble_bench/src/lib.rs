@@ -18,6 +18,7 @@ pub mod measure;
 pub mod output;
 pub mod population;
 pub mod rollback;
+pub mod scaling;
 pub mod springs;
 
 use std::path::PathBuf;
@@ -122,6 +123,10 @@ pub struct BenchResults {
     pub date: String,
     /// Copy bandwidth (read + write), GB/s, one thread and all pool threads.
     pub bandwidth_gb_s: [f64; 2],
+    /// What two independent one-thread raw loops, each over half of the 2-thread target's
+    /// bodies, run together gain over one alone: `2 t_alone / t_together`, the most any two
+    /// threads can gain on this machine ([`scaling`]).
+    pub two_copy_ceiling: f64,
     /// Bytes a body-step must move through memory in the ECS (read + write), for the floor.
     pub bytes_per_body_step: usize,
     /// All rows.
@@ -183,6 +188,12 @@ pub fn run_bench(options: &BenchOptions, mut progress: impl FnMut(&str)) -> Benc
         bandwidth::copy_bandwidth(1, 3),
         bandwidth::copy_bandwidth(pool_threads().max(1), 3),
     ];
+    // The 2-thread target is at 1e5 bodies: each thread steps half of them.
+    let half = max.min(100_000) / 2;
+    progress(&format!(
+        "two independent one-thread loops of {half} bodies"
+    ));
+    let two_copy_ceiling = scaling::two_copy_ceiling(half, effort.steps(half), effort.repetitions);
     let threaded = Parallelism::default();
     let single = Parallelism::SINGLE_THREAD;
     let mut rows = Vec::new();
@@ -257,7 +268,7 @@ pub fn run_bench(options: &BenchOptions, mut progress: impl FnMut(&str)) -> Benc
         .into_iter()
         .collect();
     let mut results = BenchResults {
-        schema: 2,
+        schema: 3,
         pool_threads: pool_threads(),
         kernel_path: tumble_core::kernel_path().to_string(),
         widest_kernel_path: KernelPath::available()
@@ -266,6 +277,7 @@ pub fn run_bench(options: &BenchOptions, mut progress: impl FnMut(&str)) -> Benc
         cpu: cpu_name(),
         date: humantime::format_rfc3339_seconds(started).to_string(),
         bandwidth_gb_s: bandwidth,
+        two_copy_ceiling,
         bytes_per_body_step: bytes_per_body_step(),
         rows,
         fixed_cost_ns,

@@ -38,7 +38,12 @@ fn small_run_measures_every_engine_and_writes_json() {
     );
     assert!(!results.targets.iter().any(|t| t.name.contains("1e5")));
     let json: serde_json::Value = serde_json::to_value(&results).unwrap();
-    assert_eq!(json["schema"], 2);
+    assert_eq!(json["schema"], 3);
+    assert!(
+        (0.5..=2.2).contains(&results.two_copy_ceiling),
+        "{}",
+        results.two_copy_ceiling
+    );
     // Where, when and on which kernel path it ran.
     assert!(json["cpu"].as_str().is_some_and(|c| !c.is_empty()));
     assert!(
@@ -56,6 +61,7 @@ fn small_run_measures_every_engine_and_writes_json() {
     assert!(json["rows"][0]["rapier"].is_number());
     let table = output::markdown(&results);
     assert!(table.contains("| bodies |") && table.contains("splitting"));
+    assert!(table.contains("Threads: two independent one-thread loops"));
     assert!(table.contains("**trajectory CSV**") && table.contains("rapier SpringJoint"));
 }
 

@@ -75,8 +75,13 @@ impl BodyState {
     #[inline]
     pub fn is_valid(&self) -> bool {
         // `is_finite` first: the length of a non-finite quaternion is NaN or Inf anyway, but
-        // a finite state is the common case and the cheap test is branch-free.
-        self.is_finite() && (self.rotation.length() - 1.0).abs() <= UNIT_QUATERNION_TOLERANCE
+        // a finite state is the common case and the cheap test is branch-free. Then the squared
+        // norm, without a square root: `|q|² − 1 = (|q| − 1)(|q| + 1)`, so
+        // `||q|² − 1| ≤ tol` implies `||q| − 1| ≤ tol` (with room for the rounding of the root);
+        // only a quaternion in between takes the exact test.
+        self.is_finite()
+            && ((self.rotation.length_squared() - 1.0).abs() <= UNIT_QUATERNION_TOLERANCE
+                || (self.rotation.length() - 1.0).abs() <= UNIT_QUATERNION_TOLERANCE)
     }
 
     /// Checks that every component is finite and the rotation is a unit quaternion.
