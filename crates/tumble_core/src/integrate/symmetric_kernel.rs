@@ -18,8 +18,8 @@
 
 use super::frame::reciprocal;
 #[cfg(target_arch = "x86_64")]
-use super::simd::{Avx2, Avx4Pair, Avx8, Avx512};
-use super::simd::{F64x4, Kernel, LANES, Lane, Portable, sin_cos};
+use super::simd::{Avx2, Avx4, Avx8, Avx512};
+use super::simd::{F64x4, Kernel, LANES, Lane, Pair, Portable, sin_cos};
 use crate::mass::MassProperties;
 use crate::math::{Narrow, Quat, Real, Vec3, Widen};
 
@@ -357,6 +357,8 @@ pub fn rotate_symmetric_lanes(
     h: [Real; LANES],
 ) -> RotatedLanes {
     match kernel {
+        // Not paired: `wide`'s `f64x4` is already two SSE2 registers side by side, and a pair of
+        // them spills so much that the kernel runs 40 % slower.
         Kernel::Portable => rotate_symmetric_lanes_in::<F64x4>(Portable, inputs, h),
         #[cfg(target_arch = "x86_64")]
         #[expect(
@@ -389,13 +391,13 @@ fn rotate_symmetric_lanes_avx512(
 }
 
 /// The kernel compiled with AVX2 enabled: eight bodies as two 256-bit registers side by side
-/// ([`Avx4Pair`]). The pair spills some values to the stack, yet on an AVX2-only EPYC it is
+/// ([`Pair`] of [`Avx4`]). The pair spills some values to the stack, yet on an AVX2-only EPYC it is
 /// 11–15 % faster per body-step than the two runs of four one after the other: each run's
 /// chain of four dependent rotations leaves the core idle, and the other run fills it.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 fn rotate_symmetric_lanes_avx2(cpu: Avx2, inputs: &LaneInputs, h: [Real; LANES]) -> RotatedLanes {
-    rotate_symmetric_lanes_in::<Avx4Pair>(cpu, inputs, h)
+    rotate_symmetric_lanes_in::<Pair<Avx4>>(cpu, inputs, h)
 }
 
 /// Runs the kernel over the batch in runs of `T::WIDTH` bodies: loads each input component of a

@@ -6,7 +6,7 @@
 //! |---|---|---|---|
 //! | (one body) | `f64` | 1 | `portable` |
 //! | `portable` | [`F64x4`] (`wide`: SSE2 pairs) | 4 | `portable` |
-//! | `avx2` | `Avx4Pair` (two `__m256d`, side by side) | 8 | `avx2` |
+//! | `avx2` | `Pair<Avx4>` (two `__m256d`, side by side: see `pair`) | 8 | `avx2` |
 //! | `avx512` | `Avx8` (`__m512d`) | 8 | `avx512` |
 //!
 //! **Bit identity.** Every operation of a lane is lane-wise IEEE-754 arithmetic (`+ − × ÷ √`,
@@ -29,14 +29,16 @@
 mod avx2;
 #[cfg(target_arch = "x86_64")]
 mod avx512;
+mod pair;
 mod path;
 mod portable;
 mod sin_cos;
 
 #[cfg(target_arch = "x86_64")]
-pub(crate) use avx2::{Avx2, Avx4Pair};
+pub(crate) use avx2::{Avx2, Avx4};
 #[cfg(target_arch = "x86_64")]
 pub(crate) use avx512::{Avx8, Avx512};
+pub(crate) use pair::Pair;
 pub(crate) use path::Kernel;
 pub use path::{KERNEL_ENV, KernelError, KernelPath, kernel_path};
 pub(crate) use portable::{F64x4, Portable};
