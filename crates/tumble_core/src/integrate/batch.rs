@@ -18,7 +18,9 @@ use std::borrow::Borrow;
 use super::Integrator;
 use super::exact_flow::{rotate_exactly, rotate_exactly_pair};
 use super::simd::{Kernel, LANES};
-use super::splitting::{drift_kick_drift_translation, free_rotation_span};
+use super::splitting::{
+    drift_kick_drift_linear, drift_kick_drift_translation, free_rotation_span, kick_angular,
+};
 use super::symmetric_kernel::{LaneInputs, rotate_symmetric_lanes, rotate_symmetric_one};
 use crate::mass::MassProperties;
 use crate::prefetch::prefetch;
@@ -147,32 +149,40 @@ impl PendingRotations {
     }
 
     /// Queues body `index` (already translated, as `state`, and not spherical) for its free
-    /// rotation; returns true when the batch is full and must be flushed.
+    /// rotation after the kick of angular impulse `impulse`; returns true when the batch is full
+    /// and must be flushed.
     #[inline(always)]
-    fn queue(&mut self, index: usize, state: &BodyState, mass: &MassProperties) -> bool {
+    fn queue(
+        &mut self,
+        index: usize,
+        state: &BodyState,
+        mass: &MassProperties,
+        impulse: Vec3,
+    ) -> bool {
         let lane = self.len;
         self.input
-            .set(lane, state.rotation, state.angular_velocity, mass);
+            .set(lane, state.rotation, state.angular_velocity, mass, impulse);
         self.index[lane] = index;
         self.translated[lane] = (state.position, state.linear_velocity);
         self.len = lane + 1;
         self.len == LANES
     }
 
-    /// Rotates the queued bodies and commits each result. A batch of one goes through the
-    /// scalar kernel; a partial batch fills its empty lanes with copies of its first body (lanes
-    /// are independent, so the results are the same bits either way).
+    /// Rotates the queued bodies (after their kicks when `kicks`) and commits each result. A
+    /// batch of one goes through the scalar kernel; a partial batch fills its empty lanes with
+    /// copies of its first body (lanes are independent, so the results are the same bits either
+    /// way).
     #[inline(always)]
-    fn flush(&mut self, bodies: &mut impl BodyBatch) {
+    fn flush(&mut self, bodies: &mut impl BodyBatch, kicks: bool) {
         match self.len {
             0 => {}
             1 => {
-                let (rotation, omega) = rotate_symmetric_one(&self.input.get(0), self.h[0]);
+                let (rotation, omega) = rotate_symmetric_one(&self.input.get(0), self.h[0], kicks);
                 self.finish(0, rotation, omega, bodies);
             }
             len => {
                 self.input.fill_from_first(len);
-                let rotated = rotate_symmetric_lanes(self.kernel, &self.input, self.h);
+                let rotated = rotate_symmetric_lanes(self.kernel, &self.input, self.h, kicks);
                 for lane in 0..len {
                     let (rotation, omega) = rotated.lane(lane);
                     self.finish(lane, rotation, omega, bodies);
@@ -215,9 +225,10 @@ fn each_alone(
     }
 }
 
-/// The `splitting` batch: each body's drift–kick–drift translation, then its free rotation,
-/// queued for the SIMD kernel ([`PendingRotations`]), or stepped whole by `alone` when its
-/// translation cannot run first (a whole step under a torque).
+/// The `splitting` batch: each body's drift–kick–drift translation and linear kick, then its
+/// free rotation (which takes the angular kick, in `Finish`), queued for the SIMD kernel
+/// ([`PendingRotations`]), or stepped whole by `alone` when its translation cannot run first
+/// (a whole step under a torque).
 #[inline(always)]
 fn batched(
     kernel: Kernel,
@@ -227,6 +238,7 @@ fn batched(
     mut alone: impl FnMut(&mut BodyState, &MassProperties, &Wrench),
 ) {
     let h = free_rotation_span(phase, dt);
+    let kicks = phase == StepPhase::Finish;
     let mut pending = PendingRotations::new(h, kernel);
     let mut next = BodyState::ZEROED;
     for i in 0..bodies.len() {
@@ -235,17 +247,18 @@ fn batched(
             continue;
         };
         let mass = bodies.mass(i);
-        match drift_kick_drift_translation(phase, &mut next, mass, &wrench, dt) {
-            true if mass.is_spherical() => {
+        match drift_kick_drift_linear(phase, &mut next, mass, &wrench, dt) {
+            Some(impulse) if mass.is_spherical() => {
+                kick_angular(&mut next, mass, impulse);
                 next.rotation = rotate_exact(next.rotation, next.angular_velocity, h);
                 commit(bodies, i, &next);
             }
-            true => {
-                if pending.queue(i, &next, mass) {
-                    pending.flush(bodies);
+            Some(impulse) => {
+                if pending.queue(i, &next, mass, impulse) {
+                    pending.flush(bodies, kicks);
                 }
             }
-            false => {
+            None => {
                 // A copy, so that `next` never escapes into the (not inlined) scalar step and
                 // stays in registers on the hot path.
                 let mut single = next;
@@ -254,7 +267,7 @@ fn batched(
             }
         }
     }
-    pending.flush(bodies);
+    pending.flush(bodies, kicks);
 }
 
 /// The `exact` batch: each body's drift–kick–drift translation, then its free rotation, two

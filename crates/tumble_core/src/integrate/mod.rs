@@ -65,8 +65,8 @@ use lclamp::lclamp;
 use rk4::rk4_free_flow;
 pub use simd::{KERNEL_ENV, KernelError, KernelPath, kernel_path};
 use splitting::{
-    Rotation, drift_kick_drift, drift_kick_drift_translation, rotate_freely, rotate_symmetric,
-    strang_free_flow,
+    Rotation, drift_kick_drift, drift_kick_drift_symmetric, drift_kick_drift_translation,
+    rotate_freely, rotate_symmetric, strang_free_flow,
 };
 use symplectic_euler::{symplectic_euler, symplectic_euler_linear};
 
@@ -211,14 +211,31 @@ impl Integrator {
         }
     }
 
+    /// `phase` of a drift–kick–drift stage with the method's free rotation (`splitting`'s takes
+    /// the angular kick into its body momentum).
+    #[inline]
+    fn drift_kick_drift_stage(
+        self,
+        phase: StepPhase,
+        state: &mut BodyState,
+        mass: &MassProperties,
+        wrench: &Wrench,
+        h: Real,
+    ) {
+        if self.rotates_on_symmetric_kernel() {
+            drift_kick_drift_symmetric(phase, state, mass, wrench, h);
+        } else {
+            drift_kick_drift(phase, state, mass, wrench, h, self.free_rotation());
+        }
+    }
+
     /// First phase of one stage of span `h`, before forces are sampled: half a drift for the
     /// drift–kick–drift methods, nothing for the others. A whole step is the stages of
     /// [`composition`](Self::composition) (see [`step_with`](Self::step_with)).
     #[inline]
     pub fn begin_stage(self, state: &mut BodyState, mass: &MassProperties, h: Real) {
         if self.samples_forces_at_midpoint() {
-            let rotation = self.free_rotation();
-            drift_kick_drift(StepPhase::Begin, state, mass, &Wrench::ZERO, h, rotation);
+            self.drift_kick_drift_stage(StepPhase::Begin, state, mass, &Wrench::ZERO, h);
         }
     }
 
@@ -243,8 +260,7 @@ impl Integrator {
             | Integrator::Rk4
             | Integrator::Exact
             | Integrator::Exact4 => {
-                let rotation = self.free_rotation();
-                drift_kick_drift(StepPhase::Finish, state, mass, wrench, h, rotation);
+                self.drift_kick_drift_stage(StepPhase::Finish, state, mass, wrench, h);
             }
         }
     }
@@ -263,8 +279,7 @@ impl Integrator {
         h: Real,
     ) {
         if self.samples_forces_at_midpoint() {
-            let rotation = self.free_rotation();
-            drift_kick_drift(StepPhase::Whole, state, mass, wrench, h, rotation);
+            self.drift_kick_drift_stage(StepPhase::Whole, state, mass, wrench, h);
         } else {
             // The kick–drift methods do nothing before the forces: the stage is its second phase.
             self.finish_stage(state, mass, wrench, h);

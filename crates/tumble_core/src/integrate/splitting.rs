@@ -133,7 +133,27 @@ pub fn rotate_symmetric(state: &mut BodyState, mass: &MassProperties, h: Real) {
         return;
     }
     let input = SymmetricInput::new(state.rotation, state.angular_velocity, mass);
-    (state.rotation, state.angular_velocity) = rotate_symmetric_one(&input, h);
+    (state.rotation, state.angular_velocity) = rotate_symmetric_one(&input, h, false);
+}
+
+/// [`rotate_symmetric`] after the kick `L += J` of the angular impulse `impulse` (world frame):
+/// the kernel folds `J` into the body momentum (see `symmetric_kernel`); a spherical body takes
+/// it as `ω += I⁻¹ J` first, as every other method does.
+#[inline]
+pub fn rotate_symmetric_kicked(
+    state: &mut BodyState,
+    mass: &MassProperties,
+    h: Real,
+    impulse: Vec3,
+) {
+    if mass.is_spherical() {
+        kick_angular(state, mass, impulse);
+        state.rotation = rotate_exact(state.rotation, state.angular_velocity, h);
+        return;
+    }
+    let input =
+        SymmetricInput::new(state.rotation, state.angular_velocity, mass).with_impulse(impulse);
+    (state.rotation, state.angular_velocity) = rotate_symmetric_one(&input, h, true);
 }
 
 /// The rotational part of a drift: the free flow over `h` at constant world `L`.
@@ -184,12 +204,11 @@ impl FreeState {
     }
 }
 
-/// Kick for `h`: `v += h F/m`, `L += h τ` (so `ω += h I⁻¹ τ` at the current pose).
-#[inline]
-fn kick(state: &mut BodyState, mass: &MassProperties, wrench: &Wrench, h: Real) {
-    state.linear_velocity += (h * mass.inv_mass()) * wrench.force;
-    if wrench.torque != Vec3::ZERO {
-        state.angular_velocity += mass.world_inv_inertia_mul(state.rotation, h * wrench.torque);
+/// The angular kick `L += J` as `ω += I⁻¹ J` at the current pose (nothing for `J = 0`).
+#[inline(always)]
+pub(crate) fn kick_angular(state: &mut BodyState, mass: &MassProperties, impulse: Vec3) {
+    if impulse != Vec3::ZERO {
+        state.angular_velocity += mass.world_inv_inertia_mul(state.rotation, impulse);
     }
 }
 
@@ -222,21 +241,67 @@ pub(crate) fn drift_kick_drift_translation(
     wrench: &Wrench,
     dt: Real,
 ) -> bool {
+    let Some(impulse) = drift_kick_drift_linear(phase, state, mass, wrench, dt) else {
+        return false;
+    };
+    kick_angular(state, mass, impulse);
+    true
+}
+
+/// [`drift_kick_drift_translation`] without the angular kick: returns the angular impulse
+/// `J = Δt τ` that the phase's free rotation must take (zero outside `Finish`), or `None` for
+/// `Whole` under a torque.
+#[inline(always)]
+pub(crate) fn drift_kick_drift_linear(
+    phase: StepPhase,
+    state: &mut BodyState,
+    mass: &MassProperties,
+    wrench: &Wrench,
+    dt: Real,
+) -> Option<Vec3> {
     let half = 0.5 * dt;
     match phase {
         StepPhase::Begin => state.position += half * state.linear_velocity,
         StepPhase::Finish => {
-            kick(state, mass, wrench, dt);
+            state.linear_velocity += (dt * mass.inv_mass()) * wrench.force;
             state.position += half * state.linear_velocity;
+            if wrench.torque != Vec3::ZERO {
+                return Some(dt * wrench.torque);
+            }
         }
         StepPhase::Whole if wrench.torque == Vec3::ZERO => {
             state.position += half * state.linear_velocity;
             state.linear_velocity += (dt * mass.inv_mass()) * wrench.force;
             state.position += half * state.linear_velocity;
         }
-        StepPhase::Whole => return false,
+        StepPhase::Whole => return None,
     }
-    true
+    Some(Vec3::ZERO)
+}
+
+/// `phase` of the drift–kick–drift step with `splitting`'s free rotation, which takes the
+/// kick's angular impulse into the body momentum ([`rotate_symmetric_kicked`]).
+#[inline]
+pub(crate) fn drift_kick_drift_symmetric(
+    phase: StepPhase,
+    state: &mut BodyState,
+    mass: &MassProperties,
+    wrench: &Wrench,
+    dt: Real,
+) {
+    let halves: &[StepPhase] = match phase {
+        StepPhase::Whole if wrench.torque != Vec3::ZERO => &[StepPhase::Begin, StepPhase::Finish],
+        _ => &[phase],
+    };
+    for &part in halves {
+        let impulse = drift_kick_drift_linear(part, state, mass, wrench, dt).unwrap_or(Vec3::ZERO);
+        let h = free_rotation_span(part, dt);
+        if part == StepPhase::Finish {
+            rotate_symmetric_kicked(state, mass, h, impulse);
+        } else {
+            rotate_symmetric(state, mass, h);
+        }
+    }
 }
 
 /// `phase` of the drift–kick–drift step with a method's free `rotation`.

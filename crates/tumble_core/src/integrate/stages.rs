@@ -61,7 +61,7 @@ pub(super) fn rotate_composed(
         return;
     }
     let input = SymmetricInput::new(state.rotation, state.angular_velocity, mass);
-    let mut flowing = Flowing::<f64>::start(&input);
+    let mut flowing = Flowing::<f64>::start(&input, false);
     for &c in weights {
         flowing.symmetric_flow(c.widen() * h.widen());
     }

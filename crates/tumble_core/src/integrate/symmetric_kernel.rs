@@ -7,11 +7,16 @@
 //! With that, every lane runs the same branch-free sequence
 //!
 //! ```text
-//! Q = q F',  m = I' ⊙ Qᵀω,
+//! Q = q F',  m = I' ⊙ Qᵀω  (+ free ⊙ QᵀJ after a kick),
 //! rotate about z by ½h (r_z − r_y) m_z,   about m by h r_y |m|,
 //! rotate about x by h (r_x − r_y) m_x,    about z by ½h (r_z − r_y) m_z,
 //! ω' = Q (r ⊙ m),  q' = normalize(Q F'ᵀ)
 //! ```
+//!
+//! The kick before the second half drift of a step under torque, `L += J` with the angular
+//! impulse `J = Δt τ`, is folded into the body momentum (`m += Qᵀ J` on the free axes) instead of
+//! being applied to `ω` first: the same motion without a round trip through the world inverse
+//! inertia and the engine's precision in between.
 //!
 //! A rotation by a zero angle is the exact identity (`sin 0 = 0`, `cos 0 = 1`), so locked axes
 //! (`r = 0`) and symmetric bodies need no branches.
@@ -130,6 +135,9 @@ pub struct SymmetricInput<T = f64> {
     pub relabel: Quat4<T>,
     /// Relabelled principal moments `I'`.
     pub inertia: Vec3L<T>,
+    /// Angular impulse `J` (world frame) of the kick just before this free flow (zero when
+    /// there is none); read only by a kicking flow (see [`symmetric_rotation`]).
+    pub impulse: Vec3L<T>,
 }
 
 /// The relabellings `P`: `x' = a`, for the odd axis `a` = x, y, z (exact in any precision).
@@ -165,6 +173,17 @@ impl SymmetricInput {
             frame: [f.x, f.y, f.z, f.w],
             relabel: RELABEL[mass.odd_axis()].map(Widen::widen),
             inertia: relabelled_inertia(mass).map(Widen::widen),
+            impulse: [0.0; 3],
+        }
+    }
+
+    /// The same inputs after a kick of angular impulse `impulse` (world frame).
+    #[inline]
+    pub fn with_impulse(self, impulse: Vec3) -> Self {
+        let j = impulse.widen();
+        Self {
+            impulse: [j.x, j.y, j.z],
+            ..self
         }
     }
 }
@@ -176,9 +195,17 @@ impl SymmetricInput {
 pub type LaneInputs = SymmetricInput<[Real; LANES]>;
 
 impl LaneInputs {
-    /// Puts one body's inputs into lane `lane` (what [`SymmetricInput::new`] makes of them).
+    /// Puts one body's inputs into lane `lane` (what [`SymmetricInput::new`] and
+    /// [`with_impulse`](SymmetricInput::with_impulse) make of them).
     #[inline(always)]
-    pub fn set(&mut self, lane: usize, rotation: Quat, omega: Vec3, mass: &MassProperties) {
+    pub fn set(
+        &mut self,
+        lane: usize,
+        rotation: Quat,
+        omega: Vec3,
+        mass: &MassProperties,
+        impulse: Vec3,
+    ) {
         let inertia = relabelled_inertia(mass);
         let frame = mass.principal_frame();
         let relabel = RELABEL[mass.odd_axis()];
@@ -195,13 +222,15 @@ impl LaneInputs {
             self.frame[k][lane] = f;
             self.relabel[k][lane] = p;
         }
-        for (k, (w, i)) in [omega.x, omega.y, omega.z]
+        for (k, ((w, i), j)) in [omega.x, omega.y, omega.z]
             .into_iter()
             .zip(inertia)
+            .zip([impulse.x, impulse.y, impulse.z])
             .enumerate()
         {
             self.omega[k][lane] = w;
             self.inertia[k][lane] = i;
+            self.impulse[k][lane] = j;
         }
     }
 
@@ -214,6 +243,7 @@ impl LaneInputs {
             frame: self.frame.map(|c| c[lane].widen()),
             relabel: self.relabel.map(|c| c[lane].widen()),
             inertia: self.inertia.map(|c| c[lane].widen()),
+            impulse: self.impulse.map(|c| c[lane].widen()),
         }
     }
 
@@ -230,6 +260,7 @@ impl LaneInputs {
         self.frame.iter_mut().for_each(fill);
         self.relabel.iter_mut().for_each(fill);
         self.inertia.iter_mut().for_each(fill);
+        self.impulse.iter_mut().for_each(fill);
     }
 }
 
@@ -242,9 +273,11 @@ pub(super) struct Flowing<T> {
 }
 
 impl<T: Lane> Flowing<T> {
-    /// `Q = q F'`, `m = I' ⊙ Qᵀω`.
+    /// `Q = q F'`, `m = I' ⊙ Qᵀω`; when `kicks`, plus `Qᵀ J` on the free axes (`I' > 0`) of
+    /// every lane whose impulse `J` is not zero (or is NaN, which must show), so that a lane
+    /// without a torque gets the bits of a flow without a kick.
     #[inline(always)]
-    pub(super) fn start(input: &SymmetricInput<T>) -> Self {
+    pub(super) fn start(input: &SymmetricInput<T>, kicks: bool) -> Self {
         let inertia = input.inertia;
         // Written out, not `inertia.map(reciprocal)`: inside a `#[target_feature]` function
         // every helper must inline, and `map` need not (see `rotate_run`).
@@ -256,11 +289,29 @@ impl<T: Lane> Flowing<T> {
         let frame = mul(input.frame, input.relabel);
         let q = mul(input.rotation, frame);
         let body = rotate(conjugate(q), input.omega);
-        let m = [
+        let mut m = [
             inertia[0] * body[0],
             inertia[1] * body[1],
             inertia[2] * body[2],
         ];
+        if kicks {
+            let j = input.impulse;
+            let cpu = j[0].cpu();
+            let zero = T::splat(cpu, 0.0);
+            let kicked = (j[0] * j[0] + j[1] * j[1] + j[2] * j[2]).beyond(0.0);
+            let body_j = rotate(conjugate(q), j);
+            // Written out, not a loop over the axes: see `reciprocal` above.
+            let free = [
+                T::select(inertia[0].gt(zero), body_j[0], zero),
+                T::select(inertia[1].gt(zero), body_j[1], zero),
+                T::select(inertia[2].gt(zero), body_j[2], zero),
+            ];
+            m = [
+                T::select(kicked, m[0] + free[0], m[0]),
+                T::select(kicked, m[1] + free[1], m[1]),
+                T::select(kicked, m[2] + free[2], m[2]),
+            ];
+        }
         Self {
             free: Free { q, m },
             r,
@@ -293,11 +344,16 @@ impl<T: Lane> Flowing<T> {
     }
 }
 
-/// The free rotation over `h` of the `splitting` method, in lanes: returns the new orientation
-/// (unit, f64) and world angular velocity. See the module documentation for the sequence.
+/// The free rotation over `h` of the `splitting` method, in lanes, after the kick of the
+/// inputs' angular impulse when `kicks`: returns the new orientation (unit, f64) and world
+/// angular velocity. See the module documentation for the sequence.
 #[inline(always)]
-pub fn symmetric_rotation<T: Lane>(input: &SymmetricInput<T>, h: T) -> (Quat4<T>, Vec3L<T>) {
-    let mut flowing = Flowing::start(input);
+pub fn symmetric_rotation<T: Lane>(
+    input: &SymmetricInput<T>,
+    h: T,
+    kicks: bool,
+) -> (Quat4<T>, Vec3L<T>) {
+    let mut flowing = Flowing::start(input, kicks);
     flowing.symmetric_flow(h);
     flowing.finish()
 }
@@ -311,11 +367,11 @@ pub(super) fn to_real(q: [f64; 4], w: [f64; 3]) -> (Quat, Vec3) {
     )
 }
 
-/// One body through the kernel (`f64` lanes): the new `(q, ω)`, rounded to the engine
-/// precision once.
+/// One body through the kernel (`f64` lanes), after the kick of its impulse when `kicks`: the
+/// new `(q, ω)`, rounded to the engine precision once.
 #[inline]
-pub fn rotate_symmetric_one(input: &SymmetricInput, h: Real) -> (Quat, Vec3) {
-    let (q, w) = symmetric_rotation::<f64>(input, h.widen());
+pub fn rotate_symmetric_one(input: &SymmetricInput, h: Real, kicks: bool) -> (Quat, Vec3) {
+    let (q, w) = symmetric_rotation::<f64>(input, h.widen(), kicks);
     to_real(q, w)
 }
 
@@ -344,9 +400,9 @@ impl RotatedLanes {
     }
 }
 
-/// [`LANES`] bodies through the kernel at once (SIMD lanes), each over its own `h`, on the
-/// `kernel`'s instruction set; lane `i` of the result is bit-identical to
-/// [`rotate_symmetric_one`]`(&inputs[i], h[i])` on every path.
+/// [`LANES`] bodies through the kernel at once (SIMD lanes), each over its own `h` (after the
+/// kick of its impulse when `kicks`), on the `kernel`'s instruction set; lane `i` of the result
+/// is bit-identical to [`rotate_symmetric_one`]`(&inputs[i], h[i], kicks)` on every path.
 // Not inlined: the portable kernel compiles into this function, and inlined into the batch
 // loops (three of them, one per phase) it bloats them past what the instruction cache and the
 // register allocator handle well; one call per eight bodies costs nothing in comparison.
@@ -355,11 +411,12 @@ pub fn rotate_symmetric_lanes(
     kernel: Kernel,
     inputs: &LaneInputs,
     h: [Real; LANES],
+    kicks: bool,
 ) -> RotatedLanes {
     match kernel {
         // Not paired: `wide`'s `f64x4` is already two SSE2 registers side by side, and a pair of
         // them spills so much that the kernel runs 40 % slower.
-        Kernel::Portable => rotate_symmetric_lanes_in::<F64x4>(Portable, inputs, h),
+        Kernel::Portable => rotate_symmetric_lanes_in::<F64x4>(Portable, inputs, h, kicks),
         #[cfg(target_arch = "x86_64")]
         #[expect(
             unsafe_code,
@@ -367,7 +424,7 @@ pub fn rotate_symmetric_lanes(
         )]
         // SAFETY: the `Avx2` token exists, so the CPU has AVX2, the only requirement of calling
         // a function compiled with `#[target_feature(enable = "avx2")]`.
-        Kernel::Avx2(cpu) => unsafe { rotate_symmetric_lanes_avx2(cpu, inputs, h) },
+        Kernel::Avx2(cpu) => unsafe { rotate_symmetric_lanes_avx2(cpu, inputs, h, kicks) },
         #[cfg(target_arch = "x86_64")]
         #[expect(
             unsafe_code,
@@ -375,7 +432,7 @@ pub fn rotate_symmetric_lanes(
         )]
         // SAFETY: the `Avx512` token exists, so the CPU has AVX-512F, the only requirement of
         // calling a function compiled with `#[target_feature(enable = "avx512f")]`.
-        Kernel::Avx512(cpu) => unsafe { rotate_symmetric_lanes_avx512(cpu, inputs, h) },
+        Kernel::Avx512(cpu) => unsafe { rotate_symmetric_lanes_avx512(cpu, inputs, h, kicks) },
     }
 }
 
@@ -386,8 +443,9 @@ fn rotate_symmetric_lanes_avx512(
     cpu: Avx512,
     inputs: &LaneInputs,
     h: [Real; LANES],
+    kicks: bool,
 ) -> RotatedLanes {
-    rotate_symmetric_lanes_in::<Avx8>(cpu, inputs, h)
+    rotate_symmetric_lanes_in::<Avx8>(cpu, inputs, h, kicks)
 }
 
 /// The kernel compiled with AVX2 enabled: eight bodies as two 256-bit registers side by side
@@ -396,8 +454,13 @@ fn rotate_symmetric_lanes_avx512(
 /// chain of four dependent rotations leaves the core idle, and the other run fills it.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-fn rotate_symmetric_lanes_avx2(cpu: Avx2, inputs: &LaneInputs, h: [Real; LANES]) -> RotatedLanes {
-    rotate_symmetric_lanes_in::<Pair<Avx4>>(cpu, inputs, h)
+fn rotate_symmetric_lanes_avx2(
+    cpu: Avx2,
+    inputs: &LaneInputs,
+    h: [Real; LANES],
+    kicks: bool,
+) -> RotatedLanes {
+    rotate_symmetric_lanes_in::<Pair<Avx4>>(cpu, inputs, h, kicks)
 }
 
 /// Runs the kernel over the batch in runs of `T::WIDTH` bodies: loads each input component of a
@@ -407,6 +470,7 @@ fn rotate_symmetric_lanes_in<T: Lane>(
     cpu: T::Cpu,
     inputs: &LaneInputs,
     h: [Real; LANES],
+    kicks: bool,
 ) -> RotatedLanes {
     let mut out = RotatedLanes {
         rotation: [[0.0; LANES]; 4],
@@ -414,7 +478,7 @@ fn rotate_symmetric_lanes_in<T: Lane>(
     };
     let mut start = 0;
     while start < LANES {
-        rotate_run::<T>(cpu, inputs, &h, start, &mut out);
+        rotate_run::<T>(cpu, inputs, &h, start, kicks, &mut out);
         start += T::WIDTH;
     }
     out
@@ -430,6 +494,7 @@ fn rotate_run<T: Lane>(
     inputs: &LaneInputs,
     h: &[Real; LANES],
     start: usize,
+    kicks: bool,
     out: &mut RotatedLanes,
 ) {
     let zero = T::splat(cpu, 0.0);
@@ -439,6 +504,7 @@ fn rotate_run<T: Lane>(
         frame: [zero; 4],
         relabel: [zero; 4],
         inertia: [zero; 3],
+        impulse: [zero; 3],
     };
     for k in 0..4 {
         input.rotation[k] = T::load_real(cpu, &inputs.rotation[k][start..]);
@@ -448,8 +514,11 @@ fn rotate_run<T: Lane>(
     for k in 0..3 {
         input.omega[k] = T::load_real(cpu, &inputs.omega[k][start..]);
         input.inertia[k] = T::load_real(cpu, &inputs.inertia[k][start..]);
+        if kicks {
+            input.impulse[k] = T::load_real(cpu, &inputs.impulse[k][start..]);
+        }
     }
-    let (q, w) = symmetric_rotation::<T>(&input, T::load_real(cpu, &h[start..]));
+    let (q, w) = symmetric_rotation::<T>(&input, T::load_real(cpu, &h[start..]), kicks);
     // Rounded lane-wise, exactly as `to_real` rounds one body.
     for k in 0..4 {
         q[k].store_real(&mut out.rotation[k][start..]);
@@ -468,7 +537,9 @@ mod tests {
     /// Every compilation of the lane kernel the CPU runs (portable, and AVX2 or AVX-512 where
     /// it has them) and the scalar kernel agree bit for bit, on bodies that exercise every
     /// relabelling, a locked axis, the wide-angle sine path and (lane 6) an angle beyond the
-    /// polynomial's range, which must not change its neighbours' bits.
+    /// polynomial's range, which must not change its neighbours' bits; with and without the
+    /// kick, whose impulse is zero in two lanes (they must get the unkicked bits) and falls on
+    /// the locked axis of lane 3.
     #[test]
     fn lane_kernels_match_the_scalar_kernel() {
         let bodies: Vec<(Vec3, Vec3)> = vec![
@@ -489,9 +560,14 @@ mod tests {
                 .unwrap();
             (Quat::from_rotation_y(i as Real), omega, mass)
         });
+        let impulses: [Vec3; LANES] = std::array::from_fn(|i| match i {
+            0 | 5 => Vec3::ZERO,
+            3 => Vec3::new(0.4, 0.0, 0.0),
+            _ => Vec3::new(0.05 * i as Real, -0.02, 0.01 * (i * i) as Real),
+        });
         let owned: [SymmetricInput; LANES] = std::array::from_fn(|i| {
             let (rotation, omega, mass) = bodies_in[i];
-            SymmetricInput::new(rotation, omega, &mass)
+            SymmetricInput::new(rotation, omega, &mass).with_impulse(impulses[i])
         });
         let h = [
             1.0 / 60.0,
@@ -503,9 +579,11 @@ mod tests {
             1.0 / 60.0,
             0.01,
         ];
-        let expected: Vec<(Quat, Vec3)> = (0..LANES)
-            .map(|i| rotate_symmetric_one(&owned[i], h[i]))
-            .collect();
+        let expected = |kicks: bool| -> Vec<(Quat, Vec3)> {
+            (0..LANES)
+                .map(|i| rotate_symmetric_one(&owned[i], h[i], kicks))
+                .collect()
+        };
         let bits = |r: &[(Quat, Vec3)]| -> Vec<u64> {
             r.iter()
                 .flat_map(|(q, w)| {
@@ -518,20 +596,53 @@ mod tests {
         };
         let mut inputs = LaneInputs::default();
         for (lane, &(rotation, omega, mass)) in bodies_in.iter().enumerate() {
-            inputs.set(lane, rotation, omega, &mass);
+            inputs.set(lane, rotation, omega, &mass, impulses[lane]);
             assert_eq!(inputs.get(lane), owned[lane], "lane {lane}");
         }
         let inputs = &inputs;
         let lanes = |r: RotatedLanes| (0..LANES).map(|i| r.lane(i)).collect::<Vec<_>>();
         let kernels = Kernel::available();
         assert_eq!(kernels[0].path(), KernelPath::Portable);
-        for kernel in kernels {
-            assert_eq!(
-                bits(&lanes(rotate_symmetric_lanes(kernel, inputs, h))),
-                bits(&expected),
-                "{}",
-                kernel.path()
-            );
+        for kicks in [false, true] {
+            for &kernel in &kernels {
+                assert_eq!(
+                    bits(&lanes(rotate_symmetric_lanes(kernel, inputs, h, kicks))),
+                    bits(&expected(kicks)),
+                    "{} kicks {kicks}",
+                    kernel.path()
+                );
+            }
         }
+        // A zero impulse is no kick, bit for bit; a non-zero one changes the motion.
+        let (unkicked, kicked) = (expected(false), expected(true));
+        for lane in 0..LANES {
+            let same = bits(&unkicked[lane..=lane]) == bits(&kicked[lane..=lane]);
+            assert_eq!(same, impulses[lane] == Vec3::ZERO, "lane {lane}");
+        }
+    }
+
+    /// The kick folded into the body momentum is the kick `ω += I⁻¹ J` applied first: the two
+    /// agree to the rounding of `ω` to the engine's precision.
+    #[test]
+    fn the_folded_kick_is_the_kick_applied_first() {
+        let mass = MassProperties::new(Mass::new(2.0).unwrap(), Vec3::new(0.4, 0.5, 0.8))
+            .unwrap()
+            .with_principal_frame(Quat::from_rotation_z(0.4))
+            .unwrap();
+        let rotation = Quat::from_rotation_y(1.1) * Quat::from_rotation_x(0.3);
+        let (omega, impulse, h) = (Vec3::new(1.0, -2.0, 0.5), Vec3::new(0.3, 0.1, -0.2), 0.01);
+        let folded = SymmetricInput::new(rotation, omega, &mass).with_impulse(impulse);
+        let (q_folded, w_folded) = rotate_symmetric_one(&folded, h, true);
+        let kicked = omega + mass.world_inv_inertia_mul(rotation, impulse);
+        let first = SymmetricInput::new(rotation, kicked, &mass);
+        let (q_first, w_first) = rotate_symmetric_one(&first, h, false);
+        // ω ≈ 3 rad/s rounded once more on the second path: a few ulps of it.
+        let tolerance = 16.0 * Real::EPSILON * 4.0;
+        assert!(
+            (w_folded - w_first).length() < tolerance,
+            "{w_folded} vs {w_first}"
+        );
+        assert!(q_folded.dot(q_first).abs() > 1.0 - tolerance);
+        assert!((w_folded - omega).length() > 0.1, "the kick acted");
     }
 }
