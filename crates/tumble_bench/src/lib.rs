@@ -127,6 +127,8 @@ pub struct BenchResults {
     /// bodies, run together gain over one alone: `2 t_alone / t_together`, the most any two
     /// threads can gain on this machine ([`scaling`]).
     pub two_copy_ceiling: f64,
+    /// Floating-point operations of the default integrator's free rotation per body-step.
+    pub kernel_flops: KernelFlops,
     /// Bytes a body-step must move through memory in the ECS (read + write), for the floor.
     pub bytes_per_body_step: usize,
     /// All rows.
@@ -145,6 +147,38 @@ pub struct BenchResults {
     pub csv: Vec<csv::CsvRow>,
     /// The targets of issue #7 and of the stiff-springs issue.
     pub targets: Vec<Target>,
+}
+
+/// The floating-point operations of one body's free rotation under the default integrator,
+/// counted by running its lane kernel on a lane type that counts
+/// ([`tumble_core::integrate::symmetric_rotation_flops`]); the SIMD paths run them four or
+/// eight bodies per instruction.
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct KernelFlops {
+    /// Additions and subtractions.
+    pub add: u64,
+    /// Multiplications.
+    pub mul: u64,
+    /// Divisions.
+    pub div: u64,
+    /// Square roots.
+    pub sqrt: u64,
+    /// All of them.
+    pub total: u64,
+}
+
+impl KernelFlops {
+    /// The count of the torque-free step's free rotation (what the free-body rows run).
+    pub fn counted() -> Self {
+        let c = tumble_core::integrate::symmetric_rotation_flops(false);
+        Self {
+            add: c.add,
+            mul: c.mul,
+            div: c.div,
+            sqrt: c.sqrt,
+            total: c.total(),
+        }
+    }
 }
 
 /// The two integrators measured: the default and the textbook step.
@@ -278,6 +312,7 @@ pub fn run_bench(options: &BenchOptions, mut progress: impl FnMut(&str)) -> Benc
         date: humantime::format_rfc3339_seconds(started).to_string(),
         bandwidth_gb_s: bandwidth,
         two_copy_ceiling,
+        kernel_flops: KernelFlops::counted(),
         bytes_per_body_step: bytes_per_body_step(),
         rows,
         fixed_cost_ns,

@@ -258,6 +258,35 @@ fn machine_line(results: &BenchResults) -> String {
     format!("Measured {} on {}, {path}.", results.date, results.cpu)
 }
 
+/// The kernel's flops per body-step beside the bytes, and the rate the ECS step runs them at.
+fn flops_line(results: &BenchResults) -> String {
+    let f = &results.kernel_flops;
+    let mut line = format!(
+        "Compute: the default integrator's free rotation is {} flops per body-step ({} adds, {} \
+         multiplies, {} divisions, {} square roots; counted by running its kernel on a lane \
+         type that counts), {:.1} flops per byte the step moves",
+        f.total,
+        f.add,
+        f.mul,
+        f.div,
+        f.sqrt,
+        f.total as f64 / results.bytes_per_body_step as f64
+    );
+    let largest = rows_of(results, DEFAULT)
+        .filter(|r| r.bodies <= 100_000)
+        .max_by_key(|r| r.bodies);
+    if let Some(r) = largest {
+        let _ = write!(
+            line,
+            "; the ECS step on one thread at N = {} runs them at {:.1} GFLOP/s",
+            r.bodies,
+            f.total as f64 / r.ecs_1t
+        );
+    }
+    line.push('.');
+    line
+}
+
 /// The full markdown report: machine, per-size table per integrator, targets.
 pub fn markdown(results: &BenchResults) -> String {
     let mut s = String::new();
@@ -269,11 +298,12 @@ pub fn markdown(results: &BenchResults) -> String {
          body-step moves {} bytes, so one thread cannot go below {floor:.1} ns per body-step.\n\n\
          Threads: two independent one-thread loops, run together, do {:.2}× the work of one \
          alone: the most any two threads gain on this machine (below 2 when the two virtual \
-         CPUs share a core or a neighbour is busy).\n",
+         CPUs share a core or a neighbour is busy).\n\n{}\n",
         machine_line(results),
         results.pool_threads,
         results.bytes_per_body_step,
-        results.two_copy_ceiling
+        results.two_copy_ceiling,
+        flops_line(results)
     );
     for integrator in crate::INTEGRATORS.map(|i| i.name()) {
         table(
@@ -312,6 +342,7 @@ pub fn markdown(results: &BenchResults) -> String {
         fmt_ns(u.without),
         fmt_ns(u.with_zero)
     );
+    let _ = writeln!(s, "{}\n", flops_line(results));
     s.push_str(&springs_markdown(results));
     s.push_str(&exact_markdown(&results.exact));
     s.push_str(&rollback_markdown(&results.rollback));

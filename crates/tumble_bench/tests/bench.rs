@@ -62,6 +62,16 @@ fn small_run_measures_every_engine_and_writes_json() {
     let table = output::markdown(&results);
     assert!(table.contains("| bodies |") && table.contains("splitting"));
     assert!(table.contains("Threads: two independent one-thread loops"));
+    // The kernel's count: the same as counting it directly, with every kind in the total.
+    let f = results.kernel_flops;
+    let counted = tumble_core::integrate::symmetric_rotation_flops(false);
+    assert_eq!(
+        (f.add, f.mul, f.div, f.sqrt),
+        (counted.add, counted.mul, counted.div, counted.sqrt)
+    );
+    assert_eq!(f.total, f.add + f.mul + f.div + f.sqrt);
+    assert!(table.contains(&format!("free rotation is {} flops per body-step", f.total)));
+    assert!(json["kernel_flops"]["total"].as_u64() == Some(f.total));
     assert!(table.contains("**trajectory CSV**") && table.contains("rapier SpringJoint"));
 }
 

@@ -56,18 +56,19 @@ use thiserror::Error;
 use crate::mass::MassProperties;
 use crate::state::{BodyState, Wrench};
 
-// The public surface is the `Integrator` enum, the batch interface, the kernel path and the two
-// frame rotations the tests and reports measure with; each method's functions are internal.
+// The public surface is the `Integrator` enum, the batch interface, the kernel path (and its
+// operation count) and the two frame rotations the tests and reports measure with; each method's functions are internal.
 use exact_flow::rotate_exactly;
 pub use frame::{rotate, rotate_inv};
 use implicit_gyroscopic::implicit_gyroscopic;
 use lclamp::lclamp;
 use rk4::rk4_free_flow;
-pub use simd::{KERNEL_ENV, KernelError, KernelPath, kernel_path};
+pub use simd::{KERNEL_ENV, KernelError, KernelPath, OpCounts, kernel_path};
 use splitting::{
     Rotation, drift_kick_drift, drift_kick_drift_symmetric, drift_kick_drift_translation,
     rotate_freely, rotate_symmetric, strang_free_flow,
 };
+pub use symmetric_kernel::symmetric_rotation_flops;
 use symplectic_euler::{symplectic_euler, symplectic_euler_linear};
 
 /// A time-integration method, selectable per world.

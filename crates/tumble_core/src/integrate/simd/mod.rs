@@ -29,6 +29,7 @@
 mod avx2;
 #[cfg(target_arch = "x86_64")]
 mod avx512;
+mod counting;
 mod pair;
 mod path;
 mod portable;
@@ -38,6 +39,8 @@ mod sin_cos;
 pub(crate) use avx2::{Avx2, Avx4};
 #[cfg(target_arch = "x86_64")]
 pub(crate) use avx512::{Avx8, Avx512};
+pub use counting::OpCounts;
+pub(crate) use counting::{Counted, counted};
 pub(crate) use pair::Pair;
 pub(crate) use path::Kernel;
 pub use path::{KERNEL_ENV, KernelError, KernelPath, kernel_path};
