@@ -57,7 +57,8 @@ use crate::mass::MassProperties;
 use crate::state::{BodyState, Wrench};
 
 // The public surface is the `Integrator` enum, the batch interface, the kernel path (and its
-// operation count) and the two frame rotations the tests and reports measure with; each method's functions are internal.
+// operation count) and the two frame rotations the tests and reports measure with; each
+// method's functions are internal.
 use exact_flow::rotate_exactly;
 pub use frame::{rotate, rotate_inv};
 use implicit_gyroscopic::implicit_gyroscopic;
@@ -65,8 +66,8 @@ use lclamp::lclamp;
 use rk4::rk4_free_flow;
 pub use simd::{KERNEL_ENV, KernelError, KernelPath, OpCounts, kernel_path};
 use splitting::{
-    Rotation, drift_kick_drift, drift_kick_drift_symmetric, drift_kick_drift_translation,
-    rotate_freely, rotate_symmetric, strang_free_flow,
+    Rotation, drift_kick_drift, drift_kick_drift_translation, kick_angular, rotate_freely,
+    rotate_symmetric_kicked, strang_free_flow,
 };
 pub use symmetric_kernel::symmetric_rotation_flops;
 use symplectic_euler::{symplectic_euler, symplectic_euler_linear};
@@ -202,31 +203,23 @@ impl Integrator {
         matches!(self, Integrator::Splitting | Integrator::Yoshida4)
     }
 
-    /// The free rotation of a drift–kick–drift method.
+    /// The free rotation of a drift–kick–drift method, after the kick's angular impulse:
+    /// `splitting`'s folds it into its body momentum, the others kick `ω` first.
     fn free_rotation(self) -> Rotation {
         match self {
-            Integrator::Rk4 => |s, m, h| rotate_freely(s, m, h, rk4_free_flow),
-            Integrator::Exact | Integrator::Exact4 => rotate_exactly,
-            Integrator::SplittingXyz => |s, m, h| rotate_freely(s, m, h, strang_free_flow),
-            _ => rotate_symmetric,
-        }
-    }
-
-    /// `phase` of a drift–kick–drift stage with the method's free rotation (`splitting`'s takes
-    /// the angular kick into its body momentum).
-    #[inline]
-    fn drift_kick_drift_stage(
-        self,
-        phase: StepPhase,
-        state: &mut BodyState,
-        mass: &MassProperties,
-        wrench: &Wrench,
-        h: Real,
-    ) {
-        if self.rotates_on_symmetric_kernel() {
-            drift_kick_drift_symmetric(phase, state, mass, wrench, h);
-        } else {
-            drift_kick_drift(phase, state, mass, wrench, h, self.free_rotation());
+            Integrator::Rk4 => |s, m, h, j| {
+                kick_angular(s, m, j);
+                rotate_freely(s, m, h, rk4_free_flow);
+            },
+            Integrator::Exact | Integrator::Exact4 => |s, m, h, j| {
+                kick_angular(s, m, j);
+                rotate_exactly(s, m, h);
+            },
+            Integrator::SplittingXyz => |s, m, h, j| {
+                kick_angular(s, m, j);
+                rotate_freely(s, m, h, strang_free_flow);
+            },
+            _ => rotate_symmetric_kicked,
         }
     }
 
@@ -236,7 +229,8 @@ impl Integrator {
     #[inline]
     pub fn begin_stage(self, state: &mut BodyState, mass: &MassProperties, h: Real) {
         if self.samples_forces_at_midpoint() {
-            self.drift_kick_drift_stage(StepPhase::Begin, state, mass, &Wrench::ZERO, h);
+            let rotation = self.free_rotation();
+            drift_kick_drift(StepPhase::Begin, state, mass, &Wrench::ZERO, h, rotation);
         }
     }
 
@@ -261,7 +255,8 @@ impl Integrator {
             | Integrator::Rk4
             | Integrator::Exact
             | Integrator::Exact4 => {
-                self.drift_kick_drift_stage(StepPhase::Finish, state, mass, wrench, h);
+                let rotation = self.free_rotation();
+                drift_kick_drift(StepPhase::Finish, state, mass, wrench, h, rotation);
             }
         }
     }
@@ -280,7 +275,8 @@ impl Integrator {
         h: Real,
     ) {
         if self.samples_forces_at_midpoint() {
-            self.drift_kick_drift_stage(StepPhase::Whole, state, mass, wrench, h);
+            let rotation = self.free_rotation();
+            drift_kick_drift(StepPhase::Whole, state, mass, wrench, h, rotation);
         } else {
             // The kick–drift methods do nothing before the forces: the stage is its second phase.
             self.finish_stage(state, mass, wrench, h);
@@ -321,7 +317,7 @@ impl Integrator {
             drift_kick_drift_translation(StepPhase::Whole, state, mass, wrench, dt);
             if self.is_exact_torque_free() {
                 // Exact flows compose exactly: the stages' rotations are one flow over `dt`.
-                (self.free_rotation())(state, mass, dt);
+                (self.free_rotation())(state, mass, dt, Vec3::ZERO);
             } else {
                 stages::rotate_composed(state, mass, weights, dt);
             }

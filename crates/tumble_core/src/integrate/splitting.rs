@@ -120,8 +120,9 @@ pub fn strang_free_flow(body: &mut FreeBody, r: DVec3, h: f64) {
     body.axis_flow(0, r.x, half);
 }
 
-/// The rotational part of a drift over `h` at constant world `L`: a method's free rotation.
-pub type Rotation = fn(&mut BodyState, &MassProperties, Real);
+/// The rotational part of a drift over `h` at constant world `L`, after the kick `L += J` of the
+/// angular impulse `J` (world frame; zero in a phase without a kick): a method's free rotation.
+pub type Rotation = fn(&mut BodyState, &MassProperties, Real, Vec3);
 
 /// The free rotation of the `splitting` method over `h`: spherical bodies exactly about `ω`
 /// (`ω ∥ L` for them), the others through the lane kernel of the module `symmetric_kernel` —
@@ -146,9 +147,10 @@ pub fn rotate_symmetric_kicked(
     h: Real,
     impulse: Vec3,
 ) {
-    if mass.is_spherical() {
+    if mass.is_spherical() || impulse == Vec3::ZERO {
+        // No impulse: the kernel's kicked flow would give the unkicked bits anyway.
         kick_angular(state, mass, impulse);
-        state.rotation = rotate_exact(state.rotation, state.angular_velocity, h);
+        rotate_symmetric(state, mass, h);
         return;
     }
     let input =
@@ -279,31 +281,6 @@ pub(crate) fn drift_kick_drift_linear(
     Some(Vec3::ZERO)
 }
 
-/// `phase` of the drift–kick–drift step with `splitting`'s free rotation, which takes the
-/// kick's angular impulse into the body momentum ([`rotate_symmetric_kicked`]).
-#[inline]
-pub(crate) fn drift_kick_drift_symmetric(
-    phase: StepPhase,
-    state: &mut BodyState,
-    mass: &MassProperties,
-    wrench: &Wrench,
-    dt: Real,
-) {
-    let halves: &[StepPhase] = match phase {
-        StepPhase::Whole if wrench.torque != Vec3::ZERO => &[StepPhase::Begin, StepPhase::Finish],
-        _ => &[phase],
-    };
-    for &part in halves {
-        let impulse = drift_kick_drift_linear(part, state, mass, wrench, dt).unwrap_or(Vec3::ZERO);
-        let h = free_rotation_span(part, dt);
-        if part == StepPhase::Finish {
-            rotate_symmetric_kicked(state, mass, h, impulse);
-        } else {
-            rotate_symmetric(state, mass, h);
-        }
-    }
-}
-
 /// `phase` of the drift–kick–drift step with a method's free `rotation`.
 #[inline]
 pub(crate) fn drift_kick_drift(
@@ -314,12 +291,12 @@ pub(crate) fn drift_kick_drift(
     dt: Real,
     rotation: Rotation,
 ) {
-    if drift_kick_drift_translation(phase, state, mass, wrench, dt) {
-        rotation(state, mass, free_rotation_span(phase, dt));
+    if let Some(impulse) = drift_kick_drift_linear(phase, state, mass, wrench, dt) {
+        rotation(state, mass, free_rotation_span(phase, dt), impulse);
         return;
     }
     for half in [StepPhase::Begin, StepPhase::Finish] {
-        drift_kick_drift_translation(half, state, mass, wrench, dt);
-        rotation(state, mass, free_rotation_span(half, dt));
+        let impulse = drift_kick_drift_linear(half, state, mass, wrench, dt).unwrap_or(Vec3::ZERO);
+        rotation(state, mass, free_rotation_span(half, dt), impulse);
     }
 }
