@@ -29,7 +29,7 @@ fn chain(n: usize, audit: EnergyAudit) -> World {
             .spawn((
                 RigidBody,
                 MassProps(mass.unwrap()),
-                Transform {
+                Pose {
                     translation: Vec3::new(i as Real, 0.0, 0.0),
                     rotation: Quat::from_rotation_z(f),
                 },
@@ -73,10 +73,9 @@ fn audit_cost(c: &mut Criterion) {
     ] {
         group.bench_with_input(BenchmarkId::from_parameter(name), &audit, |b, &audit| {
             let mut world = chain(n, audit);
-            let plan = PhysicsPlan::for_world(&mut world);
-            let mut schedule = plan.build_schedule();
+            let mut physics = PhysicsRunner::new(&mut world);
             b.iter(|| {
-                plan.run_step(&mut schedule, &mut world);
+                physics.step(&mut world);
                 world.clear_trackers();
             });
         });

@@ -16,13 +16,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             angular: Vec3::new(0.1, 4.0, 0.1),
         })
         .id();
-    let plan = PhysicsPlan::for_world(&mut world);
-    let mut schedule = plan.build_schedule();
+    let mut physics = PhysicsRunner::new(&mut world);
     for step in 1..=120 {
-        plan.run_step(&mut schedule, &mut world);
+        physics.step(&mut world);
         world.clear_trackers();
         if step % 30 == 0 {
-            let t = world.get::<Transform>(body).ok_or("body vanished")?;
+            let t = world.get::<Pose>(body).ok_or("body vanished")?;
             println!(
                 "t = {:.2} s  x = {:.3}  q = {:.3}",
                 step as Real / 60.0,

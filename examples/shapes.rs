@@ -54,19 +54,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let axis = mass.principal_frame() * Vec3::Y;
         let entity = world
             .spawn((RigidBody, MassProps(mass)))
-            .insert(Transform::from_translation(Vec3::new(i as Real, 0.0, 0.0)))
+            .insert(Pose::from_translation(Vec3::new(i as Real, 0.0, 0.0)))
             .insert(Velocity::angular(axis * 6.0 + Vec3::splat(0.01)))
             .id();
         bodies.push((name, entity));
     }
-    let plan = PhysicsPlan::for_world(&mut world);
-    let mut schedule = plan.build_schedule();
+    let mut physics = PhysicsRunner::new(&mut world);
     for _ in 0..120 {
-        plan.run_step(&mut schedule, &mut world);
+        physics.step(&mut world);
         world.clear_trackers();
     }
     for (name, entity) in bodies {
-        let t = world.get::<Transform>(entity).ok_or("body vanished")?;
+        let t = world.get::<Pose>(entity).ok_or("body vanished")?;
         let angle = t.rotation.angle_between(Quat::IDENTITY);
         println!(
             "{name:>8}: x = {:.3}  rotated by {:.3} rad",

@@ -21,7 +21,7 @@ fn world(springs: SpringSolver) -> Result<World, Box<dyn std::error::Error>> {
         .spawn((
             RigidBody,
             MassProps(mass),
-            Transform {
+            Pose {
                 translation: Vec3::new(1.2, 0.0, 0.0),
                 rotation: Quat::from_rotation_z(0.3),
             },

@@ -2,10 +2,9 @@
 //!
 //! Rigid-body dynamics for headless game loops, on `bevy_ecs`, `glam` and `parry3d`.
 //!
-//! Spawn bodies with components, build a [`PhysicsPlan`](prelude::PhysicsPlan) schedule, run one
-//! step of it per fixed step (`plan.run_step`: the schedule once per stage of the step, once
-//! unless there are substeps or a composition; or let `PhysicsRunner` plan and step), read the
-//! poses back:
+//! Spawn bodies with components, step the world once per fixed step with a
+//! [`PhysicsRunner`](prelude::PhysicsRunner) (it plans the step from the world and plans again
+//! whenever the world changes: bodies, force generators, settings, gravity), read the poses back:
 //!
 //! ```
 //! use tumble::prelude::*;
@@ -18,15 +17,25 @@
 //! let ball = world
 //!     .spawn((RigidBody, MassProps(mass), ForceAccumulator::default()))
 //!     .id();
-//! let plan = PhysicsPlan::for_world(&mut world);
-//! let mut schedule = plan.build_schedule();
+//! let mut physics = PhysicsRunner::new(&mut world);
 //! for _ in 0..60 {
-//!     plan.run_step(&mut schedule, &mut world);
+//!     physics.step(&mut world);
 //!     world.clear_trackers();
 //! }
-//! let y = world.get::<Transform>(ball).unwrap().translation.y;
+//! let y = world.get::<Pose>(ball).unwrap().translation.y;
 //! assert!((y - (-9.81 * 61.0 / 120.0)).abs() < 1e-3); // x_n = g Δt² n(n+1)/2
 //! ```
+//!
+//! Game code adds loads with the [`ApplyForces`](prelude::ApplyForces) methods — on an entity
+//! (`world.entity_mut(body).apply_force(..)`) or on the items of a `Query<BodyForces>` in a
+//! system: forces and torques in world or body coordinates, at world or body points (the centre
+//! of mass is taken from the body), consumed by the next step; linear and angular impulses,
+//! which change the momentum by exactly `J` at once.
+//!
+//! To `#[derive(Component)]` (or `Resource`, `SystemSet`, …) in your own code, add `bevy_ecs`
+//! as a direct dependency, at the version tumble re-exports as [`bevy_ecs`] (0.20): bevy's
+//! derive macros name the crate `bevy_ecs` in the code they generate, so the re-export alone
+//! does not satisfy them.
 //!
 //! The crates: [`core`] (ECS-free math: state, mass properties, integrators, invariants) and
 //! [`ecs`] (components, systems, schedule). `glam`, `bevy_ecs` (and `parry3d` with the `parry`

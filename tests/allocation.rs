@@ -65,7 +65,7 @@ fn world(integrator: Integrator, bodies: usize) -> World {
         let mut body = world.spawn((
             RigidBody,
             MassProps(mass.unwrap()),
-            Transform {
+            Pose {
                 translation: Vec3::new(2.0 * i as Real, 0.0, 0.0),
                 rotation: Quat::from_rotation_y(f),
             },

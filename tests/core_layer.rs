@@ -15,6 +15,9 @@ mod core_layer {
     pub mod precision;
     pub mod projectile;
     pub mod rollback;
+    // Scene files through the reader: the reader is the feature `scene`.
+    #[cfg(feature = "scene")]
+    pub mod scene_bits;
     pub mod schedule;
     pub mod spin;
     pub mod springs;

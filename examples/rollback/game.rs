@@ -55,7 +55,7 @@ impl Game {
             let mass =
                 MassProperties::new(Mass::new(1.0 + 0.1 * f).expect("mass > 0"), inertia.into())
                     .expect("valid inertia");
-            let pose = Transform::new(Vec3::new(f, 0.0, 0.0), Quat::from_rotation_z(0.2 * f));
+            let pose = Pose::new(Vec3::new(f, 0.0, 0.0), Quat::from_rotation_z(0.2 * f));
             let spin = Velocity::angular(Vec3::new(0.5, 1.0 + 0.3 * f, -0.2));
             let mut body = world.spawn((
                 RigidBody,

@@ -5,7 +5,7 @@ use tumble::math::{Quat, Real, Vec3};
 
 use tumble::prelude::*;
 
-use super::util::{mass_props, run_schedule, spawn_body, world_with};
+use super::util::{mass_props, run_steps, spawn_body, world_with};
 
 const STEPS: usize = 200;
 
@@ -15,7 +15,7 @@ fn spawn_good(world: &mut World) -> Entity {
         .spawn((
             RigidBody,
             mass_props(1.5, [1.0, 2.0, 3.0]),
-            Transform::from_translation(Vec3::new(0.0, 2.0, 0.0)),
+            Pose::from_translation(Vec3::new(0.0, 2.0, 0.0)),
             Velocity {
                 linear: Vec3::X,
                 angular: Vec3::new(0.3, 1.0, 0.2),
@@ -41,13 +41,13 @@ fn base_world() -> World {
 }
 
 /// Final state of the good body when it is alone.
-fn reference() -> (Transform, Velocity) {
+fn reference() -> (Pose, Velocity) {
     let mut world = base_world();
     let good = spawn_good(&mut world);
-    let mut schedule = PhysicsPlan::for_world(&mut world).build_schedule();
-    run_schedule(&mut world, &mut schedule, STEPS);
+    let mut physics = PhysicsRunner::new(&mut world);
+    run_steps(&mut world, &mut physics, STEPS);
     (
-        *world.get::<Transform>(good).unwrap(),
+        *world.get::<Pose>(good).unwrap(),
         *world.get::<Velocity>(good).unwrap(),
     )
 }
@@ -65,12 +65,12 @@ fn check_case(
     let mut world = base_world();
     let good = spawn_good(&mut world);
     let bad = make_bad(&mut world);
-    let mut schedule = PhysicsPlan::for_world(&mut world).build_schedule();
-    run_schedule(&mut world, &mut schedule, STEPS / 2);
+    let mut physics = PhysicsRunner::new(&mut world);
+    run_steps(&mut world, &mut physics, STEPS / 2);
     corrupt(&mut world, bad);
-    run_schedule(&mut world, &mut schedule, STEPS - STEPS / 2);
+    run_steps(&mut world, &mut physics, STEPS - STEPS / 2);
 
-    let t = world.get::<Transform>(good).unwrap();
+    let t = world.get::<Pose>(good).unwrap();
     let v = world.get::<Velocity>(good).unwrap();
     assert_eq!(
         (*t, *v),
@@ -93,11 +93,11 @@ fn check_case(
     );
     let errors = world.resource::<PhysicsErrors>();
     assert!(
-        errors.0.iter().any(|e| e.entity == bad),
+        errors.bodies.iter().any(|e| e.entity == bad),
         "{name}: not recorded"
     );
     assert!(
-        errors.0.iter().all(|e| e.entity != good),
+        errors.bodies.iter().all(|e| e.entity != good),
         "{name}: good body blamed"
     );
     assert!(world.get::<Rejected>(good).is_none());
@@ -107,12 +107,7 @@ fn invalid(component: &'static str) -> impl Fn(&BodyErrorKind) -> bool {
     move |k| matches!(k, BodyErrorKind::Invalid { component: c, .. } if *c == component)
 }
 
-fn spawn_bad(
-    world: &mut World,
-    t: Transform,
-    v: Velocity,
-    acc: Option<ForceAccumulator>,
-) -> Entity {
+fn spawn_bad(world: &mut World, t: Pose, v: Velocity, acc: Option<ForceAccumulator>) -> Entity {
     let mut e = world.spawn((RigidBody, mass_props(1.0, [1.0, 1.0, 1.0]), t, v));
     if let Some(acc) = acc {
         e.insert(acc);
@@ -129,13 +124,13 @@ fn nan_translation_on_insert() {
         |w| {
             spawn_bad(
                 w,
-                Transform::from_translation(Vec3::new(Real::NAN, 0.0, 0.0)),
+                Pose::from_translation(Vec3::new(Real::NAN, 0.0, 0.0)),
                 Velocity::ZERO,
                 None,
             )
         },
         no_corruption,
-        invalid("Transform"),
+        invalid("Pose"),
     );
 }
 
@@ -146,7 +141,7 @@ fn infinite_velocity_on_insert() {
         |w| {
             spawn_bad(
                 w,
-                Transform::IDENTITY,
+                Pose::IDENTITY,
                 Velocity::angular(Vec3::new(0.0, Real::INFINITY, 0.0)),
                 Some(ForceAccumulator::default()),
             )
@@ -164,13 +159,13 @@ fn non_unit_and_zero_quaternions_on_insert() {
     ] {
         check_case(
             "non-unit quaternion",
-            |w| spawn_bad(w, Transform::from_rotation(q), Velocity::ZERO, None),
+            |w| spawn_bad(w, Pose::from_rotation(q), Velocity::ZERO, None),
             no_corruption,
             |k| {
                 matches!(
                     k,
                     BodyErrorKind::Invalid {
-                        component: "Transform",
+                        component: "Pose",
                         source: tumble::core::InvalidInput::NonUnitQuaternion { .. }
                     }
                 )
@@ -188,7 +183,7 @@ fn nan_force_on_insert() {
                 force: Vec3::new(0.0, Real::NAN, 0.0),
                 torque: Vec3::ZERO,
             };
-            spawn_bad(w, Transform::IDENTITY, Velocity::ZERO, Some(acc))
+            spawn_bad(w, Pose::IDENTITY, Velocity::ZERO, Some(acc))
         },
         no_corruption,
         invalid("ForceAccumulator"),
@@ -198,10 +193,10 @@ fn nan_force_on_insert() {
 #[test]
 fn nan_written_by_game_code_after_spawn() {
     check_case(
-        "nan written through &mut Transform",
-        |w| spawn_bad(w, Transform::IDENTITY, Velocity::linear(Vec3::Y), None),
-        |w, bad| w.get_mut::<Transform>(bad).unwrap().translation.x = Real::NAN,
-        invalid("Transform"),
+        "nan written through &mut Pose",
+        |w| spawn_bad(w, Pose::IDENTITY, Velocity::linear(Vec3::Y), None),
+        |w, bad| w.get_mut::<Pose>(bad).unwrap().translation.x = Real::NAN,
+        invalid("Pose"),
     );
 }
 
@@ -212,7 +207,7 @@ fn nan_torque_added_by_game_code() {
         |w| {
             spawn_bad(
                 w,
-                Transform::IDENTITY,
+                Pose::IDENTITY,
                 Velocity::ZERO,
                 Some(ForceAccumulator::default()),
             )
@@ -252,24 +247,24 @@ fn quarantined_body_keeps_finite_state_and_can_be_revived() {
     let mut world = base_world();
     let spin = Velocity::angular(Vec3::new(1.0, 60.0, 1.0));
     let bad = spawn_body(&mut world, 1.0, [0.01, 1.0, 1.005], spin);
-    let mut schedule = PhysicsPlan::for_world(&mut world).build_schedule();
-    run_schedule(&mut world, &mut schedule, STEPS);
+    let mut physics = PhysicsRunner::new(&mut world);
+    run_steps(&mut world, &mut physics, STEPS);
     assert!(world.get::<Rejected>(bad).is_some());
-    let t = *world.get::<Transform>(bad).unwrap();
+    let t = *world.get::<Pose>(bad).unwrap();
     let v = *world.get::<Velocity>(bad).unwrap();
     assert!(t.translation.is_finite() && t.rotation.is_finite());
     assert!(v.linear.is_finite() && v.angular.is_finite());
     assert!((t.rotation.length() - 1.0).abs() < 1e-6);
     // Frozen while rejected.
-    run_schedule(&mut world, &mut schedule, 10);
-    assert_eq!(*world.get::<Transform>(bad).unwrap(), t);
+    run_steps(&mut world, &mut physics, 10);
+    assert_eq!(*world.get::<Pose>(bad).unwrap(), t);
     // Inserting valid data lifts the quarantine.
     world.entity_mut(bad).insert(Velocity::ZERO);
     world.flush();
     assert!(world.get::<Rejected>(bad).is_none());
-    run_schedule(&mut world, &mut schedule, 10);
+    run_steps(&mut world, &mut physics, 10);
     assert!(
-        world.get::<Transform>(bad).unwrap().translation.y < t.translation.y,
+        world.get::<Pose>(bad).unwrap().translation.y < t.translation.y,
         "falls again"
     );
 }

@@ -29,7 +29,7 @@ pub fn reference_world(integrator: Integrator) -> World {
             .spawn((
                 RigidBody,
                 mass_props(1.0 + 0.1 * f, inertia),
-                Transform {
+                Pose {
                     translation: Vec3::new(f, 0.2 * f, 0.0),
                     rotation: Quat::from_rotation_y(0.3 * f),
                 },

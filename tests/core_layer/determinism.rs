@@ -15,7 +15,7 @@ fn scene_bits() -> Vec<u64> {
             .spawn((
                 RigidBody,
                 mass_props(1.0 + f * 0.1, [1.0, 1.0 + f * 0.01, 1.9 + f * 0.01]),
-                Transform {
+                Pose {
                     translation: Vec3::new(f, (f * 0.7).sin(), 0.0),
                     rotation: Quat::from_rotation_y(f * 0.1),
                 },
@@ -41,7 +41,7 @@ fn scene_bits() -> Vec<u64> {
     run(&mut world, 500);
     let mut bits = Vec::new();
     for e in bodies {
-        let t = world.get::<Transform>(e).unwrap();
+        let t = world.get::<Pose>(e).unwrap();
         let v = world.get::<Velocity>(e).unwrap();
         for x in t
             .translation
@@ -84,7 +84,7 @@ fn ecs_matches_the_raw_loop_bit_for_bit() {
             .spawn((
                 RigidBody,
                 mass,
-                Transform {
+                Pose {
                     translation: start.position,
                     rotation: start.rotation,
                 },
@@ -104,7 +104,7 @@ fn ecs_matches_the_raw_loop_bit_for_bit() {
         for _ in 0..300 {
             integrator.step(&mut raw, &mass, &wrench, dt);
         }
-        let t = world.get::<Transform>(body).unwrap();
+        let t = world.get::<Pose>(body).unwrap();
         let v = world.get::<Velocity>(body).unwrap();
         assert_eq!(t.translation, raw.position, "{integrator}");
         assert_eq!(t.rotation, raw.rotation, "{integrator}");
@@ -130,7 +130,7 @@ fn big_world_bits(parallelism: Parallelism, integrator: Integrator) -> Vec<u64> 
         let mut e = world.spawn((
             RigidBody,
             mass_props(1.0 + f, inertia),
-            Transform {
+            Pose {
                 translation: Vec3::new(f * 100.0, 0.0, (i % 7) as Real),
                 rotation: Quat::from_rotation_y(f * 9.0),
             },
@@ -152,7 +152,7 @@ fn big_world_bits(parallelism: Parallelism, integrator: Integrator) -> Vec<u64> 
     run(&mut world, 40);
     let mut bits = Vec::new();
     for e in bodies {
-        let t = world.get::<Transform>(e).unwrap();
+        let t = world.get::<Pose>(e).unwrap();
         let v = world.get::<Velocity>(e).unwrap();
         let values = t
             .translation

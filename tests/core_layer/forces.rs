@@ -54,7 +54,7 @@ fn constant_force_at_body_point_gives_right_linear_and_angular_kick() {
         .spawn((
             RigidBody,
             MassProps(mass),
-            Transform {
+            Pose {
                 translation: t0,
                 rotation: q,
             },
@@ -82,7 +82,7 @@ fn constant_force_at_body_point_gives_right_linear_and_angular_kick() {
         v.angular
     );
     // The centre of mass moved by Δt·Δv (kick then drift); the origin follows it rigidly.
-    let t = world.get::<Transform>(body).unwrap();
+    let t = world.get::<Pose>(body).unwrap();
     let com_world = t
         .center_of_mass(world.get::<MassProps>(body).unwrap())
         .widen();
@@ -95,7 +95,7 @@ fn game_force_is_applied_exactly_once() {
     let dt = 0.1;
     let mut world = world_with(dt, Integrator::SymplecticEuler);
     let body = world.spawn((RigidBody, ForceAccumulator::default())).id();
-    let mut schedule = PhysicsPlan::for_world(&mut world).build_schedule();
+    let mut physics = PhysicsRunner::new(&mut world);
     world
         .get_mut::<ForceAccumulator>(body)
         .unwrap()
@@ -104,8 +104,8 @@ fn game_force_is_applied_exactly_once() {
         .get_mut::<ForceAccumulator>(body)
         .unwrap()
         .add_torque(Vec3::Y * 2.0);
-    schedule.run(&mut world);
-    schedule.run(&mut world);
+    physics.step(&mut world);
+    physics.step(&mut world);
     let v = world.get::<Velocity>(body).unwrap();
     assert_eq!(v.linear, Vec3::X * (10.0 * dt)); // one kick of F Δt / m, not two
     assert!((v.angular - Vec3::Y * (2.0 * dt)).length() < 4.0 * Real::EPSILON); // unit inertia
@@ -126,14 +126,13 @@ fn constant_torque_generator_spins_up_linearly() {
         body,
         torque: Vec3::Z * 4.0,
     });
-    let plan = PhysicsPlan::for_world(&mut world);
-    assert!(plan.contains(Stage::ConstantTorques));
+    let mut physics = PhysicsRunner::new(&mut world);
+    assert!(physics.plan().contains(Stage::ConstantTorques));
     assert!(
         world.get::<ForceAccumulator>(body).is_some(),
         "generator inserts the accumulator"
     );
-    let mut schedule = plan.build_schedule();
-    super::util::run_schedule(&mut world, &mut schedule, 100);
+    super::util::run_steps(&mut world, &mut physics, 100);
     let w = world.get::<Velocity>(body).unwrap().angular;
     assert!((w.z - 2.0).abs() < 1e-5, "ω = τ t / I = 4·1/2 = 2, got {w}");
 }
@@ -152,6 +151,6 @@ fn locked_axis_never_spins_and_never_goes_nan() {
     run(&mut world, 50);
     let w = world.get::<Velocity>(body).unwrap().angular;
     assert_eq!(w, Vec3::ZERO, "a torque about the locked axis does nothing");
-    let q = world.get::<Transform>(body).unwrap().rotation;
+    let q = world.get::<Pose>(body).unwrap().rotation;
     assert_eq!(q, Quat::IDENTITY);
 }

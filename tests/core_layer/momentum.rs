@@ -14,7 +14,7 @@ use super::util::{mass_props, run, world_with};
 fn angular_momentum_drift(dt: Real, seconds: Real) -> (f64, f64) {
     let omega0 = Vec3::new(1.0, 2.0, 3.0);
     let mass = mass_props(2.0, [1.0, 2.0, 3.0]);
-    let state = |t: &Transform, v: &Velocity| BodyState {
+    let state = |t: &Pose, v: &Velocity| BodyState {
         position: t.translation,
         rotation: t.rotation,
         linear_velocity: v.linear,
@@ -32,7 +32,7 @@ fn angular_momentum_drift(dt: Real, seconds: Real) -> (f64, f64) {
         ))
         .id();
     let l0 = tumble::core::invariants::angular_momentum(
-        &state(&Transform::IDENTITY, world.get::<Velocity>(id).unwrap()),
+        &state(&Pose::IDENTITY, world.get::<Velocity>(id).unwrap()),
         &mass,
     );
     let steps = (seconds / dt).round() as usize;
@@ -44,7 +44,7 @@ fn angular_momentum_drift(dt: Real, seconds: Real) -> (f64, f64) {
         "linear momentum must be exact"
     );
     let l = tumble::core::invariants::angular_momentum(
-        &state(world.get::<Transform>(id).unwrap(), v),
+        &state(world.get::<Pose>(id).unwrap(), v),
         &mass,
     );
     let bound = steps as f64 * 0.5 * to_f64(dt * omega0.length()).powi(2);

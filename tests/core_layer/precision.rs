@@ -14,7 +14,7 @@ fn real_follows_the_feature() {
     assert_eq!(size_of::<Vec3>(), 3 * bytes);
     assert_eq!(size_of::<Quat>(), 4 * bytes);
     // The components carry the engine's types.
-    let t = Transform::from_translation(Vec3::ONE);
+    let t = Pose::from_translation(Vec3::ONE);
     let _: Vec3 = t.translation;
     let _: Quat = t.rotation;
 }
@@ -30,12 +30,12 @@ fn far_from_the_origin_the_error_is_the_precision_s_half_ulp_per_step() {
         .spawn((
             RigidBody,
             mass_props(1.0, [1.0, 1.0, 1.0]),
-            Transform::from_translation(Vec3::new(x0, 0.0, 0.0)),
+            Pose::from_translation(Vec3::new(x0, 0.0, 0.0)),
             Velocity::linear(Vec3::new(v, 0.0, 0.0)),
         ))
         .id();
     run(&mut world, n);
-    let x = to_f64(world.get::<Transform>(id).unwrap().translation.x);
+    let x = to_f64(world.get::<Pose>(id).unwrap().translation.x);
     let exact = to_f64(x0) + to_f64(v) * to_f64(dt) * n as f64;
     let half_ulp = 0.5 * to_f64(Real::EPSILON) * to_f64(x0);
     let tolerance = n as f64 * half_ulp;

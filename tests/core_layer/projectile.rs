@@ -22,19 +22,19 @@ fn check_projectile(with_accumulator: bool) {
     let mut body = world.spawn((
         RigidBody,
         mass_props(2.5, [1.0, 2.0, 3.0]),
-        Transform::from_translation(x0),
+        Pose::from_translation(x0),
         Velocity::linear(v0),
     ));
     if with_accumulator {
         body.insert(ForceAccumulator::default());
     }
     let id = body.id();
-    let mut schedule = PhysicsPlan::for_world(&mut world).build_schedule();
+    let mut physics = PhysicsRunner::new(&mut world);
     for n in 1..=600u32 {
-        schedule.run(&mut world);
+        physics.step(&mut world);
         world.clear_trackers();
         if n % 50 == 0 {
-            let x = world.get::<Transform>(id).unwrap().translation.widen();
+            let x = world.get::<Pose>(id).unwrap().translation.widen();
             let exact = discrete_position(x0.widen(), v0.widen(), g.widen(), to_f64(dt), to_f64(n));
             // f32 round-off: ~n ε per coordinate in the worst case, far below 1e-5.
             let err = (x - exact).length() / exact.length();
@@ -67,7 +67,7 @@ fn gravity_scale_scales_the_fall() {
     let none = world.spawn((RigidBody, GravityScale(0.0))).id();
     let full = world.spawn(RigidBody).id();
     run(&mut world, 100);
-    let y = |e: Entity| to_f64(world.get::<Transform>(e).unwrap().translation.y);
+    let y = |e: Entity| to_f64(world.get::<Pose>(e).unwrap().translation.y);
     let full_y = -10.0 * 0.01 * 0.01 * 100.0 * 101.0 / 2.0;
     assert!(rel(y(full), full_y) < 1e-5);
     assert!(rel(y(half), 0.5 * full_y) < 1e-5);
@@ -86,29 +86,25 @@ fn drift_kick_drift_is_exact_for_constant_gravity() {
         let with_acc = world
             .spawn((
                 RigidBody,
-                Transform::from_translation(x0),
+                Pose::from_translation(x0),
                 Velocity::linear(v0),
                 ForceAccumulator::default(),
             ))
             .id();
         let without_acc = world
-            .spawn((
-                RigidBody,
-                Transform::from_translation(x0),
-                Velocity::linear(v0),
-            ))
+            .spawn((RigidBody, Pose::from_translation(x0), Velocity::linear(v0)))
             .id();
-        let plan = PhysicsPlan::for_world(&mut world);
+        let mut physics = PhysicsRunner::new(&mut world);
+        let plan = physics.plan();
         assert!(plan.contains(Stage::BeginStage), "{integrator}: {plan}");
-        let mut schedule = plan.build_schedule();
         let n = 600;
         for _ in 0..n {
-            plan.run_step(&mut schedule, &mut world);
+            physics.step(&mut world);
         }
         let t = to_f64(dt) * to_f64(n);
         let exact = x0.widen() + v0.widen() * t + 0.5 * g.widen() * t * t;
         for id in [with_acc, without_acc] {
-            let x = world.get::<Transform>(id).unwrap().translation.widen();
+            let x = world.get::<Pose>(id).unwrap().translation.widen();
             let err = (x - exact).length() / exact.length();
             assert!(
                 err < 1e-5,

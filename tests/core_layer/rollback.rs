@@ -22,7 +22,7 @@ fn world(integrator: Integrator, substeps: u32) -> World {
     world.insert_resource(settings.with_substeps(substeps));
     let rising = Velocity::linear(Vec3::new(0.0, 1.0, 0.0));
     let a = spawn_body(&mut world, 0.5, [0.02, 0.03, 0.04], rising);
-    let beside = Transform::from_translation(Vec3::new(0.6, 0.0, 0.0));
+    let beside = Pose::from_translation(Vec3::new(0.6, 0.0, 0.0));
     let b = spawn_body(&mut world, 0.7, [0.05, 0.02, 0.04], beside);
     let end = SpringEnd::on_body(b, Vec3::new(-0.1, 0.0, 0.05));
     world.spawn(Spring::new(a, Vec3::new(0.1, 0.05, 0.0), end, 2.0e5, 0.35));

@@ -22,7 +22,7 @@ fn check_principal_spin(integrator: Integrator, axis: Vec3, rate: Real, dt: Real
         .spawn((
             RigidBody,
             MassProps(mass),
-            Transform::from_rotation(q0),
+            Pose::from_rotation(q0),
             Velocity::angular(omega),
         ))
         .id();
@@ -38,7 +38,7 @@ fn check_principal_spin(integrator: Integrator, axis: Vec3, rate: Real, dt: Real
         (w - omega).length()
     );
     let q = world
-        .get::<tumble::ecs::components::Transform>(id)
+        .get::<tumble::ecs::components::Pose>(id)
         .unwrap()
         .rotation;
     let omega64 = omega.widen();
@@ -76,7 +76,7 @@ fn identity_frame_spin_is_bit_exact_in_rate() {
         .id();
     run(&mut world, 1000);
     assert_eq!(world.get::<Velocity>(id).unwrap().angular, omega);
-    let q = world.get::<Transform>(id).unwrap().rotation;
+    let q = world.get::<Pose>(id).unwrap().rotation;
     assert!((q.length() - 1.0).abs() < 1e-6);
 }
 
@@ -92,7 +92,7 @@ fn linearized_rotation_update_has_first_order_error() {
             .spawn((RigidBody, Velocity::angular(Vec3::Z * rate)))
             .id();
         run(&mut world, steps);
-        let q = world.get::<Transform>(id).unwrap().rotation;
+        let q = world.get::<Pose>(id).unwrap().rotation;
         let exact = to_f64(rate); // angle after 1 s
         let angle = 2.0 * to_f64(q.z).atan2(to_f64(q.w));
         let per_step = 2.0 * (to_f64(rate * dt) / 2.0).atan();

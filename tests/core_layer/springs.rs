@@ -28,7 +28,7 @@ fn anchored_spring_follows_the_discrete_map() {
     for (k, c) in [(40.0 as Real, 0.0 as Real), (40.0, 0.8)] {
         let (m, dt, x0) = (2.0 as Real, 1.0 / 60.0 as Real, 0.7 as Real);
         let mut world = world_with(dt, Integrator::SymplecticEuler);
-        let at = Transform::from_translation(Vec3::new(x0, 0.0, 0.0));
+        let at = Pose::from_translation(Vec3::new(x0, 0.0, 0.0));
         let body = on_spring_to_origin(&mut world, m, at, (k, c, 0.0));
         let steps = 300;
         run(&mut world, steps);
@@ -46,7 +46,7 @@ fn anchored_spring_follows_the_discrete_map() {
             v *= decay;
             amplitude = amplitude.max(x.abs());
         }
-        let got = world.get::<Transform>(body).unwrap().translation;
+        let got = world.get::<Pose>(body).unwrap().translation;
         // f32 round-off accumulates about n ε of the amplitude.
         let tol = 300.0 * 4.0 * to_f64(Real::EPSILON) * amplitude;
         assert!(
@@ -67,7 +67,7 @@ fn two_body_spring_conserves_linear_momentum() {
         linear: Vec3::new(0.0, 1.0, 0.0),
         angular: Vec3::new(0.0, 0.0, 2.0),
     };
-    let at = |x: Real| Transform::from_translation(Vec3::new(x, 0.0, 0.0));
+    let at = |x: Real| Pose::from_translation(Vec3::new(x, 0.0, 0.0));
     let a = spawn_body(&mut world, ma, [0.1, 0.2, 0.3], (at(-1.0), velocity));
     let b = spawn_body(&mut world, mb, [0.3, 0.2, 0.1], at(1.0));
     let end = SpringEnd::on_body(b, Vec3::new(-0.1, 0.0, 0.3));
@@ -92,7 +92,7 @@ fn default_integrator_spring_is_position_verlet() {
     let mut world = world_with(dt, Integrator::Splitting);
     // ωh = 1.5 is stiff enough for the implicit step by default: force the explicit one.
     world.resource_mut::<PhysicsSettings>().springs = SpringSolver::Explicit;
-    let at = Transform::from_translation(Vec3::new(0.3, 0.0, 0.0));
+    let at = Pose::from_translation(Vec3::new(0.3, 0.0, 0.0));
     let v = Velocity::linear(Vec3::new(-1.0, 0.0, 0.0));
     let body = on_spring_to_origin(&mut world, m, (at, v), (k, 0.0, 0.0));
     let steps = 2000;
@@ -104,7 +104,7 @@ fn default_integrator_spring_is_position_verlet() {
         v -= h * w2 * half;
         x = half + 0.5 * h * v;
     }
-    let got = world.get::<Transform>(body).unwrap().translation.x;
+    let got = world.get::<Pose>(body).unwrap().translation.x;
     // Bounded orbit of amplitude ≤ 0.4 m; f32 round-off grows like n ε relative at worst.
     assert!(
         (to_f64(got) - x).abs() < 2000.0 * 4.0 * to_f64(Real::EPSILON),
@@ -134,14 +134,14 @@ fn damped_oscillator_with(
 ) -> Vec<(f64, f64)> {
     let mut world = world_with(dt, integrator);
     world.resource_mut::<PhysicsSettings>().springs = springs;
-    let at = Transform::from_translation(Vec3::new(1.5, 0.0, 0.0));
+    let at = Pose::from_translation(Vec3::new(1.5, 0.0, 0.0));
     let body = on_spring_to_origin(&mut world, m, at, (k, c, 1.0));
     let mut physics = PhysicsRunner::new(&mut world);
     (0..steps)
         .map(|_| {
             physics.step(&mut world);
             world.clear_trackers();
-            let x = world.get::<Transform>(body).unwrap().translation.x;
+            let x = world.get::<Pose>(body).unwrap().translation.x;
             let v = world.get::<Velocity>(body).unwrap().linear.x;
             (to_f64(x) - 1.0, to_f64(v))
         })

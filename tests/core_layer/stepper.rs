@@ -48,8 +48,8 @@ fn rejects_bad_input() {
 
 #[test]
 fn interpolation_is_linear_and_spherical() {
-    let a = Transform::IDENTITY;
-    let b = Transform {
+    let a = Pose::IDENTITY;
+    let b = Pose {
         translation: Vec3::new(2.0, 0.0, 0.0),
         rotation: Quat::from_rotation_z(1.0),
     };

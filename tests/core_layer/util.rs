@@ -1,7 +1,6 @@
 //! Helpers shared by the core-layer tests.
 
 use tumble::bevy_ecs::prelude::*;
-use tumble::bevy_ecs::schedule::Schedule;
 use tumble::math::Real;
 use tumble::prelude::*;
 
@@ -12,18 +11,17 @@ pub fn world_with(dt: Real, integrator: Integrator) -> World {
     world
 }
 
-/// Plans the schedule of `world` and runs `steps` steps of it.
-pub fn run(world: &mut World, steps: usize) -> Schedule {
-    let plan = PhysicsPlan::for_world(world);
-    let mut schedule = plan.build_schedule();
-    run_schedule(world, &mut schedule, steps * plan.runs_per_step());
-    schedule
+/// Plans the step of `world` and runs `steps` steps; returns the runner to step on.
+pub fn run(world: &mut World, steps: usize) -> PhysicsRunner {
+    let mut physics = PhysicsRunner::new(world);
+    run_steps(world, &mut physics, steps);
+    physics
 }
 
-/// Runs an already built schedule `steps` times (stages: steps of a plan of one stage).
-pub fn run_schedule(world: &mut World, schedule: &mut Schedule, steps: usize) {
+/// Runs `steps` more steps with `physics`, clearing the change trackers after each.
+pub fn run_steps(world: &mut World, physics: &mut PhysicsRunner, steps: usize) {
     for _ in 0..steps {
-        schedule.run(world);
+        physics.step(world);
         world.clear_trackers();
     }
 }

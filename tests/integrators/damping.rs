@@ -84,7 +84,7 @@ fn run_oscillator(integrator: Integrator, rate: u32, horizon: f64) -> ((f64, f64
         .spawn((
             RigidBody,
             mass_props(OSC_MASS, [1.0, 1.0, 1.0]),
-            Transform::from_translation(Vec3::new((OSC_REST + OSC_X0) as Real, 0.0, 0.0)),
+            Pose::from_translation(Vec3::new((OSC_REST + OSC_X0) as Real, 0.0, 0.0)),
         ))
         .id();
     world.spawn(Spring {
@@ -101,11 +101,11 @@ fn run_oscillator(integrator: Integrator, rate: u32, horizon: f64) -> ((f64, f64
     for _ in 0..steps {
         physics.step(&mut world);
         world.clear_trackers();
-        let x = to_f64(world.get::<Transform>(body).unwrap().translation.x) - OSC_REST;
+        let x = to_f64(world.get::<Pose>(body).unwrap().translation.x) - OSC_REST;
         let v = to_f64(world.get::<Velocity>(body).unwrap().linear.x);
         energies.push(0.5 * k * x * x + 0.5 * OSC_MASS * v * v);
     }
-    let x = to_f64(world.get::<Transform>(body).unwrap().translation.x) - OSC_REST;
+    let x = to_f64(world.get::<Pose>(body).unwrap().translation.x) - OSC_REST;
     let v = to_f64(world.get::<Velocity>(body).unwrap().linear.x);
     ((x, v), energies)
 }
@@ -359,8 +359,8 @@ fn run_net(integrator: Integrator, rate: u32) -> Vec<(Vec3, Quat)> {
     ids.iter()
         .map(|&e| {
             (
-                world.get::<Transform>(e).unwrap().translation,
-                world.get::<Transform>(e).unwrap().rotation,
+                world.get::<Pose>(e).unwrap().translation,
+                world.get::<Pose>(e).unwrap().rotation,
             )
         })
         .collect()
@@ -379,7 +379,7 @@ fn net_world(integrator: Integrator, rate: u32, damping_scale: f64) -> (World, V
             let mut e = world.spawn((
                 RigidBody,
                 mass_props(b.mass, b.inertia),
-                Transform {
+                Pose {
                     translation: f(b.position),
                     rotation: Quat::from_xyzw(q.x as Real, q.y as Real, q.z as Real, q.w as Real),
                 },
@@ -449,15 +449,14 @@ fn splitting_is_second_order_on_a_damped_spring_net() {
 fn net_energy(world: &mut World) -> f64 {
     let mut e = 0.0;
     for (t, v, m) in world
-        .query_filtered::<(&Transform, &Velocity, &MassProps), With<RigidBody>>()
+        .query_filtered::<(&Pose, &Velocity, &MassProps), With<RigidBody>>()
         .iter(world)
     {
         e += tumble::ecs::components::kinetic_energy_f64(t, v, m);
     }
     for s in world.query::<&Spring>().iter(world) {
-        let anchor = |body: Entity, local: Vec3| {
-            world.get::<Transform>(body).unwrap().transform_point(local)
-        };
+        let anchor =
+            |body: Entity, local: Vec3| world.get::<Pose>(body).unwrap().transform_point(local);
         let pb = match s.b {
             SpringEnd::World(p) => p,
             SpringEnd::Body {

@@ -82,10 +82,9 @@ fn thin_rod_spinning_fast_stays_finite_and_unit() {
 }
 
 fn run_world(world: &mut World, steps: usize) {
-    let plan = PhysicsPlan::for_world(world);
-    let mut schedule = plan.build_schedule();
+    let mut physics = PhysicsRunner::new(world);
     for _ in 0..steps {
-        plan.run_step(&mut schedule, world);
+        physics.step(world);
         world.clear_trackers();
     }
 }
@@ -105,7 +104,7 @@ fn mass_ratio_1e9_on_a_spring_stays_finite_and_bounded() {
         .spawn((
             RigidBody,
             MassProps(MassProperties::solid_sphere(Mass::new(1.0).unwrap(), 0.1).unwrap()),
-            Transform::from_translation(Vec3::new(1.5, 0.0, 0.0)),
+            Pose::from_translation(Vec3::new(1.5, 0.0, 0.0)),
         ))
         .id();
     // √(k/m_light) Δt = 1: inside the position-Verlet stable region (< 2).
@@ -122,13 +121,13 @@ fn mass_ratio_1e9_on_a_spring_stays_finite_and_bounded() {
         rest_length: 1.0,
     });
     run_world(&mut world, 100_000);
-    let x = world.get::<Transform>(light).unwrap().translation;
+    let x = world.get::<Pose>(light).unwrap().translation;
     assert!(x.is_finite());
     // Amplitude 0.5 m about the rest length 1 m (so the bodies never meet, where a spring has
     // no direction): a symplectic method keeps it bounded (modified energy), within
     // (1 − (ωΔt)²/4)^(-1/2) = 1.15 of the start at ωΔt = 1.
     assert!((x.x - 1.0).abs() < 0.5 * 1.2, "light body at {x}");
-    let heavy_x = world.get::<Transform>(heavy).unwrap().translation;
+    let heavy_x = world.get::<Pose>(heavy).unwrap().translation;
     assert!(heavy_x.length() < 1e-6, "heavy body moved to {heavy_x}");
     assert!(world.get::<Rejected>(light).is_none());
 }
@@ -143,7 +142,7 @@ fn far_from_origin_spin_is_unchanged_and_drift_is_resolution_limited() {
             .spawn((
                 RigidBody,
                 MassProps(flat_rod_mass()),
-                Transform {
+                Pose {
                     translation: at,
                     rotation: Quat::from_rotation_x(0.3),
                 },
@@ -160,8 +159,8 @@ fn far_from_origin_spin_is_unchanged_and_drift_is_resolution_limited() {
     let steps = 6000;
     run_world(&mut world, steps);
     let (tf, tn) = (
-        world.get::<Transform>(far).unwrap(),
-        world.get::<Transform>(near).unwrap(),
+        world.get::<Pose>(far).unwrap(),
+        world.get::<Pose>(near).unwrap(),
     );
     // Rotation never depends on position: bit-identical to the same body at the origin.
     assert_eq!(tf.rotation, tn.rotation);
@@ -232,7 +231,7 @@ fn divergence_warns_naming_body_and_method_and_never_leaks_nan() {
     assert!(log.contains("symplectic-euler"), "log: {log}");
     assert!(log.contains(&body.to_string()), "log: {log}");
     let v = world.get::<Velocity>(body).unwrap();
-    let t = world.get::<Transform>(body).unwrap();
+    let t = world.get::<Pose>(body).unwrap();
     assert!(v.angular.is_finite() && t.rotation.is_finite());
     assert!(world.get::<Rejected>(body).is_some());
 }

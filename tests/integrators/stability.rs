@@ -19,7 +19,7 @@ fn spring_world(omega_dt: Real, integrator: Integrator, springs: SpringSolver) -
         .spawn((
             RigidBody,
             MassProps(MassProperties::solid_sphere(Mass::new(m).unwrap(), 0.1).unwrap()),
-            Transform::from_translation(Vec3::new(1.0, 0.0, 0.0)),
+            Pose::from_translation(Vec3::new(1.0, 0.0, 0.0)),
         ))
         .id();
     world.spawn(Spring::new(
@@ -33,11 +33,10 @@ fn spring_world(omega_dt: Real, integrator: Integrator, springs: SpringSolver) -
 }
 
 fn diverges(world: &mut World, body: Entity, steps: usize) -> bool {
-    let plan = PhysicsPlan::for_world(world);
-    let mut schedule = plan.build_schedule();
+    let mut physics = PhysicsRunner::new(world);
     for _ in 0..steps {
-        plan.run_step(&mut schedule, world);
-        let x = world.get::<Transform>(body).unwrap().translation.length();
+        physics.step(world);
+        let x = world.get::<Pose>(body).unwrap().translation.length();
         if world.get::<Rejected>(body).is_some() || x > 1e3 {
             return true;
         }

@@ -40,7 +40,7 @@ fn a_load_added_before_a_step_of_several_stages_is_applied_once() {
             "{label}: {v:?}"
         );
         // L = τ Δt (the rotation under way turns ω, not L).
-        let t = *w.get::<Transform>(body).unwrap();
+        let t = *w.get::<Pose>(body).unwrap();
         let l = mass.world_inertia_mul(t.rotation, v.angular);
         assert!((l - torque * dt).length() < tol, "{label}: L = {l}");
         let x = t.translation;
@@ -64,7 +64,7 @@ struct Samples(Vec<Real>);
 
 /// Game code's own force system, in `PhysicsSet::Forces`: records the time it is sampled at
 /// (from the body's position, which moves at 1 m/s) and pushes.
-fn sample(mut samples: ResMut<Samples>, mut bodies: Query<(&Transform, &mut ForceAccumulator)>) {
+fn sample(mut samples: ResMut<Samples>, mut bodies: Query<(&Pose, &mut ForceAccumulator)>) {
     for (t, mut acc) in &mut bodies {
         samples.0.push(t.translation.x);
         acc.add_force(Vec3::Y);
@@ -90,11 +90,12 @@ fn game_force_systems_run_in_every_stage_on_its_state() {
             ForceAccumulator::default(),
         ))
         .id();
-    let plan = PhysicsPlan::for_world(&mut w);
-    assert_eq!(plan.runs_per_step(), 4);
-    let mut schedule = plan.build_schedule();
-    schedule.add_systems(sample.in_set(PhysicsSet::Forces));
-    plan.run_step(&mut schedule, &mut w);
+    let mut forces = ForceSystems::default();
+    forces.add(sample);
+    w.insert_resource(forces);
+    let mut physics = PhysicsRunner::new(&mut w);
+    assert_eq!(physics.plan().runs_per_step(), 4);
+    physics.step(&mut w);
     let samples = &w.resource::<Samples>().0;
     let midpoints = [0.05, 0.15, 0.25, 0.35];
     assert_eq!(samples.len(), 4, "{samples:?}");

@@ -112,6 +112,28 @@ impl Engine for Ecs {
     }
 }
 
+/// The world of an [`Ecs`] whose "step" is only the runner's check of the world before a step
+/// ([`PhysicsRunner::prepare`](tumble_ecs::runner::PhysicsRunner::prepare)): what the check
+/// costs on its own.
+pub struct RunnerCheck(Ecs);
+
+impl RunnerCheck {
+    /// The bodies of `scene` as entities, one thread.
+    pub fn new(scene: &ComparisonScene, integrator: Integrator) -> Self {
+        Self(Ecs::new(scene, integrator, Parallelism::SINGLE_THREAD))
+    }
+}
+
+impl Engine for RunnerCheck {
+    fn step(&mut self) {
+        self.0.0.prepare_step();
+    }
+
+    fn state(&self, i: usize) -> BodyState {
+        self.0.state(i)
+    }
+}
+
 /// rapier 0.36 with its default solver settings (4 iterations), gyroscopic term on, sleeping off.
 pub struct Rapier(RapierScene);
 

@@ -30,7 +30,7 @@ use tumble_ecs::parallel::{Parallelism, pool_threads};
 use tumble_scene::output::{OutputError, create_directory, write_atomically};
 use tumble_scene::text::path_for_terminal;
 
-use crate::engines::{Ecs, Engine, Rapier, RawLoop};
+use crate::engines::{Ecs, Engine, Rapier, RawLoop, RunnerCheck};
 use crate::measure::{Effort, compare};
 
 /// What to measure and where to write it (the arguments of `tumble bench` and `tumble-bench`).
@@ -91,6 +91,20 @@ pub struct UnusedFeature {
     pub with_zero: f64,
 }
 
+/// What the runner's check of the world before each step costs against the whole step (the
+/// check that keeps a stale plan from ever running).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct RunnerCheckCost {
+    /// What is compared.
+    pub what: String,
+    /// Bodies in the world.
+    pub bodies: usize,
+    /// ns per body-step of the check alone.
+    pub check: f64,
+    /// ns per body-step of the whole step (check included).
+    pub step: f64,
+}
+
 /// A target of issue #7 and whether this run met it.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Target {
@@ -137,6 +151,10 @@ pub struct BenchResults {
     pub fixed_cost_ns: Vec<(String, f64)>,
     /// The cost of an unused feature.
     pub unused_feature: UnusedFeature,
+    /// The runner's check of the world against the whole step (absent in runs from before it
+    /// was measured).
+    #[serde(default)]
+    pub runner_check: Option<RunnerCheckCost>,
     /// Spring chains: the cost of stiffness and spring throughput.
     pub springs: springs::SpringResults,
     /// The exact free flow against the default, ECS, one thread.
@@ -184,11 +202,11 @@ impl KernelFlops {
 /// The two integrators measured: the default and the textbook step.
 pub const INTEGRATORS: [Integrator; 2] = [Integrator::Splitting, Integrator::SymplecticEuler];
 
-/// Bytes moved per ECS body-step: `Transform` and `Velocity` read and written, `MassProps`
+/// Bytes moved per ECS body-step: `Pose` and `Velocity` read and written, `MassProps`
 /// read, one changed-tick written per mutated component.
 pub fn bytes_per_body_step() -> usize {
-    use tumble_ecs::components::{MassProps, Transform, Velocity};
-    let state = size_of::<Transform>() + size_of::<Velocity>();
+    use tumble_ecs::components::{MassProps, Pose, Velocity};
+    let state = size_of::<Pose>() + size_of::<Velocity>();
     2 * state + size_of::<MassProps>() + 2 * size_of::<u32>()
 }
 
@@ -280,6 +298,11 @@ pub fn run_bench(options: &BenchOptions, mut progress: impl FnMut(&str)) -> Benc
         .collect();
     progress("unused feature: no gravity vs zero gravity");
     let unused_feature = unused_gravity(sizes.last().copied().unwrap_or(1).min(10_000), &effort);
+    let check_bodies = max.min(100_000);
+    progress(&format!(
+        "the runner's check of a world of {check_bodies} bodies"
+    ));
+    let runner_check = Some(runner_check(check_bodies, &effort));
     let springs = springs::run(options.quick, &mut progress);
     let exact_sizes: &[usize] = if options.quick {
         &[1_000]
@@ -319,6 +342,7 @@ pub fn run_bench(options: &BenchOptions, mut progress: impl FnMut(&str)) -> Benc
         rows,
         fixed_cost_ns,
         unused_feature,
+        runner_check,
         springs,
         exact,
         rollback,
@@ -365,6 +389,20 @@ fn unused_gravity(n: usize, effort: &Effort) -> UnusedFeature {
         what: format!("{n} free bodies, default integrator, one thread"),
         without: ns[0],
         with_zero: ns[1],
+    }
+}
+
+/// The runner's check before a step against the whole step, default integrator, one thread.
+fn runner_check(n: usize, effort: &Effort) -> RunnerCheckCost {
+    let scene = population::scene(n);
+    let mut check = RunnerCheck::new(&scene, Integrator::default());
+    let mut step = Ecs::new(&scene, Integrator::default(), Parallelism::SINGLE_THREAD);
+    let ns = compare(&mut [&mut check, &mut step], n, effort);
+    RunnerCheckCost {
+        what: format!("{n} free bodies, default integrator, one thread"),
+        bodies: n,
+        check: ns[0],
+        step: ns[1],
     }
 }
 

@@ -171,6 +171,20 @@ pub fn targets(results: &BenchResults) -> Vec<Target> {
         "<=",
         1.05,
     ));
+    // The check is one pass over the archetypes: a fixed cost per step, a target where a step
+    // is big enough for it to be measured against.
+    if let Some(c) = results
+        .runner_check
+        .as_ref()
+        .filter(|c| c.bodies >= 100_000)
+    {
+        out.push(target(
+            "runner's world check / whole step, 1e5 bodies (a stale plan never runs, for free)",
+            c.check / c.step,
+            "<=",
+            0.01,
+        ));
+    }
     for row in &results.exact {
         out.push(target(
             &format!("exact / splitting, ECS 1 thread, {} bodies", row.bodies),
@@ -342,6 +356,17 @@ pub fn markdown(results: &BenchResults) -> String {
         fmt_ns(u.without),
         fmt_ns(u.with_zero)
     );
+    if let Some(c) = &results.runner_check {
+        let _ = writeln!(
+            s,
+            "The runner's check of the world before each step ({}): {} of {} ns per body-step \
+             ({:.2} %).\n",
+            c.what,
+            fmt_ns(c.check),
+            fmt_ns(c.step),
+            100.0 * c.check / c.step
+        );
+    }
     let _ = writeln!(s, "{}\n", flops_line(results));
     s.push_str(&springs_markdown(results));
     s.push_str(&exact_markdown(&results.exact));

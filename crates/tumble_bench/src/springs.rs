@@ -91,7 +91,6 @@ impl SpringWorld {
                 .world_mut()
                 .resource_mut::<PhysicsSettings>()
                 .substeps = substeps;
-            tumble.replan();
         }
         Self {
             tumble,
@@ -102,7 +101,6 @@ impl SpringWorld {
     /// The same world stepped under `parallelism`.
     pub fn with_parallelism(mut self, parallelism: Parallelism) -> Self {
         self.tumble.world_mut().insert_resource(parallelism);
-        self.tumble.replan();
         self
     }
 

@@ -91,7 +91,7 @@ fn readme_section_replaces_only_between_markers() {
 
 #[test]
 fn bytes_per_body_step_counts_the_ecs_data() {
-    // Transform (32) + Velocity (24) read and written, MassProps read, two change ticks, in
+    // Pose (32) + Velocity (24) read and written, MassProps read, two change ticks, in
     // f32; the vectors double in an `f64` build, the ticks do not.
     let bytes = tumble_bench::bytes_per_body_step();
     let (low, high) = if tumble_core::math::DOUBLE_PRECISION {

@@ -122,8 +122,9 @@ pub struct RunArgs {
     /// Record every K-th step (step 0 is always recorded).
     #[arg(long, default_value_t = 1, allow_hyphen_values = true)]
     pub every: i64,
-    /// Record only these bodies: a comma-separated list of names or patterns (`*` any run of
-    /// characters, `?` one character, `[abc]` one of a class), e.g. `--bodies 'b1,b2?,b9*'`.
+    /// Record only these bodies: a comma-separated list of names or shell glob patterns (`*`
+    /// any run of characters, `?` one character, `[abc]` one of a class, `[!abc]` or `[^abc]`
+    /// none of it, `\` escapes the next character), e.g. `--bodies 'b1,b2?,b9*'`.
     /// Rows keep the order of the scene file; a pattern that matches no body is an error.
     #[arg(long)]
     pub bodies: Option<OsString>,

@@ -1,5 +1,7 @@
 //! `tumble compare`: the scene in tumble and in rapier 0.36, side by side.
 
+use std::fmt::Write as _;
+
 use glam::DQuat;
 use tumble_core::math::{Narrow, Quat, Real, Vec3, Widen, to_f64};
 use tumble_core::{BodyState, Integrator};
@@ -120,14 +122,17 @@ pub fn run(scene: &Scene, settings: Settings) -> Result<(), Failure> {
             ),
         )
     };
-    println!(
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
         "scene {} · tumble `{integrator}`{tumble_springs} vs rapier 0.36 (gyroscopic {}, 4 substeps{rapier_springs}) · {} steps of {} s",
         terminal_safe(scene.name()),
         if gyroscopic { "on" } else { "off" },
         options.steps,
         scene.dt()
     );
-    println!(
+    let _ = writeln!(
+        out,
         "{:<16} {:>11} {:>12} {:>11} {:>11} {:>21} {:>21}",
         "body",
         "Δx (m)",
@@ -140,7 +145,8 @@ pub fn run(scene: &Scene, settings: Settings) -> Result<(), Failure> {
     let pair =
         |p: Option<(f64, f64)>| p.map_or("—".to_owned(), |(t, r)| format!("{t:.2e} / {r:.2e}"));
     for d in &result.bodies {
-        println!(
+        let _ = writeln!(
+            out,
             "{:<16} {:>11.3e} {:>12.3e} {:>11.3e} {:>11.3e} {:>21} {:>21}",
             d.name,
             d.position,
@@ -151,13 +157,15 @@ pub fn run(scene: &Scene, settings: Settings) -> Result<(), Failure> {
             pair(d.exact_angle)
         );
     }
-    print_energy(&result);
-    println!(
+    print_energy(&mut out, &result);
+    let _ = writeln!(
+        out,
         "time per step: tumble {:.0} ns, rapier {:.0} ns (rapier/tumble = {:.2})",
         result.tumble_ns_per_step,
         result.rapier_ns_per_step,
         result.speed_ratio()
     );
+    crate::stdout::print(&out)?;
     let unclean: Vec<_> = result.bodies.iter().filter(|d| !d.is_clean()).collect();
     for d in &unclean {
         let name = terminal_safe(&d.name);
@@ -242,7 +250,7 @@ fn comparison_scene(scene: &Scene) -> ComparisonScene {
 /// Prints each engine's total energy (kinetic + spring + gravity, [`ComparisonScene::total_energy`])
 /// before and after, with the largest relative change over the run, or the step after which it
 /// stopped meaning anything (a quarantined or non-finite body).
-fn print_energy(result: &Comparison) {
+fn print_energy(out: &mut String, result: &Comparison) {
     let describe = |series: &[f64]| {
         let e0 = series[0];
         let end = series.last().copied().unwrap_or(e0);
@@ -262,7 +270,8 @@ fn print_energy(result: &Comparison) {
             }
         }
     };
-    println!(
+    let _ = writeln!(
+        out,
         "total energy (kinetic + spring + gravity): tumble {}; rapier {}",
         describe(&result.tumble_energy),
         describe(&result.rapier_energy)

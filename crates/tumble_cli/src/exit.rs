@@ -2,6 +2,7 @@
 //! every command returns.
 
 use std::fmt;
+use std::io::Write;
 use std::process::ExitCode;
 
 /// The command did what was asked.
@@ -14,7 +15,8 @@ pub const USAGE: u8 = 2;
 pub const REJECTED: u8 = 3;
 /// tumble predicts the step unstable for the scene: refused unless `--allow-unstable`.
 pub const UNSTABLE: u8 = 4;
-/// Interrupted by SIGINT or SIGTERM (128 + SIGINT, as shells report it); nothing was written.
+/// Interrupted by a signal that ends the process (SIGINT, SIGTERM, SIGHUP, SIGUSR1, …: see
+/// `interrupt`; 128 + SIGINT, as shells report it); nothing was written.
 pub const INTERRUPTED: u8 = 130;
 
 /// A failed command: the one-line message for stderr and the exit code.
@@ -39,7 +41,8 @@ impl Failure {
     pub fn report(&self) -> ExitCode {
         // A message built from a library error may hold a line break: keep it to one line.
         let message = self.message.replace(['\n', '\r'], " ");
-        eprintln!("error: {message}");
+        // A closed stderr must not turn the report into a panic: the exit code still tells.
+        let _ = writeln!(std::io::stderr(), "error: {message}");
         ExitCode::from(self.code)
     }
 }

@@ -1,5 +1,9 @@
-//! SIGINT / SIGTERM (and SIGHUP): a flag that long loops poll, so that they return an error, drop
-//! their temporary file and exit with [`exit::INTERRUPTED`].
+//! SIGINT / SIGTERM (and SIGHUP, and on Unix every other signal whose default action ends the
+//! process: SIGUSR1, SIGUSR2, SIGALRM, SIGVTALRM, SIGPROF, SIGXCPU, SIGQUIT): a flag that long
+//! loops poll, so that they return an error, drop their temporary file and exit with
+//! [`exit::INTERRUPTED`]. SIGXFSZ (a write past the file-size limit, `ulimit -f`) is caught and
+//! ignored, so that the write fails with `EFBIG` and takes the ordinary error path, which
+//! removes the temporary file, instead of killing the process and leaving it.
 //!
 //! Only the loops that poll (`run`, `gen`) can stop cleanly. Elsewhere (`report`, `bench`, or a
 //! second Ctrl-C while a loop winds down) the handler exits at once with the same code, as the
@@ -15,13 +19,49 @@ static POLLED: AtomicBool = AtomicBool::new(false);
 /// Installs the handler (once, at start-up). A failure to install is logged, not fatal: the
 /// signals then keep their default action.
 pub fn install() {
-    if let Err(e) = ctrlc::set_handler(|| {
-        let again = INTERRUPTED.swap(true, Ordering::SeqCst);
-        if again || !POLLED.load(Ordering::SeqCst) {
-            std::process::exit(i32::from(exit::INTERRUPTED));
-        }
-    }) {
+    if let Err(e) = ctrlc::set_handler(on_signal) {
         tracing::warn!("cannot handle Ctrl-C ({e}); an interrupted run may leave a temporary file");
+    }
+    #[cfg(unix)]
+    install_other_signals();
+}
+
+/// What every ending signal does: set the flag for a loop that polls, or exit at once.
+fn on_signal() {
+    let again = INTERRUPTED.swap(true, Ordering::SeqCst);
+    if again || !POLLED.load(Ordering::SeqCst) {
+        std::process::exit(i32::from(exit::INTERRUPTED));
+    }
+}
+
+/// The Unix signals ctrlc leaves at their default action (see the module docs).
+#[cfg(unix)]
+fn install_other_signals() {
+    use signal_hook::consts::signal::{
+        SIGALRM, SIGPROF, SIGQUIT, SIGUSR1, SIGUSR2, SIGVTALRM, SIGXCPU, SIGXFSZ,
+    };
+    // A handler of its own replaces the default action (terminate): the write that crossed
+    // the limit then fails with EFBIG.
+    let ignored = std::sync::Arc::new(AtomicBool::new(false));
+    if let Err(e) = signal_hook::flag::register(SIGXFSZ, ignored) {
+        tracing::warn!(
+            "cannot handle SIGXFSZ ({e}); a run over `ulimit -f` may leave a temporary file"
+        );
+    }
+    let ending = [
+        SIGUSR1, SIGUSR2, SIGALRM, SIGVTALRM, SIGPROF, SIGXCPU, SIGQUIT,
+    ];
+    match signal_hook::iterator::Signals::new(ending) {
+        Ok(mut signals) => {
+            std::thread::spawn(move || {
+                for _ in signals.forever() {
+                    on_signal();
+                }
+            });
+        }
+        Err(e) => tracing::warn!(
+            "cannot handle SIGUSR1 and the like ({e}); such a signal may leave a temporary file"
+        ),
     }
 }
 

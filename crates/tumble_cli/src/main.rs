@@ -9,6 +9,7 @@ mod generate;
 mod interrupt;
 mod logging;
 mod run;
+mod stdout;
 mod summary;
 
 use std::ffi::OsString;
@@ -85,8 +86,13 @@ fn main() -> ExitCode {
 fn usage_error(e: &clap::Error) -> ExitCode {
     match e.kind() {
         ErrorKind::DisplayHelp | ErrorKind::DisplayVersion => {
-            let _ = e.print();
-            ExitCode::from(exit::SUCCESS)
+            match e
+                .print()
+                .and_then(|()| std::io::Write::flush(&mut std::io::stdout()))
+            {
+                Ok(()) => ExitCode::from(exit::SUCCESS),
+                Err(err) => stdout::failed(&err).report(),
+            }
         }
         ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {
             let _ = e.print();
@@ -167,6 +173,27 @@ pub fn load(scene: &Path) -> Result<Loaded, Failure> {
             path: None,
         });
     }
+    // A name that is neither a bundled scene nor a file: say which names exist (and how to
+    // make the generated one) instead of only "no such file".
+    if !scene.exists()
+        && let Some(name) = scene.to_str().filter(|n| !n.contains(['/', '.']))
+    {
+        let bundled: Vec<&str> = BUNDLED.iter().map(|(n, _)| *n).collect();
+        let hint = if name == "many" {
+            "`many` is generated, not bundled: run `tumble gen many --n 100000 --out many.toml` \
+             first, then `tumble run many.toml`"
+                .to_owned()
+        } else {
+            format!(
+                "it is neither a file nor a bundled scene ({}; `tumble scenes` lists them)",
+                bundled.join(", ")
+            )
+        };
+        return Err(Failure::new(
+            exit::ERROR,
+            format!("{}: no such scene: {hint}", terminal_safe(name)),
+        ));
+    }
     Ok(Loaded {
         scene: load_scene(scene)?,
         path: Some(scene.to_owned()),
@@ -196,16 +223,17 @@ fn dispatch(cli: Cli) -> Result<(), Failure> {
             generate::run(n, steps, out.as_deref(), format)
         }
         Command::Scenes => {
+            let mut out = String::new();
             for (name, text) in BUNDLED {
                 let first = text.lines().find(|l| l.starts_with("name")).unwrap_or("");
-                println!("{name:<16} {first}");
+                out.push_str(&format!("{name:<16} {first}\n"));
             }
-            println!(
+            out.push_str(&format!(
                 "{:<16} generated: tumble gen many --n 100000 --out many.toml (or --n 1000000 \
-                 --out many.json)",
+                 --out many.json)\n",
                 "many"
-            );
-            Ok(())
+            ));
+            stdout::print(&out)
         }
         Command::Compare {
             scene,

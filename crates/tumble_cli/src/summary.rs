@@ -102,7 +102,7 @@ pub fn warning_line(warning: &StabilityWarning, names: &Names) -> String {
 /// A quarantined body: which, when, why, and the last valid state it keeps.
 pub fn quarantine_line(error: &BodyError, step: u64, world: &World, names: &Names) -> String {
     let kept = match (
-        world.get::<Transform>(error.entity),
+        world.get::<Pose>(error.entity),
         world.get::<Velocity>(error.entity),
     ) {
         (Some(t), Some(v)) => format!(
@@ -139,7 +139,7 @@ pub fn totals(world: &mut World) -> (f64, DVec3) {
         .get_resource::<Gravity>()
         .map_or(DVec3::ZERO, |g| g.0.widen());
     let mut bodies = world.query_filtered::<(
-        &Transform,
+        &Pose,
         &Velocity,
         &MassProps,
         Option<&GravityScale>,
@@ -161,8 +161,7 @@ pub fn totals(world: &mut World) -> (f64, DVec3) {
     }
     let springs: Vec<Spring> = world.query::<&Spring>().iter(world).copied().collect();
     for s in springs {
-        let point =
-            |e: Entity, local: Vec3| world.get::<Transform>(e).map(|t| t.transform_point(local));
+        let point = |e: Entity, local: Vec3| world.get::<Pose>(e).map(|t| t.transform_point(local));
         let pb = match s.b {
             SpringEnd::World(p) => Some(p),
             SpringEnd::Body { body, anchor } => point(body, anchor),

@@ -36,7 +36,7 @@ fn run_writes_the_specified_csv_bit_identical_to_the_library() {
     for (k, (name, e)) in built.bodies.iter().enumerate() {
         let row = &rows[5 * 3 + k];
         assert_eq!((row[0], row[2]), ("50", name.as_str()));
-        let t = built.world.get::<Transform>(*e).unwrap();
+        let t = built.world.get::<Pose>(*e).unwrap();
         let v = built.world.get::<Velocity>(*e).unwrap();
         let values: Vec<Real> = row[3..].iter().map(|x| x.parse().unwrap()).collect();
         let expected = [

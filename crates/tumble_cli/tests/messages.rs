@@ -323,3 +323,29 @@ fn substeps_are_checked_and_shown() {
     assert!(run.status.success());
     assert!(String::from_utf8_lossy(&run.stdout).contains("(splitting, 3 substeps)"));
 }
+
+/// A scene name that is neither bundled nor a file says which names exist; `many` says how to
+/// generate it.
+#[test]
+fn an_unknown_scene_name_says_what_exists() {
+    for (name, expected) in [
+        (
+            "many",
+            "run `tumble gen many --n 100000 --out many.toml` first",
+        ),
+        (
+            "projectil",
+            "neither a file nor a bundled scene (projectile, ",
+        ),
+    ] {
+        let out = common::tumble().args(["run", name]).output().unwrap();
+        assert_eq!(out.status.code(), Some(1), "{name}");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            stderr.starts_with(&format!("error: {name}: no such scene: "))
+                && stderr.contains(expected),
+            "{stderr}"
+        );
+        assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    }
+}

@@ -243,8 +243,8 @@ fn start_long_run(dir: &Path, out: &Path, extra: &[&str]) -> Child {
 
 #[cfg(unix)]
 #[test]
-fn sigint_and_sigterm_remove_the_temporary_file_and_exit_130() {
-    for signal in ["-INT", "-TERM"] {
+fn ending_signals_remove_the_temporary_file_and_exit_130() {
+    for signal in ["-INT", "-TERM", "-USR1", "-USR2", "-ALRM", "-QUIT"] {
         let dir = scratch_dir();
         let out = dir.path().join("long.csv");
         let mut child = start_long_run(dir.path(), &out, &["--every", "100000"]);
@@ -267,6 +267,32 @@ fn sigint_and_sigterm_remove_the_temporary_file_and_exit_130() {
         );
         assert!(listing(dir.path()).is_empty(), "{:?}", listing(dir.path()));
     }
+}
+
+/// A run that crosses the file-size limit (`ulimit -f`, SIGXFSZ) fails with an `error:` line and
+/// leaves no temporary file (the signal's default action killed it and left the file).
+#[cfg(unix)]
+#[test]
+fn the_file_size_limit_is_an_error_that_leaves_nothing() {
+    let dir = scratch_dir();
+    let out = dir.path().join("big.csv");
+    // 100 blocks of 512 bytes: far less than the trajectory.
+    let output = Command::new("sh")
+        .arg("-c")
+        .arg("ulimit -f 100 && exec \"$0\" run spring_chain --steps 20000 --out \"$1\"")
+        .arg(env!("CARGO_BIN_EXE_tumble"))
+        .arg(&out)
+        .env_remove("RUST_LOG")
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(1), "{stderr}");
+    let last = stderr.lines().last().unwrap_or_default();
+    assert!(
+        last.starts_with("error: ") && last.contains("big.csv"),
+        "{stderr}"
+    );
+    assert!(listing(dir.path()).is_empty(), "{:?}", listing(dir.path()));
 }
 
 #[test]
@@ -436,4 +462,54 @@ fn report_and_bench_name_an_output_that_is_not_a_directory_before_working() {
         );
     }
     assert_eq!(std::fs::read_to_string(&file).unwrap(), "x");
+}
+
+/// A link planted by another user in a shared sticky directory is not followed (the kernel's
+/// `protected_symlinks` rule, which cannot act when tumble reads the link itself): the run
+/// fails and the link's target is untouched. The caller's own link there is followed as before.
+/// Giving a link to another user needs root: elsewhere the test says so and skips.
+#[cfg(unix)]
+#[test]
+fn a_link_planted_by_another_user_in_a_sticky_directory_is_not_followed() {
+    use std::os::unix::fs::{MetadataExt, PermissionsExt, lchown, symlink};
+
+    let dir = scratch_dir();
+    let sticky = dir.path().join("sticky");
+    std::fs::create_dir(&sticky).unwrap();
+    std::fs::set_permissions(&sticky, std::fs::Permissions::from_mode(0o1777)).unwrap();
+    let victim = dir.path().join("victim");
+    std::fs::write(&victim, "precious").unwrap();
+    std::fs::set_permissions(&victim, std::fs::Permissions::from_mode(0o600)).unwrap();
+    let link = sticky.join("out.csv");
+    symlink("../victim", &link).unwrap();
+    let me = std::fs::symlink_metadata(&link).unwrap().uid();
+    let other = if me == 65534 { 65533 } else { 65534 };
+    if lchown(&link, Some(other), None).is_err() {
+        eprintln!("skipped: giving the link to another user needs root");
+        return;
+    }
+    let output = tumble()
+        .args(["run", "projectile", "--out"])
+        .arg(&link)
+        .output()
+        .unwrap();
+    let line = failure(&output, 1);
+    assert!(line.contains("belongs to another user"), "{line}");
+    assert_eq!(std::fs::read_to_string(&victim).unwrap(), "precious");
+    assert_eq!(std::fs::read_link(&link).unwrap(), Path::new("../victim"));
+    assert_eq!(listing(&sticky), ["out.csv"]);
+    // The caller's own link is followed: the target gets the trajectory.
+    lchown(&link, Some(me), None).unwrap();
+    let status = tumble()
+        .args(["run", "projectile", "--out"])
+        .arg(&link)
+        .stdout(Stdio::null())
+        .status()
+        .unwrap();
+    assert!(status.success());
+    assert!(
+        std::fs::read_to_string(&victim)
+            .unwrap()
+            .starts_with(CSV_HEADER)
+    );
 }

@@ -8,12 +8,13 @@
 //! 1. the tag `tumble-checksum-1`;
 //! 2. the step settings: `dt`, the integrator's and the spring step's names, the substeps, the
 //!    stage cursor, and gravity (a presence byte, then its vector);
-//! 3. every rigid body, in increasing `Entity::to_bits` order: the entity, `Transform`,
+//! 3. every rigid body, in increasing `Entity::to_bits` order: the entity, `Pose`,
 //!    `Velocity`, `MassProps` (mass, principal moments and frame, centre of mass), then one
 //!    presence byte and the values for each of `ForceAccumulator`, `HeldLoad`, `GravityScale`,
 //!    `Damping`, and one byte each for `Static`, `Kinematic` and `Rejected`;
-//! 4. every force generator, by kind (`ConstantForce`, `ConstantTorque`, `Spring`), each kind
-//!    in increasing entity order, with all its fields.
+//! 4. every force generator, by kind (`ConstantForce`, `ConstantTorque`, `Spring`, then —
+//!    only in a world that has some, behind its name — `ConstantLocalForce`), each kind in
+//!    increasing entity order, with all its fields.
 //!
 //! Equal worlds give equal checksums on every run, thread count and platform (no pointer, no
 //! iteration order, no `Hash` implementation of std enters it); a world built in `f32` and the
@@ -26,9 +27,9 @@ use xxhash_rust::xxh3::Xxh3;
 
 use crate::components::{
     Damping, ForceAccumulator, Gravity, GravityScale, HeldLoad, Kinematic, MassProps,
-    PhysicsSettings, RigidBody, Static, Transform, Velocity,
+    PhysicsSettings, Pose, RigidBody, Static, Velocity,
 };
-use crate::forces::{ConstantForce, ConstantTorque, Spring, SpringEnd};
+use crate::forces::{ConstantForce, ConstantLocalForce, ConstantTorque, Spring, SpringEnd};
 use crate::stages::StageCursor;
 use crate::validate::Rejected;
 
@@ -81,7 +82,9 @@ impl Stream {
     }
 }
 
-/// The checksum of `world` (see the module docs).
+/// The checksum of `world` (see the module docs). A rigid body counts from when it has
+/// [`MassProps`] (a body spawned without one gets it before its first step: see
+/// [`assume_missing_masses`](crate::components::assume_missing_masses)).
 pub fn world_checksum(world: &World) -> WorldChecksum {
     let mut out = Stream(Xxh3::new());
     out.text("tumble-checksum-1");
@@ -135,7 +138,7 @@ where
 fn bodies(world: &World, out: &mut Stream) {
     // The optional parts by entity lookup: a query naming a component no entity ever had finds
     // nothing at all (`try_query` needs every component registered).
-    let rows = rows::<(Entity, &Transform, &Velocity, &MassProps), With<RigidBody>, _>(
+    let rows = rows::<(Entity, &Pose, &Velocity, &MassProps), With<RigidBody>, _>(
         world,
         |(e, t, v, m)| {
             let entity = world.entity(e);
@@ -196,10 +199,7 @@ fn bodies(world: &World, out: &mut Stream) {
 
 fn generators(world: &World, out: &mut Stream) {
     components::<ConstantForce>(world, out, |out, f| {
-        out.entity(f.body);
-        out.vec3(f.force);
-        out.flag(f.local_point.is_some());
-        out.vec3(f.local_point.unwrap_or(Vec3::ZERO));
+        force_at_point(out, f.body, f.force, f.local_point);
     });
     components::<ConstantTorque>(world, out, |out, t| {
         out.entity(t.body);
@@ -223,6 +223,23 @@ fn generators(world: &World, out: &mut Stream) {
         out.real(s.damping);
         out.real(s.rest_length);
     });
+    // Body-frame forces came later: their section is in the stream only when the world has
+    // some, behind a name, so that the checksums of worlds without them stay what they were.
+    let local = rows::<(Entity, &ConstantLocalForce), (), _>(world, |(e, c)| (e, *c));
+    if !local.is_empty() {
+        out.text("ConstantLocalForce");
+        section(out, local, |out, f| {
+            force_at_point(out, f.body, f.force, f.local_point);
+        });
+    }
+}
+
+/// A force generator's fields: its body, its force and its optional point.
+fn force_at_point(out: &mut Stream, body: Entity, force: Vec3, point: Option<Vec3>) {
+    out.entity(body);
+    out.vec3(force);
+    out.flag(point.is_some());
+    out.vec3(point.unwrap_or(Vec3::ZERO));
 }
 
 /// One section of the stream: how many entities hold a `C`, then each (in entity order) as its
@@ -232,7 +249,16 @@ fn components<C: Component + Copy>(
     out: &mut Stream,
     write: impl Fn(&mut Stream, C),
 ) {
-    let rows = rows::<(Entity, &C), (), _>(world, |(e, c)| (e, *c));
+    section(
+        out,
+        rows::<(Entity, &C), (), _>(world, |(e, c)| (e, *c)),
+        write,
+    );
+}
+
+/// A section of the stream from its rows: their count, then each as its entity and what
+/// `write` writes of its value.
+fn section<C>(out: &mut Stream, rows: Vec<(Entity, C)>, write: impl Fn(&mut Stream, C)) {
     out.bytes(&(rows.len() as u64).to_le_bytes());
     for (e, c) in rows {
         out.entity(e);

@@ -13,47 +13,103 @@ use crate::validate::revalidate_body_hook;
 /// Marks an entity as a rigid body. Only entities with this marker are touched by the physics
 /// systems, so resources and other entities never are.
 ///
-/// Requires [`Transform`], [`Velocity`] and [`MassProps`] (inserted with their defaults when
-/// missing: identity pose, at rest, 1 kg with unit principal moments).
+/// Requires [`Pose`] and [`Velocity`] (inserted with their defaults when missing: identity
+/// pose, at rest). [`MassProps`] is the game's to give: a dynamic body without one is never
+/// stepped silently with a made-up mass — before its first step it gets 1 kg with unit
+/// principal moments, the [`AssumedMass`] marker and a warning naming it, once (see
+/// [`assume_missing_masses`]). [`Static`] and [`Kinematic`] bodies, whose mass no step uses
+/// for their own motion, get the default quietly.
 #[derive(Component, Debug, Clone, Copy, Default, PartialEq, Eq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-#[require(Transform, Velocity, MassProps)]
+#[require(Pose, Velocity)]
+#[component(on_remove = crate::generator_check::body_removed)]
 pub struct RigidBody;
 
 /// Marks a rigid body that never moves: it is never integrated (forces on it are discarded), but
 /// springs may anchor to it and its mass properties still count where they are read.
 #[derive(Component, Debug, Clone, Copy, Default, PartialEq, Eq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[require(MassProps)]
 pub struct Static;
 
-/// Marks a rigid body that game code moves (by writing its [`Transform`] and [`Velocity`]): tumble
+/// Marks a rigid body that game code moves (by writing its [`Pose`] and [`Velocity`]): tumble
 /// never integrates it and discards forces on it; springs attached to it see its pose and
 /// velocity as the game sets them.
 #[derive(Component, Debug, Clone, Copy, Default, PartialEq, Eq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[require(MassProps)]
 pub struct Kinematic;
 
-/// Pose of the body origin in world coordinates.
+/// Marks a dynamic body that was given no [`MassProps`] and is stepped with the default (1 kg,
+/// unit principal moments); a warning named it when the marker was set. Inserting the body's
+/// own `MassProps` does not remove the marker: remove it too, or better, give the mass when
+/// spawning.
+#[derive(Component, Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct AssumedMass;
+
+/// True when some rigid body has no [`MassProps`]: one pass over the archetypes, allocation-free
+/// (the runner asks before every step).
+pub fn bodies_without_mass(world: &World) -> bool {
+    let Some(body) = world.component_id::<RigidBody>() else {
+        return false;
+    };
+    let mass = world.component_id::<MassProps>();
+    world
+        .archetypes()
+        .iter()
+        .any(|a| !a.is_empty() && a.contains(body) && mass.is_none_or(|m| !a.contains(m)))
+}
+
+/// Gives every rigid body without [`MassProps`] the default (1 kg, unit principal moments) and
+/// the [`AssumedMass`] marker, with a warning naming it: run by
+/// [`PhysicsPlan::for_world`](crate::schedule::PhysicsPlan::for_world) and by the runner before
+/// each step, so no body is stepped on a mass it was never given without a word.
+pub fn assume_missing_masses(world: &mut World) {
+    if !bodies_without_mass(world) {
+        return;
+    }
+    let mut missing = world.query_filtered::<Entity, (With<RigidBody>, Without<MassProps>)>();
+    let bodies: Vec<Entity> = missing.iter(world).collect();
+    for body in bodies {
+        tracing::warn!(
+            entity = %body,
+            "rigid body {body} has no MassProps: stepped as 1 kg with unit principal moments \
+             (marked AssumedMass); give it MassProps(MassProperties::…) when spawning"
+        );
+        world
+            .entity_mut(body)
+            .insert((MassProps::default(), AssumedMass));
+    }
+}
+
+/// Pose of the body origin in world coordinates: where the physics keeps a body.
 ///
 /// The centre of mass sits at `translation + rotation * c`, with `c` the local centre of mass of
 /// the body's [`MassProps`].
+///
+/// Named `Pose`, not `Transform`, so that it lives beside Bevy's `Transform` (which every Bevy
+/// game has in scope) without ambiguity. It maps onto Bevy's `Transform` field for field —
+/// `translation` and `rotation` are the same, and a rigid body has scale 1 — so rendering code
+/// copies them (interpolated between fixed steps with
+/// [`interpolate`](crate::stepper::interpolate)) into the entity's `Transform`.
 #[derive(Component, Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[component(on_insert = revalidate_body_hook)]
-pub struct Transform {
+pub struct Pose {
     /// World position of the body origin (m).
     pub translation: Vec3,
     /// Orientation, body → world; must stay a unit quaternion.
     pub rotation: Quat,
 }
 
-impl Default for Transform {
+impl Default for Pose {
     fn default() -> Self {
         Self::IDENTITY
     }
 }
 
-impl Transform {
+impl Pose {
     /// At the origin, unrotated.
     pub const IDENTITY: Self = Self {
         translation: Vec3::ZERO,
@@ -181,6 +237,13 @@ impl From<MassProperties> for MassProps {
 
 /// Net force and torque (about the centre of mass, world frame) to apply in the next step.
 ///
+/// **Opt-in:** a body takes loads from game code only with an accumulator (a body without one
+/// takes the cheaper force-free path). Spawn it with `ForceAccumulator::default()`, or apply
+/// loads through [`ApplyForces`](crate::body_forces::ApplyForces) on the entity
+/// (`world.entity_mut(body).apply_force(..)`), which inserts it when missing; force generators
+/// insert it on their bodies. [`BodyForces`](crate::body_forces::BodyForces) adds loads in
+/// world or body coordinates and at points, with the centre of mass taken from the body.
+///
 /// **Clearing rule:** the integrator *consumes* the accumulator: it reads it and resets it to zero
 /// in the same pass. So a force that game code adds between two steps is applied in the next
 /// step exactly once, and nothing needs to clear it at the start of a step.
@@ -217,7 +280,7 @@ impl ForceAccumulator {
     }
 
     /// Adds a force applied at a world point: the force, plus the torque `(p − x) × F` about the
-    /// centre of mass `x` (see [`Transform::center_of_mass`]).
+    /// centre of mass `x` (see [`Pose::center_of_mass`]).
     ///
     /// The lever arm is formed before the cross product, so a body far from the world origin
     /// loses no precision to cancellation.
@@ -419,7 +482,7 @@ impl Default for PhysicsSettings {
 /// The world offset `R c` of the centre of mass from the body origin, or `None` when the centre
 /// of mass is the origin (the common case, which then costs no arithmetic at all).
 ///
-/// Skipping the arithmetic matters beyond the saved work: `Transform` has 4 bytes of padding
+/// Skipping the arithmetic matters beyond the saved work: `Pose` has 4 bytes of padding
 /// after its `Vec3`, and compiled vector code may add a whole 16-byte lane including whatever
 /// bits sit there; when they happen to be a subnormal float pattern every such add takes a
 /// microcode assist (over twenty times the cost of the add).
@@ -434,7 +497,7 @@ fn com_offset(rotation: Quat, mass: &MassProps) -> Option<Vec3> {
 
 /// Kinetic energy `½ m |v|² + ½ ωᵀ I ω` (J) of a body, in `f64` (energy balances sum many
 /// bodies; [`tumble_core::invariants::kinetic_energy`] is the same in the engine's precision).
-pub fn kinetic_energy_f64(transform: &Transform, velocity: &Velocity, mass: &MassProps) -> f64 {
+pub fn kinetic_energy_f64(transform: &Pose, velocity: &Velocity, mass: &MassProps) -> f64 {
     let v = velocity.linear.widen();
     let rotational = mass.world_inertia_quadratic_f64(transform.rotation, velocity.angular);
     0.5 * mass.mass().widen() * v.length_squared() + 0.5 * rotational
@@ -442,7 +505,7 @@ pub fn kinetic_energy_f64(transform: &Transform, velocity: &Velocity, mass: &Mas
 
 /// Reads a body's core state (centre-of-mass position) from its components.
 #[inline]
-pub fn body_state(transform: &Transform, velocity: &Velocity, mass: &MassProps) -> BodyState {
+pub fn body_state(transform: &Pose, velocity: &Velocity, mass: &MassProps) -> BodyState {
     let t = transform.translation;
     let position = match com_offset(transform.rotation, mass) {
         Some(offset) => Vec3::new(t.x + offset.x, t.y + offset.y, t.z + offset.z),
@@ -461,7 +524,7 @@ pub fn body_state(transform: &Transform, velocity: &Velocity, mass: &MassProps) 
 pub fn write_body_state(
     state: &BodyState,
     mass: &MassProps,
-    transform: &mut Transform,
+    transform: &mut Pose,
     velocity: &mut Velocity,
 ) {
     transform.rotation = state.rotation;

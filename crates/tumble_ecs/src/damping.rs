@@ -27,9 +27,7 @@ use bevy_ecs::prelude::*;
 use tumble_core::damping::decrement;
 use tumble_core::math::{Real, Vec3};
 
-use crate::components::{
-    Kinematic, MassProps, PhysicsSettings, RigidBody, Static, Transform, Velocity,
-};
+use crate::components::{Kinematic, MassProps, PhysicsSettings, Pose, RigidBody, Static, Velocity};
 use crate::forces::{Spring, SpringEnd};
 use crate::stages::StageCursor;
 use crate::validate::Rejected;
@@ -40,7 +38,7 @@ type DamperEnds<'w, 's> = Query<
     'w,
     's,
     (
-        &'static Transform,
+        &'static Pose,
         &'static mut Velocity,
         &'static MassProps,
         Has<Static>,
@@ -106,12 +104,7 @@ struct Anchor {
 }
 
 impl Anchor {
-    fn of(
-        transform: &Transform,
-        velocity: &Velocity,
-        mass: &MassProps,
-        local: Vec3,
-    ) -> (Vec3, Self) {
+    fn of(transform: &Pose, velocity: &Velocity, mass: &MassProps, local: Vec3) -> (Vec3, Self) {
         let point = transform.transform_point(local);
         let arm = point - transform.center_of_mass(mass);
         let velocity = velocity.linear + velocity.angular.cross(arm);
@@ -119,19 +112,13 @@ impl Anchor {
     }
 
     /// This end's share of `1/m_eff` along `n`: `1/m + (r × n)·I⁻¹(r × n)`.
-    fn inverse_mass(&self, transform: &Transform, mass: &MassProps, n: Vec3) -> Real {
+    fn inverse_mass(&self, transform: &Pose, mass: &MassProps, n: Vec3) -> Real {
         let rn = self.arm.cross(n);
         mass.inv_mass() + rn.dot(mass.world_inv_inertia_mul(transform.rotation, rn))
     }
 
     /// Applies the impulse `impulse` (world frame) at the anchor.
-    fn push(
-        &self,
-        transform: &Transform,
-        mass: &MassProps,
-        velocity: &mut Velocity,
-        impulse: Vec3,
-    ) {
+    fn push(&self, transform: &Pose, mass: &MassProps, velocity: &mut Velocity, impulse: Vec3) {
         velocity.linear += mass.inv_mass() * impulse;
         velocity.angular += mass.world_inv_inertia_mul(transform.rotation, self.arm.cross(impulse));
     }

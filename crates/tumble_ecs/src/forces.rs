@@ -1,14 +1,16 @@
 //! Force generators. Each generator is its own entity (a body may have any number of them) that
 //! names its body; its system runs in [`PhysicsSet::Forces`](crate::schedule::PhysicsSet::Forces)
 //! and adds to the body's [`ForceAccumulator`] (inserted automatically when a generator is
-//! spawned). A generator whose body is missing or rejected does nothing.
+//! spawned). A generator is checked when inserted and whenever it changes, and left out of the
+//! step with a [`GeneratorError`](crate::generator_check::GeneratorError) when it is invalid or
+//! its body is gone (see [`crate::generator_check`]); a generator whose body is quarantined does
+//! nothing until the body is valid again.
 
-use bevy_ecs::lifecycle::HookContext;
 use bevy_ecs::prelude::*;
-use bevy_ecs::world::DeferredWorld;
-use tumble_core::math::{Real, Vec3, Widen};
+use tumble_core::math::{Real, Vec3, Widen, quat_rotate};
 
-use crate::components::{ForceAccumulator, Gravity, GravityScale, MassProps, Transform, Velocity};
+use crate::components::{ForceAccumulator, Gravity, GravityScale, MassProps, Pose, Velocity};
+use crate::generator_check::generator_inserted;
 use crate::parallel::{Parallelism, scope};
 use crate::stiff::ImplicitBody;
 use crate::systems::dense;
@@ -17,7 +19,7 @@ use crate::targets::{TargetRows, Targets};
 /// A constant world-frame force on `body`, through a body-local point (or the centre of mass).
 #[derive(Component, Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-#[component(on_insert = ensure_accumulators)]
+#[component(on_insert = generator_inserted::<ConstantForce>)]
 pub struct ConstantForce {
     /// The body that receives the force.
     pub body: Entity,
@@ -28,10 +30,30 @@ pub struct ConstantForce {
     pub local_point: Option<Vec3>,
 }
 
+/// A constant force given in the body's own frame, so that it turns with the body (a thruster
+/// fixed to a hull), through a body-local point or the centre of mass: in the world it is
+/// `R f`, at `x + R p`, with `R` the body's rotation at the stage where forces are sampled.
+///
+/// For a body stepped by an implicit spring group (see [`crate::stiff`]) the force's world
+/// direction is taken once per stage, where the force stage samples it, and held over that
+/// stage: first order in the body's turn over the stage, where a body-frame force is exact
+/// for every explicit method.
+#[derive(Component, Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[component(on_insert = generator_inserted::<ConstantLocalForce>)]
+pub struct ConstantLocalForce {
+    /// The body that receives the force.
+    pub body: Entity,
+    /// Force `f` (N), body frame.
+    pub force: Vec3,
+    /// Point of application in body coordinates; `None` = the centre of mass (no torque).
+    pub local_point: Option<Vec3>,
+}
+
 /// A constant world-frame torque on `body`.
 #[derive(Component, Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-#[component(on_insert = ensure_accumulators)]
+#[component(on_insert = generator_inserted::<ConstantTorque>)]
 pub struct ConstantTorque {
     /// The body that receives the torque.
     pub body: Entity,
@@ -77,7 +99,7 @@ impl SpringEnd {
 /// `c Δt`.
 #[derive(Component, Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-#[component(on_insert = ensure_accumulators)]
+#[component(on_insert = generator_inserted::<Spring>)]
 pub struct Spring {
     /// First body.
     pub a: Entity,
@@ -127,15 +149,16 @@ impl Spring {
 }
 
 /// Kinetic energy of every body with a velocity plus the elastic energy of every spring (J), in
-/// `f64`. Panics if a spring names a body without a [`Transform`].
+/// `f64`. Panics if a spring names a body without a [`Pose`].
 pub fn kinetic_and_elastic_energy(world: &mut World) -> f64 {
+    crate::components::assume_missing_masses(world);
     let kinetic: f64 = world
-        .query::<(&Transform, &Velocity, &MassProps)>()
+        .query::<(&Pose, &Velocity, &MassProps)>()
         .iter(world)
         .map(|(t, v, m)| crate::components::kinetic_energy_f64(t, v, m))
         .sum();
     let springs: Vec<Spring> = world.query::<&Spring>().iter(world).copied().collect();
-    let mut poses = world.query::<&Transform>();
+    let mut poses = world.query::<&Pose>();
     let elastic: f64 = springs
         .iter()
         .map(|s| {
@@ -152,26 +175,11 @@ pub fn kinetic_and_elastic_energy(world: &mut World) -> f64 {
     kinetic + elastic
 }
 
-/// Inserts a zero [`ForceAccumulator`] on every body a generator names, where missing.
-fn ensure_accumulators(mut world: DeferredWorld, ctx: HookContext) {
-    let entity = ctx.entity;
-    let mut targets = Vec::with_capacity(2);
-    if let Some(f) = world.get::<ConstantForce>(entity) {
-        targets.push(f.body);
-    }
-    if let Some(t) = world.get::<ConstantTorque>(entity) {
-        targets.push(t.body);
-    }
-    if let Some(s) = world.get::<Spring>(entity) {
-        targets.push(s.a);
-        if let SpringEnd::Body { body, .. } = s.b {
-            targets.push(body);
-        }
-    }
-    for body in targets {
-        if world.get::<ForceAccumulator>(body).is_none()
-            && let Ok(mut e) = world.commands().get_entity(body)
-        {
+/// Inserts a zero [`ForceAccumulator`] on every one of `bodies` that has none (a valid
+/// generator's bodies: see [`crate::generator_check`]).
+pub(crate) fn ensure_accumulators(commands: &mut Commands, bodies: impl Iterator<Item = Entity>) {
+    for body in bodies {
+        if let Ok(mut e) = commands.get_entity(body) {
             e.insert_if_new(ForceAccumulator::default());
         }
     }
@@ -200,6 +208,7 @@ pub fn apply_gravity(
 /// solve instead, which takes that torque at mid-step: see [`ImplicitBody`]).
 pub fn apply_constant_forces(
     generators: Query<&ConstantForce>,
+    local_generators: Query<&ConstantLocalForce>,
     mut bodies: ForceTargets,
     mut rows: Local<TargetRows>,
     mut implicit: Query<&mut ImplicitBody>,
@@ -207,12 +216,21 @@ pub fn apply_constant_forces(
     let mut targets = Targets::of(&mut bodies, &mut rows);
     // Looked up only where some body is in an implicit group: a lookup per force otherwise.
     let any_implicit = !implicit.is_empty();
-    for gen_force in &generators {
-        let (body, force) = (gen_force.body, gen_force.force);
+    // World-frame forces first, then body-frame ones (`None`: already in the world frame).
+    let world_frame = generators
+        .iter()
+        .map(|g| (g.body, g.force, false, g.local_point));
+    let body_frame = (local_generators.iter()).map(|g| (g.body, g.force, true, g.local_point));
+    for (body, force, in_body_frame, local_point) in world_frame.chain(body_frame) {
         let Some((transform, mass)) = targets.body(body) else {
             continue;
         };
-        let Some(local) = gen_force.local_point else {
+        let force = if in_body_frame {
+            quat_rotate(transform.rotation, force)
+        } else {
+            force
+        };
+        let Some(local) = local_point else {
             targets.push(body, |acc| acc.add_force(force));
             continue;
         };
@@ -245,7 +263,7 @@ pub fn apply_constant_torques(
 
 /// World anchor point and the centre of mass, for a body-local anchor.
 #[inline]
-fn anchor_point(transform: &Transform, mass: &MassProps, local: Vec3) -> (Vec3, Vec3) {
+fn anchor_point(transform: &Pose, mass: &MassProps, local: Vec3) -> (Vec3, Vec3) {
     (
         transform.transform_point(local),
         transform.center_of_mass(mass),

@@ -42,9 +42,9 @@ use tumble_core::math::Real;
 use crate::audit::{EnergyAudit, EnergyLedger, LedgerState};
 use crate::components::{
     Damping, ForceAccumulator, Gravity, GravityScale, HeldLoad, Kinematic, MassProps,
-    PhysicsSettings, RigidBody, Static, Transform, Velocity,
+    PhysicsSettings, Pose, RigidBody, Static, Velocity,
 };
-use crate::forces::{ConstantForce, ConstantTorque, Spring};
+use crate::forces::{ConstantForce, ConstantLocalForce, ConstantTorque, Spring};
 use crate::stages::StageCursor;
 use crate::systems::HalfDrifted;
 use crate::validate::Rejected;
@@ -85,7 +85,7 @@ pub struct BodyRecord {
     /// The body (the same entity is written back).
     pub entity: Entity,
     /// Pose.
-    pub transform: Transform,
+    pub transform: Pose,
     /// Velocity.
     pub velocity: Velocity,
     /// Mass properties.
@@ -141,6 +141,7 @@ pub struct RollbackSnapshot {
     /// The quarantined bodies' reasons (rare, so kept out of the records).
     rejections: Vec<(Entity, Rejected)>,
     constant_forces: Vec<(Entity, ConstantForce)>,
+    constant_local_forces: Vec<(Entity, ConstantLocalForce)>,
     constant_torques: Vec<(Entity, ConstantTorque)>,
     springs: Vec<(Entity, Spring)>,
 }
@@ -202,7 +203,7 @@ type BodyParts<T, V, A, H, G, D> = (
 /// One body of the restore's query.
 type BodyItem<'a> = (
     Entity,
-    Mut<'a, Transform>,
+    Mut<'a, Pose>,
     Mut<'a, Velocity>,
     &'a MassProps,
     Option<Mut<'a, ForceAccumulator>>,
@@ -225,6 +226,7 @@ impl RollbackSnapshot {
     /// Captures `world` into `self`, reusing its record buffers (the body and generator
     /// queries are still built afresh on each call, a few small allocations).
     pub fn capture_into(&mut self, world: &mut World) {
+        crate::components::assume_missing_masses(world);
         self.settings = world
             .get_resource::<PhysicsSettings>()
             .copied()
@@ -251,7 +253,7 @@ impl RollbackSnapshot {
         self.bodies.clear();
         self.rejections.clear();
         let mut query = world.query_filtered::<BodyParts<
-            &'static Transform,
+            &'static Pose,
             &'static Velocity,
             &'static ForceAccumulator,
             &'static HeldLoad,
@@ -289,6 +291,7 @@ impl RollbackSnapshot {
             }
         }
         save_generators(world, &mut self.constant_forces);
+        save_generators(world, &mut self.constant_local_forces);
         save_generators(world, &mut self.constant_torques);
         save_generators(world, &mut self.springs);
     }
@@ -314,6 +317,7 @@ impl RollbackSnapshot {
             self.restore_parts(world, record);
         }
         restore_generators(world, &self.constant_forces);
+        restore_generators(world, &self.constant_local_forces);
         restore_generators(world, &self.constant_torques);
         restore_generators(world, &self.springs);
         world.flush();
@@ -331,6 +335,8 @@ impl RollbackSnapshot {
             + self.bodies.capacity() * std::mem::size_of::<BodyRecord>()
             + self.rejections.capacity() * std::mem::size_of::<(Entity, Rejected)>()
             + self.constant_forces.capacity() * std::mem::size_of::<(Entity, ConstantForce)>()
+            + self.constant_local_forces.capacity()
+                * std::mem::size_of::<(Entity, ConstantLocalForce)>()
             + self.constant_torques.capacity() * std::mem::size_of::<(Entity, ConstantTorque)>()
             + self.springs.capacity() * std::mem::size_of::<(Entity, Spring)>()
             + self.ledger.as_ref().map_or(0, LedgerState::heap_bytes)
@@ -357,6 +363,7 @@ impl RollbackSnapshot {
             }
         }
         check_generators(world, "ConstantForce", &self.constant_forces)?;
+        check_generators(world, "ConstantLocalForce", &self.constant_local_forces)?;
         check_generators(world, "ConstantTorque", &self.constant_torques)?;
         check_generators(world, "Spring", &self.springs)
     }
@@ -366,7 +373,7 @@ impl RollbackSnapshot {
     /// or removed.
     fn restore_bodies(&self, world: &mut World) -> Vec<&BodyRecord> {
         let mut query = world.query_filtered::<BodyParts<
-            &'static mut Transform,
+            &'static mut Pose,
             &'static mut Velocity,
             &'static mut ForceAccumulator,
             &'static mut HeldLoad,

@@ -6,6 +6,8 @@ use bevy_ecs::prelude::*;
 use bevy_ecs::schedule::{IntoScheduleConfigs, Schedule};
 use bevy_ecs::system::ScheduleSystem;
 
+use crate::components::PhysicsSettings;
+use crate::generator_check::GeneratorWatch;
 use crate::schedule::{PhysicsPlan, PhysicsSet, SpringQuery};
 
 /// Game systems that compute forces inside the step: added to [`PhysicsSet::Forces`] of every
@@ -80,13 +82,22 @@ fn build(plan: &PhysicsPlan, world: &World) -> Schedule {
     schedule
 }
 
-/// Runs one physics step per [`step`](Self::step) — the schedule once per stage of the step
-/// ([`PhysicsPlan::runs_per_step`]) — re-planning when the world changed: when it
-/// gains or loses a [`Gravity`](crate::components::Gravity) resource, a kind of force generator,
-/// its first damped spring or its last (a damping coefficient changed in place counts),
-/// dynamic bodies with or without accumulators, static or kinematic bodies; when its
-/// [`ForceSystems`] change; or when the integrator changes between a kick–drift and a
-/// drift–kick–drift method, or it or the substeps change the stages of a step. Re-planning is one pass
+/// The way to step a world: one physics step per [`step`](Self::step) — the schedule once per
+/// stage of the step ([`PhysicsPlan::runs_per_step`]) — planned from the world and checked
+/// against it before every step, so it never runs a plan the world has outgrown.
+///
+/// Before each step the runner gives every dynamic body that has no
+/// [`MassProps`](crate::components::MassProps) the default
+/// with a warning (see [`assume_missing_masses`](crate::components::assume_missing_masses)),
+/// leaves out every force generator whose values turned bad or whose
+/// body went away (see [`crate::generator_check`]), then compares the world with what it
+/// planned from and plans again
+/// when the world gained or lost a [`Gravity`](crate::components::Gravity) resource, a kind of
+/// force generator, its first damped spring or its last (a damping coefficient changed in place
+/// counts), dynamic bodies with or without accumulators, static or kinematic bodies; when its
+/// [`ForceSystems`] changed; when its [`PhysicsSettings`] changed in any way (time step,
+/// integrator, substeps, spring solver: the stiff springs are classified again and the stability
+/// prediction is checked again); or when its springs need classifying again. The check is one pass
 /// over the archetypes per step, plus, in a world with springs, a read of their damping
 /// coefficients up to the first damped one; the schedule is rebuilt only when the plan differs.
 ///
@@ -114,11 +125,15 @@ pub struct PhysicsRunner {
     plan: PhysicsPlan,
     schedule: Schedule,
     replans: u64,
+    /// The settings the plan was made for.
+    settings: PhysicsSettings,
     /// The springs, read by every re-planning (whether any is damped): kept so that planning
     /// every step builds no query.
     springs: Option<SpringQuery>,
     /// When the [`ForceSystems`] the schedule holds were last changed.
     force_systems: Option<bevy_ecs::change_detection::Tick>,
+    /// The checks of the force generators before each step.
+    generators: GeneratorWatch,
 }
 
 impl PhysicsRunner {
@@ -130,26 +145,54 @@ impl PhysicsRunner {
             plan,
             schedule,
             replans: 0,
+            settings: *world.resource::<PhysicsSettings>(),
             springs: None,
             force_systems: force_systems_changed(world),
+            generators: GeneratorWatch::default(),
         }
     }
 
     /// Advances `world` by one step, re-planning first if the world changed. (In a bare `World`,
     /// call `world.clear_trackers()` once per frame as well.)
     pub fn step(&mut self, world: &mut World) {
-        if PhysicsPlan::of_with(world, &mut self.springs) != self.plan
+        self.prepare(world);
+        self.plan.run_step(&mut self.schedule, world);
+    }
+
+    /// What [`step`](Self::step) does before it runs the plan: gives bodies without mass
+    /// properties the default (with a warning), leaves out generators that turned bad, checks
+    /// the plan against the world and plans again if it no longer matches. Public so that its
+    /// cost can be measured on its own (`tumble bench` reports it against a whole step).
+    pub fn prepare(&mut self, world: &mut World) {
+        crate::components::assume_missing_masses(world);
+        self.generators.check(world);
+        if self.is_stale(world) {
+            self.replan(world);
+        }
+    }
+
+    /// True when `world` no longer matches the plan (see the type's docs).
+    fn is_stale(&mut self, world: &World) -> bool {
+        world.get_resource::<PhysicsSettings>() != Some(&self.settings)
+            || PhysicsPlan::of_with(world, &mut self.springs) != self.plan
             || crate::stiff::classification_is_stale(world)
             || force_systems_changed(world) != self.force_systems
-        {
-            let plan = PhysicsPlan::for_world(world);
-            tracing::debug!(from = %self.plan, to = %plan, "physics re-planned");
-            self.schedule = build(&plan, world);
-            self.plan = plan;
-            self.replans += 1;
-            self.force_systems = force_systems_changed(world);
+    }
+
+    /// Plans `world` again ([`PhysicsPlan::for_world`]: classification, stability check) and
+    /// rebuilds the schedule if the plan or the force systems changed.
+    fn replan(&mut self, world: &mut World) {
+        let plan = PhysicsPlan::for_world(world);
+        self.settings = *world.resource::<PhysicsSettings>();
+        let force_systems = force_systems_changed(world);
+        if plan == self.plan && force_systems == self.force_systems {
+            return;
         }
-        self.plan.run_step(&mut self.schedule, world);
+        tracing::debug!(from = %self.plan, to = %plan, "physics re-planned");
+        self.schedule = build(&plan, world);
+        self.plan = plan;
+        self.replans += 1;
+        self.force_systems = force_systems;
     }
 
     /// The current plan.

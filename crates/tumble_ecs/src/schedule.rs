@@ -50,8 +50,8 @@ use crate::audit::{
 use crate::components::{ForceAccumulator, Gravity, Kinematic, PhysicsSettings, RigidBody, Static};
 use crate::damping::{damp_springs_end, damp_springs_start, is_damped};
 use crate::forces::{
-    ConstantForce, ConstantTorque, Spring, apply_constant_forces, apply_constant_torques,
-    apply_gravity, apply_springs,
+    ConstantForce, ConstantLocalForce, ConstantTorque, Spring, apply_constant_forces,
+    apply_constant_torques, apply_gravity, apply_springs,
 };
 use crate::stages::{StageCursor, hold_game_loads, next_stage};
 use crate::stiff::{ImplicitBody, ImplicitSpring, solve_implicit_springs};
@@ -60,9 +60,12 @@ use crate::systems::{
     integrate_without_forces,
 };
 
-/// Label of the schedule that advances physics by one fixed step.
+/// Label of the schedule a plan builds: one run is one stage of a step. Private, so that no
+/// public label invites a game system into a schedule that only the plan's owner runs: game
+/// force systems go in [`ForceSystems`](crate::runner::ForceSystems) (every stage) or, with the
+/// plugin, before `TumbleStep` (held over the step).
 #[derive(ScheduleLabel, Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
-pub struct PhysicsSchedule;
+pub(crate) struct PlannedStage;
 
 /// The ordered stages of one physics step.
 #[derive(SystemSet, Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -188,6 +191,9 @@ impl Stage {
 /// are any; the stages live inline), so [`PhysicsRunner`](crate::runner::PhysicsRunner)
 /// re-plans every step and rebuilds the schedule only when the plan changes; the runner keeps
 /// its spring query between steps, so its re-planning does not allocate.
+///
+/// A plan describes a step; only a [`PhysicsRunner`](crate::runner::PhysicsRunner) runs one,
+/// after checking it against the world, so no public path steps a world by a stale plan.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct PhysicsPlan {
     stages: ArrayVec<Stage, { Stage::COUNT }>,
@@ -224,6 +230,7 @@ impl Contents {
             world.component_id::<Kinematic>(),
         ];
         let force = world.component_id::<ConstantForce>();
+        let local_force = world.component_id::<ConstantLocalForce>();
         let torque = world.component_id::<ConstantTorque>();
         let spring = world.component_id::<Spring>();
         let implicit = world.component_id::<ImplicitBody>();
@@ -242,7 +249,7 @@ impl Contents {
                     (true, _) => {}
                 }
             }
-            out.constant_forces |= has(force);
+            out.constant_forces |= has(force) || has(local_force);
             out.constant_torques |= has(torque);
             out.springs |= has(spring);
             out.explicit_springs |= has(spring) && !has(implicit_spring);
@@ -276,11 +283,14 @@ impl PhysicsPlan {
     /// [`check_stability`](crate::stability::check_stability)).
     pub fn for_world(world: &mut World) -> Self {
         world.get_resource_or_init::<PhysicsSettings>();
+        crate::components::assume_missing_masses(world);
         crate::stiff::classify_springs(world);
         for warning in crate::stability::check_stability(world) {
             tracing::warn!("{warning}");
         }
         world.init_resource::<HalfDrifted>();
+        // Game code reads the record from the first step on, errors or not.
+        world.init_resource::<crate::validate::PhysicsErrors>();
         world.init_resource::<EnergyLedger>();
         // A new plan starts at the first stage of a step.
         world.insert_resource(StageCursor::default());
@@ -353,7 +363,9 @@ impl PhysicsPlan {
     /// Runs `schedule` — built by [`build_schedule`](Self::build_schedule) from this plan —
     /// for one whole step: once per stage ([`runs_per_step`](Self::runs_per_step) times; once
     /// unless there are substeps or a composition). A single `schedule.run` is one *stage*.
-    pub fn run_step(&self, schedule: &mut Schedule, world: &mut World) {
+    /// Crate-private: only [`PhysicsRunner`](crate::runner::PhysicsRunner), which checks the
+    /// plan against the world before every step, runs a plan.
+    pub(crate) fn run_step(&self, schedule: &mut Schedule, world: &mut World) {
         for _ in 0..self.runs_per_step {
             schedule.run(world);
         }
@@ -369,13 +381,11 @@ impl PhysicsPlan {
         self.stages.contains(&stage)
     }
 
-    /// Builds the [`PhysicsSchedule`] holding exactly the planned systems, strictly ordered (so
-    /// forces are summed in the same order every run: bit-identical results). One run of it is
-    /// one stage of a step: run a step with [`run_step`](Self::run_step) (or let
-    /// [`PhysicsRunner`](crate::runner::PhysicsRunner) do it), which is a single run unless
-    /// the step has several stages (substeps, `yoshida4`).
-    pub fn build_schedule(&self) -> Schedule {
-        let mut schedule = Schedule::new(PhysicsSchedule);
+    /// Builds the schedule holding exactly the planned systems, strictly ordered (so forces are
+    /// summed in the same order every run: bit-identical results). One run of it is one stage
+    /// of a step: [`run_step`](Self::run_step) runs a whole step.
+    pub(crate) fn build_schedule(&self) -> Schedule {
+        let mut schedule = Schedule::new(PlannedStage);
         // The stages run strictly one after another, so a multi-threaded executor (bevy's
         // default with `multi_threaded`) could only add overhead: ~45 µs per step measured.
         // Parallelism lives inside the integrate systems instead (see `crate::parallel`).
@@ -423,32 +433,6 @@ impl PhysicsPlan {
     }
 }
 
-/// A [`PhysicsPlan`] with the schedule built from it: the step of a bare `World`, planned once
-/// and again only on request ([`PhysicsRunner`](crate::runner::PhysicsRunner) re-plans by
-/// itself when the world changes).
-pub struct PlannedStep {
-    /// The plan the schedule was built from.
-    pub plan: PhysicsPlan,
-    /// The schedule holding only the planned systems (one run is one stage of a step: step
-    /// with [`step`](Self::step)).
-    pub schedule: Schedule,
-}
-
-impl PlannedStep {
-    /// Plans the step for `world` ([`PhysicsPlan::for_world`]) and builds its schedule.
-    pub fn for_world(world: &mut World) -> Self {
-        let plan = PhysicsPlan::for_world(world);
-        let schedule = plan.build_schedule();
-        Self { plan, schedule }
-    }
-
-    /// Advances `world` by one step ([`PhysicsPlan::run_step`]) and clears its change trackers.
-    pub fn step(&mut self, world: &mut World) {
-        self.plan.run_step(&mut self.schedule, world);
-        world.clear_trackers();
-    }
-}
-
 /// A marker set per stage, used to chain the stages in plan order.
 #[derive(SystemSet, Debug, Clone, Copy, PartialEq, Eq, Hash)]
 struct StageSet(Stage);
@@ -487,5 +471,39 @@ impl fmt::Display for PhysicsPlan {
             write!(f, " (× {} stages per step)", self.runs_per_step)?;
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::forces::SpringEnd;
+    use tumble_core::math::Vec3;
+
+    /// The schedule a plan builds holds exactly the planned systems, one each.
+    #[test]
+    fn the_schedule_holds_exactly_the_planned_systems() {
+        let mut world = World::new();
+        world.insert_resource(Gravity(Vec3::new(0.0, -9.81, 0.0)));
+        let pulled = world.spawn((RigidBody, ForceAccumulator::default())).id();
+        world.spawn(RigidBody);
+        world.spawn((RigidBody, Static, ForceAccumulator::default()));
+        world.spawn(Spring {
+            a: pulled,
+            anchor_a: Vec3::ZERO,
+            b: SpringEnd::World(Vec3::X),
+            stiffness: 10.0,
+            damping: 0.5,
+            rest_length: 1.0,
+        });
+        world.spawn(ConstantTorque {
+            body: pulled,
+            torque: Vec3::Y,
+        });
+        let plan = PhysicsPlan::for_world(&mut world);
+        assert!(plan.stages().len() >= 8, "{plan}");
+        let mut schedule = plan.build_schedule();
+        schedule.initialize(&mut world).unwrap();
+        assert_eq!(schedule.systems_len(), plan.stages().len(), "{plan}");
     }
 }

@@ -19,10 +19,10 @@ use thiserror::Error;
 
 use crate::audit::{EnergyLedger, SavedAccount};
 use crate::components::{
-    Damping, ForceAccumulator, Gravity, GravityScale, Kinematic, MassProps, PhysicsSettings,
-    RigidBody, Static, Transform, Velocity,
+    Damping, ForceAccumulator, Gravity, GravityScale, Kinematic, MassProps, PhysicsSettings, Pose,
+    RigidBody, Static, Velocity,
 };
-use crate::forces::{ConstantForce, ConstantTorque, Spring, SpringEnd};
+use crate::forces::{ConstantForce, ConstantLocalForce, ConstantTorque, Spring, SpringEnd};
 use crate::parallel::Parallelism;
 use crate::systems::HalfDrifted;
 use crate::validate::{BodyError, BodyErrorKind, PhysicsErrors, Rejected};
@@ -46,7 +46,7 @@ pub struct BodySnapshot {
     /// How tumble treats it.
     pub kind: BodyKind,
     /// Pose.
-    pub transform: Transform,
+    pub transform: Pose,
     /// Velocity.
     pub velocity: Velocity,
     /// Mass properties.
@@ -78,6 +78,10 @@ pub struct Snapshot {
     pub bodies: Vec<BodySnapshot>,
     /// Constant forces, in iteration order (their `body` is a saved entity).
     pub constant_forces: Vec<ConstantForce>,
+    /// Body-frame constant forces, in iteration order (absent in snapshots saved before they
+    /// existed).
+    #[serde(default)]
+    pub constant_local_forces: Vec<ConstantLocalForce>,
     /// Constant torques, in iteration order.
     pub constant_torques: Vec<ConstantTorque>,
     /// Springs, in iteration order.
@@ -110,10 +114,11 @@ pub const SNAPSHOT_VERSION: u32 = 1;
 impl Snapshot {
     /// Captures every physics component and resource of `world`.
     pub fn capture(world: &mut World) -> Self {
+        crate::components::assume_missing_masses(world);
         let mut bodies = Vec::new();
         let mut query = world.query_filtered::<(
             Entity,
-            &Transform,
+            &Pose,
             &Velocity,
             &MassProps,
             Option<&ForceAccumulator>,
@@ -154,11 +159,12 @@ impl Snapshot {
             half_drifted: world.get_resource::<HalfDrifted>().is_some_and(|h| h.0),
             bodies,
             constant_forces: all::<ConstantForce>(world),
+            constant_local_forces: all::<ConstantLocalForce>(world),
             constant_torques: all::<ConstantTorque>(world),
             springs: all::<Spring>(world),
             errors: world
                 .get_resource::<PhysicsErrors>()
-                .map(|e| e.0.iter().map(ToString::to_string).collect())
+                .map(|e| e.bodies.iter().map(ToString::to_string).collect())
                 .unwrap_or_default(),
             energy_accounts: world
                 .get_resource::<EnergyLedger>()
@@ -191,6 +197,9 @@ impl Snapshot {
             }
         }
         for f in &self.constant_forces {
+            body(f.body)?;
+        }
+        for f in &self.constant_local_forces {
             body(f.body)?;
         }
         for t in &self.constant_torques {
@@ -240,6 +249,12 @@ impl Snapshot {
         let remap = |saved: Entity| map[&saved];
         for f in &self.constant_forces {
             world.spawn(ConstantForce {
+                body: remap(f.body),
+                ..*f
+            });
+        }
+        for f in &self.constant_local_forces {
+            world.spawn(ConstantLocalForce {
                 body: remap(f.body),
                 ..*f
             });
@@ -300,7 +315,10 @@ impl Snapshot {
                     kind: BodyErrorKind::Restored(message.clone()),
                 })
                 .collect();
-            world.insert_resource(PhysicsErrors(errors));
+            world.insert_resource(PhysicsErrors {
+                bodies: errors,
+                generators: Vec::new(),
+            });
         }
         Ok(map)
     }

@@ -64,8 +64,7 @@ use tumble_core::Integrator;
 use tumble_core::math::{DOUBLE_PRECISION, REAL_NAME, Real, Vec3};
 
 use crate::components::{
-    Gravity, GravityScale, Kinematic, MassProps, PhysicsSettings, RigidBody, Static, Transform,
-    Velocity,
+    Gravity, GravityScale, Kinematic, MassProps, PhysicsSettings, Pose, RigidBody, Static, Velocity,
 };
 use crate::forces::{Spring, SpringEnd};
 
@@ -255,6 +254,7 @@ pub fn split_rotation_error(inertia: Vec3, omega: Vec3, dt: Real) -> Real {
 /// Springs stepped implicitly (see [`crate::stiff`]; classified here if needed) are never
 /// reported: the implicit step is stable at any stiffness.
 pub fn check_stability(world: &mut World) -> Vec<StabilityWarning> {
+    crate::components::assume_missing_masses(world);
     let Some(settings) = world.get_resource::<PhysicsSettings>().copied() else {
         return Vec::new();
     };
@@ -292,7 +292,7 @@ pub fn check_stability(world: &mut World) -> Vec<StabilityWarning> {
     let gravity = world.get_resource::<Gravity>().map_or(Vec3::ZERO, |g| g.0);
     let mut moving = world.query_filtered::<(
         Entity,
-        &Transform,
+        &Pose,
         &Velocity,
         &MassProps,
         Option<&GravityScale>,
@@ -321,7 +321,7 @@ pub fn check_stability(world: &mut World) -> Vec<StabilityWarning> {
         // One substep's span: the split is applied once per stage.
         let h = settings.dt() / settings.substeps.get() as Real;
         let mut spins =
-            world.query_filtered::<(Entity, &MassProps, &Transform, &Velocity), With<RigidBody>>();
+            world.query_filtered::<(Entity, &MassProps, &Pose, &Velocity), With<RigidBody>>();
         for (body, mass, transform, velocity) in spins.iter(world) {
             let principal = transform.rotation * mass.principal_frame();
             let omega = tumble_core::integrate::rotate_inv(principal, velocity.angular);
@@ -338,7 +338,7 @@ pub fn check_stability(world: &mut World) -> Vec<StabilityWarning> {
     if settings.integrator == Integrator::Rk4 {
         let h = settings.dt() / settings.substeps.get() as Real;
         let mut spins =
-            world.query_filtered::<(Entity, &MassProps, &Transform, &Velocity), With<RigidBody>>();
+            world.query_filtered::<(Entity, &MassProps, &Pose, &Velocity), With<RigidBody>>();
         for (body, mass, transform, velocity) in spins.iter(world) {
             let momentum = mass
                 .world_inertia_mul(transform.rotation, velocity.angular)

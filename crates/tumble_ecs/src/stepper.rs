@@ -8,7 +8,7 @@
 use thiserror::Error;
 use tumble_core::math::{Real, Vec3, to_f64};
 
-use crate::components::Transform;
+use crate::components::Pose;
 
 /// Invalid stepper input.
 #[derive(Debug, Clone, Copy, PartialEq, Error)]
@@ -95,8 +95,8 @@ impl FixedStepper {
 }
 
 /// Interpolates a pose for rendering: linear in translation, spherical (slerp) in rotation.
-pub fn interpolate(previous: &Transform, current: &Transform, alpha: Real) -> Transform {
-    Transform {
+pub fn interpolate(previous: &Pose, current: &Pose, alpha: Real) -> Pose {
+    Pose {
         translation: Vec3::lerp(previous.translation, current.translation, alpha),
         rotation: previous.rotation.slerp(current.rotation, alpha),
     }

@@ -40,8 +40,7 @@ use tumble_core::springs::{
 };
 
 use crate::components::{
-    ForceAccumulator, MassProps, PhysicsSettings, RigidBody, Transform, body_state,
-    write_body_state,
+    ForceAccumulator, MassProps, PhysicsSettings, Pose, RigidBody, body_state, write_body_state,
 };
 use crate::forces::{Spring, SpringEnd};
 use crate::systems::{Dynamic, Stepped};
@@ -364,7 +363,7 @@ pub fn solve_implicit_springs(
         (Stepped<&mut ForceAccumulator>, &mut ImplicitBody),
         (Dynamic, With<ImplicitBody>),
     >,
-    others: Query<&Transform, (With<RigidBody>, Without<ImplicitBody>)>,
+    others: Query<&Pose, (With<RigidBody>, Without<ImplicitBody>)>,
 ) {
     let s = &mut *scratch;
     s.index.clear();

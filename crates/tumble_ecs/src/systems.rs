@@ -8,8 +8,8 @@ use bevy_ecs::prelude::*;
 use tumble_core::StepPhase;
 
 use crate::components::{
-    Damping, ForceAccumulator, Gravity, GravityScale, Kinematic, MassProps, PhysicsSettings,
-    RigidBody, Static, Transform, Velocity,
+    Damping, ForceAccumulator, Gravity, GravityScale, Kinematic, MassProps, PhysicsSettings, Pose,
+    RigidBody, Static, Velocity,
 };
 use crate::parallel::Parallelism;
 use crate::stiff::ImplicitBody;
@@ -63,7 +63,7 @@ pub type Dynamic = (
 /// component `L` and its damping.
 pub(crate) type Stepped<L> = (
     Entity,
-    &'static mut Transform,
+    &'static mut Pose,
     &'static mut Velocity,
     &'static MassProps,
     L,

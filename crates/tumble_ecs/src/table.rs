@@ -15,7 +15,7 @@ use tumble_core::prefetch::prefetch;
 use tumble_core::{BodyBatch, BodyState, Integrator, MassProperties, StepPhase, Wrench};
 
 use crate::components::{
-    Damping, ForceAccumulator, GravityScale, MassProps, PhysicsSettings, Transform, Velocity,
+    Damping, ForceAccumulator, GravityScale, MassProps, PhysicsSettings, Pose, Velocity,
     body_state, write_body_state,
 };
 use crate::parallel::Parallelism;
@@ -80,7 +80,7 @@ impl Loads<'_> {
 /// A run of bodies from one table, as plain slices.
 pub(crate) struct Bodies<'a> {
     pub(crate) entities: &'a [Entity],
-    pub(crate) transforms: &'a mut [Transform],
+    pub(crate) transforms: &'a mut [Pose],
     pub(crate) velocities: &'a mut [Velocity],
     pub(crate) masses: &'a [MassProps],
     pub(crate) dampings: Option<&'a [Damping]>,

@@ -14,7 +14,7 @@
 use bevy_ecs::change_detection::ContiguousMut;
 use bevy_ecs::prelude::*;
 
-use crate::components::{ForceAccumulator, MassProps, RigidBody, Transform, Velocity};
+use crate::components::{ForceAccumulator, MassProps, Pose, RigidBody, Velocity};
 use crate::systems::dense;
 use crate::validate::Rejected;
 
@@ -25,7 +25,7 @@ pub type ForceTargets<'w, 's> = Query<
     's,
     (
         Entity,
-        &'static Transform,
+        &'static Pose,
         &'static MassProps,
         &'static mut ForceAccumulator,
     ),
@@ -44,7 +44,7 @@ pub struct TargetRows(Vec<(u32, u32)>);
 /// One table of targets as column slices.
 pub(crate) struct TargetTable<'a> {
     entities: &'a [Entity],
-    transforms: &'a [Transform],
+    transforms: &'a [Pose],
     masses: &'a [MassProps],
     accumulators: &'a mut [ForceAccumulator],
 }
@@ -114,7 +114,7 @@ impl<'a, 'w, 's> Targets<'a, 'w, 's> {
 
     /// The pose and mass of target `entity`.
     #[inline]
-    pub(crate) fn body(&self, entity: Entity) -> Option<(&Transform, &MassProps)> {
+    pub(crate) fn body(&self, entity: Entity) -> Option<(&Pose, &MassProps)> {
         match self {
             Targets::Tables { tables, rows } => {
                 let (t, row) = Self::slot(rows, entity)?;
@@ -154,6 +154,7 @@ mod tests {
 
     use super::*;
     use crate::prelude::*;
+    use tumble_core::math::{Quat, Real, Vec3};
 
     /// A marker that splits bodies into archetypes (tables) without changing their physics.
     #[derive(Component)]
@@ -184,7 +185,7 @@ mod tests {
                 let mut body = world.spawn((
                     RigidBody,
                     MassProps(mass),
-                    Transform {
+                    Pose {
                         translation: Vec3::new(x, 0.0, 0.0),
                         rotation: Quat::from_rotation_z(0.3 * x),
                     },
@@ -270,7 +271,7 @@ mod tests {
             plan_s.run_step(&mut schedule_s, &mut spread);
         }
         let states = |world: &mut World| {
-            let mut query = world.query::<(Entity, &Transform, &Velocity)>();
+            let mut query = world.query::<(Entity, &Pose, &Velocity)>();
             let mut states: Vec<(Entity, [Real; 13])> = query
                 .iter(world)
                 .map(|(e, t, v)| {

@@ -2,11 +2,11 @@
 //! so that one bad body never harms another.
 //!
 //! Bad data is caught in two places:
-//! - **on insert**: a component hook on [`Transform`], [`Velocity`] and [`ForceAccumulator`]
+//! - **on insert**: a component hook on [`Pose`], [`Velocity`] and [`ForceAccumulator`]
 //!   re-checks the whole body; [`MassProps`](crate::components::MassProps) and
 //!   [`PhysicsSettings`](crate::components::PhysicsSettings) cannot hold bad values at all;
 //! - **on change**: the integrate systems check each body's input before stepping it (game code
-//!   may have written NaN into a `&mut Transform`) and its output after (a method outside its
+//!   may have written NaN into a `&mut Pose`) and its output after (a method outside its
 //!   stable region).
 //!
 //! A rejected body gets the [`Rejected`] marker, keeps its last valid data untouched and is skipped
@@ -19,7 +19,7 @@ use bevy_ecs::world::DeferredWorld;
 use thiserror::Error;
 use tumble_core::{InvalidInput, StepError};
 
-use crate::components::{ForceAccumulator, RigidBody, Transform, Velocity};
+use crate::components::{ForceAccumulator, Pose, RigidBody, Velocity};
 
 /// Why a body was rejected.
 #[derive(Debug, Clone, PartialEq, Error)]
@@ -27,7 +27,7 @@ pub enum BodyErrorKind {
     /// A component holds invalid data.
     #[error("invalid {component}: {source}")]
     Invalid {
-        /// The component type, e.g. `"Transform"`.
+        /// The component type, e.g. `"Pose"`.
         component: &'static str,
         /// What is wrong with it.
         source: InvalidInput,
@@ -78,18 +78,32 @@ pub struct BodyError {
 #[derive(Component, Debug, Clone, PartialEq)]
 pub struct Rejected(pub BodyError);
 
-/// Every body error raised so far, oldest first. Game code may drain it.
+/// Every error raised so far, oldest first, one record per incident. Exists from the first
+/// plan on ([`PhysicsPlan::for_world`](crate::schedule::PhysicsPlan::for_world)); game code
+/// may drain it.
 #[derive(Resource, Debug, Clone, Default, PartialEq)]
-pub struct PhysicsErrors(pub Vec<BodyError>);
+pub struct PhysicsErrors {
+    /// Quarantined bodies (see [`Rejected`]).
+    pub bodies: Vec<BodyError>,
+    /// Force generators left out of the step (see [`crate::generator_check`]).
+    pub generators: Vec<crate::generator_check::GeneratorError>,
+}
 
-/// Checks the body data of a [`Transform`], [`Velocity`] and optional [`ForceAccumulator`].
+impl PhysicsErrors {
+    /// True when nothing was recorded.
+    pub fn is_empty(&self) -> bool {
+        self.bodies.is_empty() && self.generators.is_empty()
+    }
+}
+
+/// Checks the body data of a [`Pose`], [`Velocity`] and optional [`ForceAccumulator`].
 ///
 /// Runs for every body every step, so valid data takes an inlined fast test (finite values, unit
 /// quaternion within [`UNIT_QUATERNION_TOLERANCE`](tumble_core::error::UNIT_QUATERNION_TOLERANCE));
 /// only bad data goes through the detailed checks that build the error.
 #[inline]
 pub fn check_body(
-    transform: &Transform,
+    transform: &Pose,
     velocity: &Velocity,
     forces: Option<&ForceAccumulator>,
 ) -> Result<(), BodyErrorKind> {
@@ -114,14 +128,14 @@ pub fn check_body(
 /// The detailed checks behind [`check_body`], naming the component and field at fault.
 #[cold]
 fn check_body_in_detail(
-    transform: &Transform,
+    transform: &Pose,
     velocity: &Velocity,
     forces: Option<&ForceAccumulator>,
 ) -> Result<(), BodyErrorKind> {
     use tumble_core::error::{check_finite_vec3, check_unit_quat};
     let invalid = |component| move |source| BodyErrorKind::Invalid { component, source };
-    check_finite_vec3("translation", transform.translation).map_err(invalid("Transform"))?;
-    check_unit_quat("rotation", transform.rotation).map_err(invalid("Transform"))?;
+    check_finite_vec3("translation", transform.translation).map_err(invalid("Pose"))?;
+    check_unit_quat("rotation", transform.rotation).map_err(invalid("Pose"))?;
     check_finite_vec3("linear velocity", velocity.linear).map_err(invalid("Velocity"))?;
     check_finite_vec3("angular velocity", velocity.angular).map_err(invalid("Velocity"))?;
     match forces {
@@ -154,12 +168,23 @@ fn check_accumulator_in_detail(acc: &ForceAccumulator) -> Result<(), BodyErrorKi
 
 /// Quarantines `entity`: logs the error, records it in [`PhysicsErrors`] and inserts
 /// [`Rejected`]. Used by the hooks and the integrate systems.
+///
+/// One incident is one record: a body already quarantined for the same reason (several hooks
+/// of one insertion see the same bad data) is neither logged nor recorded again.
 pub fn reject(commands: &mut Commands, error: BodyError) {
-    tracing::warn!(entity = %error.entity, "{error}");
-    let entity = error.entity;
-    commands.entity(entity).insert(Rejected(error.clone()));
     commands.queue(move |world: &mut World| {
-        world.get_resource_or_init::<PhysicsErrors>().0.push(error);
+        let Ok(mut entity) = world.get_entity_mut(error.entity) else {
+            return;
+        };
+        if entity.get::<Rejected>().is_some_and(|r| r.0 == error) {
+            return;
+        }
+        tracing::warn!(entity = %error.entity, "{error}");
+        entity.insert(Rejected(error.clone()));
+        world
+            .get_resource_or_init::<PhysicsErrors>()
+            .bodies
+            .push(error);
     });
 }
 
@@ -169,10 +194,9 @@ pub fn revalidate_body_hook(mut world: DeferredWorld, ctx: HookContext) {
     if world.get::<RigidBody>(entity).is_none() {
         return;
     }
-    let (Some(transform), Some(velocity)) = (
-        world.get::<Transform>(entity),
-        world.get::<Velocity>(entity),
-    ) else {
+    let (Some(transform), Some(velocity)) =
+        (world.get::<Pose>(entity), world.get::<Velocity>(entity))
+    else {
         return; // the rest of the bundle is still being inserted; its own hook will check.
     };
     let result = check_body(transform, velocity, world.get::<ForceAccumulator>(entity));

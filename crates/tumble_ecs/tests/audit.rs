@@ -61,20 +61,18 @@ fn chain(world: &mut World, n: usize, x0: Real, omega_dt: Real) -> Vec<Entity> {
     bodies
 }
 
-fn run(world: &mut World, steps: usize) -> Schedule {
-    let plan = PhysicsPlan::for_world(world);
-    let mut schedule = plan.build_schedule();
+fn run(world: &mut World, steps: usize) {
+    let mut physics = PhysicsRunner::new(world);
     for _ in 0..steps {
-        plan.run_step(&mut schedule, world);
+        physics.step(world);
         world.clear_trackers();
     }
-    schedule
 }
 
 fn errors(world: &World) -> Vec<BodyError> {
     world
         .get_resource::<PhysicsErrors>()
-        .map(|e| e.0.clone())
+        .map(|e| e.bodies.clone())
         .unwrap_or_default()
 }
 
@@ -98,7 +96,7 @@ fn an_unstable_spring_chain_is_quarantined_before_its_state_is_garbage() {
         );
         // The chain starts within a few metres of the origin: the kept state is sane, not
         // the 1e19 m an unchecked run reaches.
-        let t = w.get::<Transform>(b).unwrap();
+        let t = w.get::<Pose>(b).unwrap();
         assert!(t.translation.length() < 1e3, "{:?}", t.translation);
         assert!(w.get::<Velocity>(b).unwrap().linear.length() < 1e4);
     }
@@ -159,9 +157,10 @@ fn work_of_gravity_forces_torques_and_game_code_is_credited() {
             body: b,
             torque: Vec3::new(0.1, 0.0, 0.0),
         });
-        let plan = PhysicsPlan::for_world(&mut w);
-        let mut schedule = plan.build_schedule();
-        schedule.add_systems(thrust.in_set(PhysicsSet::Forces));
+        let mut forces = ForceSystems::default();
+        forces.add(thrust);
+        w.insert_resource(forces);
+        let mut physics = PhysicsRunner::new(&mut w);
         for step in 0..3000 {
             // Game code kicks a body between steps, and adds a force before one.
             if step % 500 == 0 {
@@ -171,7 +170,7 @@ fn work_of_gravity_forces_torques_and_game_code_is_credited() {
                     torque: Vec3::new(0.0, 5.0, 0.0),
                 });
             }
-            plan.run_step(&mut schedule, &mut w);
+            physics.step(&mut w);
             w.clear_trackers();
         }
         assert!(errors(&w).is_empty(), "{integrator}: {:?}", errors(&w));
@@ -202,10 +201,7 @@ fn a_diverging_group_harms_no_other_body() {
         }
         run(&mut w, 800);
         let rejected = w.query::<&Rejected>().iter(&w).count();
-        let poses: Vec<Transform> = soft
-            .iter()
-            .map(|&e| *w.get::<Transform>(e).unwrap())
-            .collect();
+        let poses: Vec<Pose> = soft.iter().map(|&e| *w.get::<Pose>(e).unwrap()).collect();
         (rejected, poses)
     };
     let (none, alone) = stepped(false);
@@ -256,10 +252,9 @@ fn despawned_and_new_bodies_keep_the_groups_right() {
         // order, where the springs left pointing at its dead entities must not find them.
         let gone = chain(&mut w, 3, 20.0, 0.5);
         let kept = chain(&mut w, 4, 0.0, 0.5);
-        let plan = PhysicsPlan::for_world(&mut w);
-        let mut schedule = plan.build_schedule();
+        let mut physics = PhysicsRunner::new(&mut w);
         let mut step = |w: &mut World| {
-            plan.run_step(&mut schedule, w);
+            physics.step(w);
             w.clear_trackers();
         };
         for _ in 0..30 {
@@ -276,10 +271,7 @@ fn despawned_and_new_bodies_keep_the_groups_right() {
         for _ in 0..600 {
             step(&mut w);
         }
-        let poses: Vec<Transform> = kept
-            .iter()
-            .map(|&e| *w.get::<Transform>(e).unwrap())
-            .collect();
+        let poses: Vec<Pose> = kept.iter().map(|&e| *w.get::<Pose>(e).unwrap()).collect();
         let quarantined: Vec<bool> = unstable
             .iter()
             .map(|&e| w.get::<Rejected>(e).is_some())

@@ -1,10 +1,13 @@
 //! `TumblePlugin` in any schedule, with its runner kept in the world: a rollback of the world
 //! alone (a `RollbackSnapshot`) steps on exactly as a run that never rolled back.
 
-use bevy_app::{App, Update};
+use std::time::Duration;
+
+use bevy_app::{App, FixedUpdate, Update};
 use bevy_ecs::prelude::*;
 use bevy_ecs::schedule::ScheduleLabel;
-use tumble_core::math::Vec3;
+use bevy_time::{Fixed, Time, TimePlugin, TimeUpdateStrategy, Virtual};
+use tumble_core::math::{Real, Vec3, to_f64};
 use tumble_ecs::checksum::world_checksum;
 use tumble_ecs::plugin::{TumblePlugin, TumbleStep};
 use tumble_ecs::prelude::*;
@@ -56,7 +59,7 @@ fn one_step_per_run_of_the_chosen_schedule() {
             app.world_mut().run_schedule(run);
         }
         // One second at 64 Hz under (1, −1, 0) m/s² from rest: x = ½ t², y = −½ t².
-        let x = app.world().get::<Transform>(body).unwrap().translation;
+        let x = app.world().get::<Pose>(body).unwrap().translation;
         assert!((x.x - 0.5).abs() < 1e-5 && (x.y + 0.5).abs() < 1e-5, "{x}");
         assert!(app.world().contains_resource::<PhysicsRunner>());
     }
@@ -94,4 +97,118 @@ fn the_plugin_keeps_no_state_outside_the_world() {
             "frame {frame}"
         );
     }
+}
+
+/// An app on Bevy's clock: `FixedUpdate` at `hz`, frames of `frame` of game time each.
+fn app_on_clock(hz: f64, frame: Duration, plugin: TumblePlugin) -> App {
+    let mut app = App::new();
+    app.add_plugins((TimePlugin, plugin))
+        .insert_resource(Time::<Fixed>::from_hz(hz))
+        .insert_resource(TimeUpdateStrategy::ManualDuration(frame));
+    app
+}
+
+/// Runs frames until `seconds` of game (virtual) time have passed; returns the fixed clock's
+/// elapsed time, the game time the physics steps cover.
+fn run_for(app: &mut App, seconds: f64) -> f64 {
+    while app.world().resource::<Time<Virtual>>().elapsed_secs_f64() < seconds {
+        app.update();
+    }
+    app.world().resource::<Time<Fixed>>().elapsed_secs_f64()
+}
+
+/// `FixedUpdate` at 60 Hz: one second of game time moves a body at 1 m/s by 1 m and a body
+/// under 1 m/s² by ½ m (the default integrator is exact for a constant force), to f32
+/// rounding over 60 steps, whatever the plugin's own default step (1/64 s) says.
+#[test]
+fn the_plugin_steps_by_bevys_fixed_clock() {
+    let mut app = app_on_clock(60.0, Duration::from_millis(10), TumblePlugin::default());
+    let moving = app
+        .world_mut()
+        .spawn((RigidBody, Velocity::linear(Vec3::X)))
+        .id();
+    let pushed = app.world_mut().spawn(RigidBody).id();
+    app.world_mut().spawn(ConstantForce {
+        body: pushed,
+        force: Vec3::X,
+        local_point: None,
+    });
+    let t = run_for(&mut app, 1.0);
+    // The fixed clock lags game time by less than one of its steps (1/60 s rounded up to the
+    // nanosecond: 59 steps fit in the first second).
+    assert!(t <= 1.0 && 1.0 - t < 1.0 / 60.0, "fixed clock at {t} s");
+    let x = |e| to_f64(app.world().get::<Pose>(e).unwrap().translation.x);
+    let tol = 60.0 * 4.0 * f64::from(f32::EPSILON);
+    assert!(
+        (x(moving) - t).abs() < tol,
+        "moved {} m in {t} s",
+        x(moving)
+    );
+    assert!(
+        (x(pushed) - 0.5 * t * t).abs() < tol,
+        "pushed {} m in {t} s",
+        x(pushed)
+    );
+    let dt = app.world().resource::<PhysicsSettings>().dt();
+    let timestep = app.world().resource::<Time<Fixed>>().timestep();
+    assert_eq!(dt, timestep.as_secs_f64() as Real);
+}
+
+/// A time step set by game code that differs from the clock is overridden by the clock (with a
+/// warning), and a change of the clock's rate is followed from the next step on.
+#[test]
+fn the_clock_wins_over_a_settings_time_step() {
+    let settings = PhysicsSettings::new(0.1, Integrator::Splitting).unwrap();
+    let plugin = TumblePlugin::default().with_settings(settings);
+    let mut app = app_on_clock(50.0, Duration::from_millis(5), plugin);
+    let moving = app
+        .world_mut()
+        .spawn((RigidBody, Velocity::linear(Vec3::X)))
+        .id();
+    let t = run_for(&mut app, 0.5);
+    assert_eq!(app.world().resource::<PhysicsSettings>().dt(), 0.02);
+    app.world_mut()
+        .resource_mut::<Time<Fixed>>()
+        .set_timestep_hz(100.0);
+    let t = run_for(&mut app, 1.0) - t;
+    assert_eq!(app.world().resource::<PhysicsSettings>().dt(), 0.01);
+    let fixed = app.world().resource::<Time<Fixed>>().elapsed_secs_f64();
+    let x = to_f64(app.world().get::<Pose>(moving).unwrap().translation.x);
+    assert!(
+        (x - fixed).abs() < 1e-5,
+        "moved {x} m in {fixed} s ({t} s at 100 Hz)"
+    );
+}
+
+/// A force system placed in `PhysicsSet::Forces` of the plugin's schedule (the avian habit) runs
+/// before the step, once per step.
+#[test]
+fn a_force_system_in_the_forces_set_is_applied() {
+    let mut app = App::new();
+    app.add_plugins(TumblePlugin::new(Tick))
+        .add_systems(Tick, push.in_set(PhysicsSet::Forces));
+    let body = app
+        .world_mut()
+        .spawn((RigidBody, ForceAccumulator::default()))
+        .id();
+    app.world_mut().run_schedule(Tick);
+    let v = app.world().get::<Velocity>(body).unwrap().linear;
+    assert_eq!(v, Vec3::X / 64.0, "one kick of F Δt / m");
+}
+
+/// Without a fixed clock (a schedule of the game's own) the step is the settings' time step.
+#[test]
+fn a_schedule_of_the_game_steps_by_the_settings() {
+    let settings = PhysicsSettings::new(0.1, Integrator::Splitting).unwrap();
+    let mut app = App::new();
+    app.add_plugins((TimePlugin, TumblePlugin::new(Tick).with_settings(settings)));
+    let body = app
+        .world_mut()
+        .spawn((RigidBody, Velocity::linear(Vec3::X)))
+        .id();
+    app.world_mut().run_schedule(Tick);
+    let x = app.world().get::<Pose>(body).unwrap().translation.x;
+    assert!((x - 0.1).abs() < 1e-6, "{x}");
+    assert!(!TumblePlugin::new(Tick).on_fixed_clock());
+    assert!(TumblePlugin::new(FixedUpdate).on_fixed_clock());
 }

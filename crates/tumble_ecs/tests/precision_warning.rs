@@ -15,7 +15,7 @@ fn moving_body_at(distance: Real) -> (World, Entity) {
     let body = world
         .spawn((
             RigidBody,
-            Transform::from_translation(Vec3::new(distance, 0.0, 0.0)),
+            Pose::from_translation(Vec3::new(distance, 0.0, 0.0)),
             Velocity::linear(Vec3::new(1.0, 0.0, 0.0)),
         ))
         .id();
@@ -30,13 +30,12 @@ fn warned(world: &mut World) -> bool {
 
 /// Relative error of the distance travelled in `STEPS` steps at 1 m/s.
 fn measured_error(world: &mut World, body: Entity, distance: Real) -> f64 {
-    let plan = PhysicsPlan::for_world(world);
-    let mut schedule = plan.build_schedule();
+    let mut physics = PhysicsRunner::new(world);
     for _ in 0..STEPS {
-        plan.run_step(&mut schedule, world);
+        physics.step(world);
         world.clear_trackers();
     }
-    let x = world.get::<Transform>(body).unwrap().translation.x.widen();
+    let x = world.get::<Pose>(body).unwrap().translation.x.widen();
     let travelled = x - distance.widen();
     let exact = STEPS as f64 * DT.widen();
     (travelled / exact - 1.0).abs()

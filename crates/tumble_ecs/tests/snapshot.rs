@@ -1,7 +1,7 @@
 //! Save a world, load it elsewhere, resume: bit-identical to running straight through.
 
 use bevy_ecs::prelude::*;
-use tumble_core::math::{Quat, Vec3, Widen};
+use tumble_core::math::{Quat, Real, Vec3, Widen};
 
 use tumble_core::{Integrator, Mass, MassProperties};
 use tumble_ecs::prelude::*;
@@ -23,7 +23,7 @@ fn scene(integrator: Integrator) -> World {
         .unwrap()
         .with_center_of_mass(Vec3::new(0.05, 0.0, -0.02))
         .unwrap();
-        let pose = Transform::new(Vec3::new(f, 1.0, 0.0), Quat::from_rotation_z(0.2 * f));
+        let pose = Pose::new(Vec3::new(f, 1.0, 0.0), Quat::from_rotation_z(0.2 * f));
         let velocity = Velocity::new(
             Vec3::new(0.0, 0.5, 0.1 * f),
             Vec3::new(1.0, 3.0 - 0.2 * f, 0.3),
@@ -70,7 +70,7 @@ fn run(world: &mut World, physics: &mut PhysicsRunner, steps: usize) {
 /// Every body's state as bits, sorted (entity ids and archetype order differ between a world
 /// and its restored copy; the set of body states must not).
 fn bits(world: &mut World) -> Vec<Vec<u64>> {
-    let mut q = world.query_filtered::<(&Transform, &Velocity), With<RigidBody>>();
+    let mut q = world.query_filtered::<(&Pose, &Velocity), With<RigidBody>>();
     let mut bodies: Vec<Vec<u64>> = q
         .iter(world)
         .map(|(t, v)| {

@@ -79,9 +79,11 @@ fn run(build: impl Fn(&mut World), steps: usize) -> (f64, f64, String) {
         last = (e - e0) / e0;
         worst = worst.max(last.abs());
     }
-    let errors = world.get_resource::<PhysicsErrors>().map(|e| e.0.clone());
+    let errors = world
+        .get_resource::<PhysicsErrors>()
+        .map(|e| e.bodies.clone());
     assert!(errors.as_ref().is_none_or(Vec::is_empty), "{errors:?}");
-    for t in world.query::<&Transform>().iter(&world) {
+    for t in world.query::<&Pose>().iter(&world) {
         assert!((t.rotation.length() - 1.0).abs() < 1e-5);
     }
     (worst, last, physics.plan().to_string())
@@ -222,7 +224,7 @@ fn a_stiff_cloth_falls_without_making_energy() {
                     .spawn((
                         RigidBody,
                         MassProps(mass),
-                        Transform::from_translation(Vec3::new(
+                        Pose::from_translation(Vec3::new(
                             i as Real * spacing,
                             0.0,
                             j as Real * spacing,
@@ -252,7 +254,7 @@ fn a_stiff_cloth_falls_without_making_energy() {
     let total = |world: &mut World| {
         let g = world.resource::<Gravity>().0;
         let potential: f64 = world
-            .query::<(&Transform, &MassProps)>()
+            .query::<(&Pose, &MassProps)>()
             .iter(world)
             .map(|(t, mp)| -to_f64(mp.mass()) * to_f64(g.dot(t.translation)))
             .sum();
@@ -268,7 +270,7 @@ fn a_stiff_cloth_falls_without_making_energy() {
         // Round-off: the f32 state rounds positions by ε|x| per step; the springs' energy moves
         // by k |stretch| ε |x| for each, far below 1e-6 J here.
         assert!(e <= e0 + 1e-6, "energy grew: {e} > {e0}");
-        for t in world.query::<&Transform>().iter(&world) {
+        for t in world.query::<&Pose>().iter(&world) {
             assert!(t.translation.is_finite());
             lowest = lowest.min(t.translation.y);
         }

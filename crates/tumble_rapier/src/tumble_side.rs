@@ -5,14 +5,13 @@ use tumble_core::math::Vec3;
 use tumble_core::{BodyState, Integrator};
 use tumble_ecs::components::{body_state, write_body_state};
 use tumble_ecs::prelude::*;
-use tumble_ecs::schedule::PlannedStep;
 
 use crate::scene::{ComparisonScene, ComparisonSpringEnd, Load};
 
 /// A tumble world holding the bodies of a [`ComparisonScene`] and its planned schedule.
 pub struct TumbleScene {
     world: World,
-    physics: PlannedStep,
+    physics: PhysicsRunner,
     entities: Vec<Entity>,
 }
 
@@ -50,7 +49,7 @@ impl TumbleScene {
         let mut entities = Vec::with_capacity(scene.bodies.len());
         for body in &scene.bodies {
             let mass = MassProps(body.mass);
-            let (mut transform, mut velocity) = (Transform::IDENTITY, Velocity::ZERO);
+            let (mut transform, mut velocity) = (Pose::IDENTITY, Velocity::ZERO);
             write_body_state(&body.state, &mass, &mut transform, &mut velocity);
             let mut e = world.spawn((RigidBody, mass, transform, velocity));
             if body.gravity_scale != 1.0 {
@@ -96,7 +95,7 @@ impl TumbleScene {
                 rest_length: spring.rest_length,
             });
         }
-        let physics = PlannedStep::for_world(&mut world);
+        let physics = PhysicsRunner::new(&mut world);
         Self {
             world,
             physics,
@@ -104,27 +103,28 @@ impl TumbleScene {
         }
     }
 
-    /// Plans the world again (after a change of its settings or resources) and rebuilds the
-    /// schedule.
-    pub fn replan(&mut self) {
-        self.physics = PlannedStep::for_world(&mut self.world);
-    }
-
     /// The world, to add resources (e.g. a threading policy) or read components.
     pub fn world_mut(&mut self) -> &mut World {
         &mut self.world
     }
 
+    /// Only what a step does before running its plan (the runner's check of the world, see
+    /// [`PhysicsRunner::prepare`]): to time the check alone.
+    pub fn prepare_step(&mut self) {
+        self.physics.prepare(&mut self.world);
+    }
+
     /// Advances tumble by one step.
     pub fn step(&mut self) {
         self.physics.step(&mut self.world);
+        self.world.clear_trackers();
     }
 
     /// The state of body `i` (position = centre of mass).
     pub fn state(&self, i: usize) -> BodyState {
         let e = self.entities[i];
         let (Some(t), Some(v), Some(m)) = (
-            self.world.get::<Transform>(e),
+            self.world.get::<Pose>(e),
             self.world.get::<Velocity>(e),
             self.world.get::<MassProps>(e),
         ) else {

@@ -109,7 +109,7 @@ pub fn spawn(world: &mut World) -> [Entity; 3] {
                 .spawn((
                     RigidBody,
                     MassProps(mass),
-                    Transform {
+                    Pose {
                         translation: x,
                         rotation: q,
                     },
@@ -248,7 +248,7 @@ pub fn reference(horizon: f64, steps: usize) -> [Ref; 3] {
 pub fn error(world: &World, bodies: &[Entity; 3], exact: &[Ref; 3]) -> (f64, f64) {
     let mut worst = (0.0_f64, 0.0_f64);
     for (&e, r) in bodies.iter().zip(exact) {
-        let t = world.get::<Transform>(e).expect("a body of the scene");
+        let t = world.get::<Pose>(e).expect("a body of the scene");
         let q = r.q.normalize();
         let position = (t.translation.widen() - r.x).length();
         let orientation = angle_between(
@@ -294,7 +294,7 @@ pub fn measure(
     let (w, bodies) = last.expect("at least one repetition");
     let rejected = w
         .get_resource::<PhysicsErrors>()
-        .is_some_and(|e| !e.0.is_empty());
+        .is_some_and(|e| !e.is_empty());
     let (position, orientation) = error(&w, &bodies, exact);
     Point {
         scene: NAME.to_owned(),

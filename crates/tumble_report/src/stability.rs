@@ -91,15 +91,14 @@ fn run(
     };
     let floor = gravity_floor(world);
     let e0 = total_energy(world, floor);
-    let plan = PhysicsPlan::for_world(world);
-    let mut schedule = plan.build_schedule();
+    let mut physics = PhysicsRunner::new(world);
     let mut max_q = 0.0_f64;
     let mut finite = true;
     let mut range = [1.0_f64, 1.0];
     for _ in 0..steps {
-        plan.run_step(&mut schedule, world);
+        physics.step(world);
         world.clear_trackers();
-        let mut q = world.query::<(&Transform, Option<&Rejected>)>();
+        let mut q = world.query::<(&Pose, Option<&Rejected>)>();
         for (t, rejected) in q.iter(world) {
             max_q = max_q.max(to_f64((t.rotation.length() - 1.0).abs()));
             finite &= rejected.is_none() && t.translation.is_finite();
@@ -129,7 +128,7 @@ fn run(
 fn total_energy(world: &mut World, floor: f64) -> f64 {
     let g = world.get_resource::<Gravity>().map_or(Vec3::ZERO, |g| g.0);
     let gravity: f64 = world
-        .query_filtered::<(&Transform, &MassProps), With<RigidBody>>()
+        .query_filtered::<(&Pose, &MassProps), With<RigidBody>>()
         .iter(world)
         .map(|(t, m)| {
             let height = -to_f64(g.dot(t.center_of_mass(m)));
@@ -148,7 +147,7 @@ fn gravity_floor(world: &mut World) -> f64 {
     };
     let down = g.normalize_or_zero();
     world
-        .query_filtered::<(&Transform, &MassProps), With<RigidBody>>()
+        .query_filtered::<(&Pose, &MassProps), With<RigidBody>>()
         .iter(world)
         .map(|(t, m)| -to_f64(down.dot(t.center_of_mass(m))))
         .fold(f64::INFINITY, f64::min)
@@ -157,14 +156,14 @@ fn gravity_floor(world: &mut World) -> f64 {
 
 /// Kinetic energy of every body plus the potential `½ k (|d| − L₀)²` of every spring (J).
 fn elastic_and_kinetic(world: &mut World) -> f64 {
-    let mut q = world.query_filtered::<(&Transform, &Velocity, &MassProps), With<RigidBody>>();
+    let mut q = world.query_filtered::<(&Pose, &Velocity, &MassProps), With<RigidBody>>();
     let kinetic: f64 = q
         .iter(world)
         .map(|(t, v, m)| to_f64(kinetic_energy(&body_state(t, v, m), m)))
         .sum();
     let springs: Vec<Spring> = world.query::<&Spring>().iter(world).copied().collect();
-    let mut poses = world.query::<&Transform>();
-    let point = |poses: &mut QueryState<&Transform>, world: &World, e: Entity, p: Vec3| {
+    let mut poses = world.query::<&Pose>();
+    let point = |poses: &mut QueryState<&Pose>, world: &World, e: Entity, p: Vec3| {
         poses
             .get(world, e)
             .map(|t| t.transform_point(p))
@@ -261,7 +260,7 @@ fn stiff_spring(
     let (dt, m) = (1.0 / 60.0 as Real, 1.0 as Real);
     let mut w = springs_world(dt, integrator, springs);
     let body = w
-        .spawn((RigidBody, sphere(m), Transform::from_translation(Vec3::X)))
+        .spawn((RigidBody, sphere(m), Pose::from_translation(Vec3::X)))
         .id();
     let k = m * (omega_dt / dt).powi(2);
     w.spawn(Spring::new(
@@ -290,7 +289,7 @@ fn mass_ratio(integrator: Integrator, dt: Real, steps: usize) -> Cell {
             sphere(1.0),
             // Stretched by half the rest length: the spring never passes through zero length,
             // where the force of `½k(|d| − L₀)²` flips direction.
-            Transform::from_translation(Vec3::new(1.5, 0.0, 0.0)),
+            Pose::from_translation(Vec3::new(1.5, 0.0, 0.0)),
         ))
         .id();
     let k = (1.0 / dt).powi(2);
@@ -313,7 +312,7 @@ fn far_away(integrator: Integrator, dt: Real, steps: usize) -> Cell {
     w.spawn((
         RigidBody,
         MassProps(mass),
-        Transform {
+        Pose {
             translation: Vec3::splat(1e5),
             rotation: Quat::from_rotation_x(0.4),
         },
@@ -420,7 +419,7 @@ fn cloth(springs: SpringSolver, omega_dt: Real, steps: usize) -> Cell {
             w.spawn((
                 RigidBody,
                 MassProps(mass),
-                Transform::from_translation(Vec3::new(i * spacing, 0.0, j * spacing)),
+                Pose::from_translation(Vec3::new(i * spacing, 0.0, j * spacing)),
             ))
             .id()
         })

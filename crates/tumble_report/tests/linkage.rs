@@ -20,7 +20,7 @@ fn total_error(integrator: Integrator, steps: u32, exact: &[Ref; 3]) -> f64 {
     }
     assert!(
         w.get_resource::<PhysicsErrors>()
-            .is_none_or(|e| e.0.is_empty())
+            .is_none_or(|e| e.is_empty())
     );
     let (position, orientation) = error(&w, &bodies, exact);
     position + orientation
@@ -64,7 +64,7 @@ fn bits(world: &World, bodies: &[Entity]) -> Vec<u64> {
     bodies
         .iter()
         .flat_map(|&e| {
-            let t = world.get::<Transform>(e).unwrap();
+            let t = world.get::<Pose>(e).unwrap();
             let v = world.get::<Velocity>(e).unwrap();
             [t.translation, v.linear, v.angular]
                 .into_iter()
@@ -91,14 +91,9 @@ fn the_composition_is_time_reversible_with_conservative_forces() {
     for e in loads {
         w.despawn(e);
     }
-    let before: Vec<(Transform, Velocity)> = bodies
+    let before: Vec<(Pose, Velocity)> = bodies
         .iter()
-        .map(|&e| {
-            (
-                *w.get::<Transform>(e).unwrap(),
-                *w.get::<Velocity>(e).unwrap(),
-            )
-        })
+        .map(|&e| (*w.get::<Pose>(e).unwrap(), *w.get::<Velocity>(e).unwrap()))
         .collect();
     let mut physics = PhysicsRunner::new(&mut w);
     let mut run = |w: &mut World| {
@@ -115,8 +110,7 @@ fn the_composition_is_time_reversible_with_conservative_forces() {
         }
     };
     run(&mut w);
-    let moved =
-        (w.get::<Transform>(bodies[2]).unwrap().translation - before[2].0.translation).length();
+    let moved = (w.get::<Pose>(bodies[2]).unwrap().translation - before[2].0.translation).length();
     assert!(moved > 0.1, "the bodies moved: {moved}");
     flip(&mut w);
     run(&mut w);
@@ -124,7 +118,7 @@ fn the_composition_is_time_reversible_with_conservative_forces() {
     // Round-off: a few ulps per stage, growing at most linearly over the 3 × 400 stages.
     let tolerance = to_f64(Real::EPSILON) * 3.0 * 400.0 * 20.0;
     for (&e, (t0, v0)) in bodies.iter().zip(&before) {
-        let t = w.get::<Transform>(e).unwrap();
+        let t = w.get::<Pose>(e).unwrap();
         let v = w.get::<Velocity>(e).unwrap();
         let dx = to_f64((t.translation - t0.translation).length());
         let dq = tumble_core::rotation::angle_between(t.rotation, t0.rotation);
@@ -171,7 +165,7 @@ fn substeps_are_steps_of_the_substep_bit_for_bit() {
                             )
                             .unwrap(),
                         ),
-                        Transform::from_translation(Vec3::new(5.0 + i as Real, 0.0, 0.0)),
+                        Pose::from_translation(Vec3::new(5.0 + i as Real, 0.0, 0.0)),
                         Velocity {
                             linear: Vec3::new(0.0, i as Real, 0.0),
                             angular: Vec3::new(0.3, -0.2, i as Real),
@@ -223,7 +217,7 @@ fn substeps_are_steps_of_the_substep_bit_for_bit() {
         assert_eq!(bits(&sub, &bodies), bits(&fine, &bodies), "{integrator}");
         assert!(
             sub.get_resource::<PhysicsErrors>()
-                .is_none_or(|e| e.0.is_empty())
+                .is_none_or(|e| e.is_empty())
         );
     }
 }

@@ -2,7 +2,7 @@
 
 use std::collections::HashMap;
 use std::num::NonZeroU32;
-use tumble_core::math::{Quat, REAL_NAME, Real, Vec3};
+use tumble_core::math::{Quat, REAL_NAME, Real, Vec3, quat_normalize};
 
 use bevy_ecs::prelude::*;
 
@@ -10,7 +10,6 @@ use tumble_core::shapes::parry::shape::{Ball, Capsule, Cone, Cuboid, Cylinder};
 use tumble_core::shapes::{HullError, convex_hull_mass_properties, mass_properties_of};
 use tumble_core::{Density, Integrator, Mass, MassProperties};
 use tumble_ecs::prelude::*;
-use tumble_ecs::schedule::PlannedStep;
 
 use crate::error::{SaveError, SceneError};
 use crate::format::{BodyDef, ForceDef, SceneFile, ShapeDef, WorldDef};
@@ -54,7 +53,7 @@ pub struct SceneBody {
 #[derive(Debug, Clone, PartialEq)]
 struct ValidBody {
     mass: MassProperties,
-    transform: Transform,
+    transform: Pose,
     velocity: Velocity,
     gravity_scale: Real,
     damping: Damping,
@@ -104,9 +103,9 @@ pub enum SceneForce {
 pub struct BuiltScene {
     /// The world.
     pub world: World,
-    /// The plan of the systems the scene needs and their schedule (step with
+    /// The step of the world, planned from it and re-planned when it changes (step with
     /// [`step`](Self::step)).
-    pub physics: PlannedStep,
+    pub physics: PhysicsRunner,
     /// `(name, entity)` of every body, in file order.
     pub bodies: Vec<(String, Entity)>,
 }
@@ -405,7 +404,7 @@ impl Scene {
                 }
             }
         }
-        let physics = PlannedStep::for_world(&mut world);
+        let physics = PhysicsRunner::new(&mut world);
         BuiltScene {
             world,
             physics,
@@ -439,15 +438,11 @@ fn spawn_body(world: &mut World, b: &ValidBody) -> Entity {
 }
 
 impl BuiltScene {
-    /// Advances the world by one step (the schedule once per stage) and clears its change
-    /// trackers.
+    /// Advances the world by one step (the schedule once per stage, re-planned first if the
+    /// world changed) and clears its change trackers.
     pub fn step(&mut self) {
         self.physics.step(&mut self.world);
-    }
-
-    /// Plans the world again (after a change of its resources) and rebuilds the schedule.
-    pub fn replan(&mut self) {
-        self.physics = PlannedStep::for_world(&mut self.world);
+        self.world.clear_trackers();
     }
 }
 
@@ -681,7 +676,7 @@ fn validate_body(ck: &Checker<'_>, i: usize, b: &BodyDef) -> Result<ValidBody, S
     }
     let angular_energy = 0.5
         * mass
-            .world_inertia_mul(rotation.normalize(), angular)
+            .world_inertia_mul(quat_normalize(rotation), angular)
             .dot(angular);
     if !angular_energy.is_finite() {
         return Err(overflow("angular_velocity", "½ωᵀIω", angular_energy));
@@ -711,9 +706,11 @@ fn validate_body(ck: &Checker<'_>, i: usize, b: &BodyDef) -> Result<ValidBody, S
     }
     Ok(ValidBody {
         mass,
-        transform: Transform {
+        transform: Pose {
             translation: position,
-            rotation: rotation.normalize(),
+            // The engine's own normalization (in f64, rounded once), not glam's, whose SIMD and
+            // scalar builds round differently: the same file gives the same bits in every build.
+            rotation: quat_normalize(rotation),
         },
         velocity: Velocity { linear, angular },
         gravity_scale,

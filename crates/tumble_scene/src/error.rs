@@ -63,5 +63,15 @@ fn one_line(text: String, max: usize) -> String {
 
 /// A scene model that could not be written as TOML.
 #[derive(Debug, Error)]
-#[error("the scene cannot be written as TOML: {0}")]
-pub struct SaveError(#[from] toml::ser::Error);
+pub enum SaveError {
+    /// The serializer refused the model.
+    #[error("the scene cannot be written as TOML: {0}")]
+    Serialize(#[from] toml::ser::Error),
+    /// The text written does not read back as the same model: a value TOML cannot hold (its
+    /// integers are 64-bit signed, so e.g. `steps` above 9223372036854775807), or a float
+    /// that does not survive the round trip.
+    #[error(
+        "the scene cannot be written as TOML: the text would not read back as the same scene ({0})"
+    )]
+    NotReadable(String),
+}

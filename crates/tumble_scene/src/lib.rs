@@ -40,11 +40,27 @@ pub const MAX_SCENE_BYTES: u64 = 64 * 1024 * 1024;
 /// scene (about 300 bytes a body), not the text: room for ten million bodies.
 pub const MAX_JSON_SCENE_BYTES: u64 = 4 << 30;
 
-/// Serializes a scene model to TOML (loading the text gives the same model back).
+/// Serializes a scene model to TOML; loading the text gives the same model back, or this is an
+/// error ([`SaveError::NotReadable`]): the text is read back and compared before it is
+/// returned, so no text is handed out that a reader would refuse or read differently.
 ///
 /// The model is not validated here: parse the text with [`Scene::parse`] to check it.
 pub fn to_toml_string(model: &SceneFile) -> Result<String, SaveError> {
-    Ok(toml::to_string(model)?)
+    let text = toml::to_string(model)?;
+    // As any TOML reader holds it (integers are signed 64-bit), then as the model.
+    let read =
+        toml::from_str::<toml::Table>(&text).and_then(|_| toml::from_str::<SceneFile>(&text));
+    match read {
+        // Compared as text, so that a NaN (which the model may hold: it is checked only when
+        // parsed) reads back as itself.
+        Ok(back) if toml::to_string(&back).is_ok_and(|again| again == text) => Ok(text),
+        Ok(_) => Err(SaveError::NotReadable(
+            "it reads back with different values".to_owned(),
+        )),
+        Err(e) => Err(SaveError::NotReadable(
+            text::terminal_safe(e.message()).into_owned(),
+        )),
+    }
 }
 
 /// Loads and validates a scene file: JSON when its name ends in `.json`, read as a stream of at

@@ -12,7 +12,11 @@
 //! - a directory, a device (`/dev/null`), a FIFO or a socket is refused: replacing it by a
 //!   regular file would destroy it;
 //! - a symbolic link is resolved (up to 40 links), and its final target must be a regular file
-//!   or absent: the target is replaced (or created), the link stays;
+//!   or absent: the target is replaced (or created), the link stays. A link in a shared sticky
+//!   directory (world-writable with the sticky bit, as `/tmp`) is followed only if it belongs to
+//!   the user running tumble or to the directory's owner — the kernel's `protected_symlinks`
+//!   rule, which cannot apply here since tumble reads the link itself: otherwise another user
+//!   could plant a link there and make a run (as root, say) replace any file;
 //! - an existing file without write permission is refused, as a shell redirect would refuse it
 //!   (also for root, who could write it: read-only is taken as the owner's intent);
 //! - an existing file keeps its permission bits (and its owner and group where the process may
@@ -82,6 +86,22 @@ pub enum OutputError {
         /// The path the caller gave.
         path: PathBuf,
     },
+    /// A symbolic link on the way that another user planted in a shared sticky directory.
+    #[error(
+        "{}: the symbolic link {} belongs to another user (uid {owner}) in a shared sticky \
+         directory; tumble does not follow it, as the kernel's protected_symlinks rule would \
+         not: remove it or write elsewhere",
+        path_for_terminal(.path),
+        path_for_terminal(.link)
+    )]
+    UntrustedLink {
+        /// The path the caller gave.
+        path: PathBuf,
+        /// The link refused.
+        link: PathBuf,
+        /// The link's owner.
+        owner: u32,
+    },
     /// The output path is empty.
     #[error("the output path is empty")]
     EmptyPath,
@@ -113,6 +133,7 @@ impl OutputError {
             | Self::ReadOnly { path }
             | Self::IsInput { path, .. }
             | Self::SymlinkLoop { path }
+            | Self::UntrustedLink { path, .. }
             | Self::Io { path, .. } => path,
             Self::EmptyPath => Path::new(""),
         }
@@ -275,6 +296,8 @@ fn resolve_links(path: &Path) -> Result<PathBuf, OutputError> {
     for _ in 0..=MAX_SYMLINKS {
         match std::fs::symlink_metadata(&current) {
             Ok(meta) if meta.file_type().is_symlink() => {
+                #[cfg(unix)]
+                check_link_is_trusted(path, &current, &meta)?;
                 let link = std::fs::read_link(&current).map_err(|e| OutputError::io(path, e))?;
                 current = match current.parent() {
                     Some(parent) if link.is_relative() => parent.join(link),
@@ -289,6 +312,34 @@ fn resolve_links(path: &Path) -> Result<PathBuf, OutputError> {
     Err(OutputError::SymlinkLoop {
         path: path.to_owned(),
     })
+}
+
+/// The kernel's `protected_symlinks` rule for a link tumble is about to follow: in a directory
+/// that is world-writable and sticky, only a link owned by the follower (the effective user) or
+/// by the directory's owner is followed.
+#[cfg(unix)]
+fn check_link_is_trusted(
+    path: &Path,
+    link: &Path,
+    link_meta: &Metadata,
+) -> Result<(), OutputError> {
+    use std::os::unix::fs::MetadataExt;
+    let dir = match link.parent() {
+        Some(dir) if !dir.as_os_str().is_empty() => dir,
+        _ => Path::new("."),
+    };
+    let dir_meta = std::fs::metadata(dir).map_err(|e| OutputError::io(path, e))?;
+    let shared_sticky = dir_meta.mode() & 0o1000 != 0 && dir_meta.mode() & 0o002 != 0;
+    let follower = rustix::process::geteuid().as_raw();
+    let owner = link_meta.uid();
+    if shared_sticky && owner != follower && owner != dir_meta.uid() {
+        return Err(OutputError::UntrustedLink {
+            path: path.to_owned(),
+            link: link.to_owned(),
+            owner,
+        });
+    }
+    Ok(())
 }
 
 fn metadata_if_exists(path: &Path, target: &Path) -> Result<Option<Metadata>, OutputError> {

@@ -35,6 +35,17 @@ pub enum TrajectoryError {
     /// with (a [`BuiltScene`] from [`Scene::build`](crate::Scene::build) always has one).
     #[error("the world has no PhysicsSettings resource (no time step)")]
     NoSettings,
+    /// [`Recording::bodies`] names a body the scene does not have.
+    #[error("recording body index {index}, but the scene has {bodies} bodies (0..{bodies})")]
+    NoSuchBody {
+        /// The index asked for.
+        index: usize,
+        /// How many bodies the scene has.
+        bodies: usize,
+    },
+    /// [`Recording::bodies`] names a body twice (its rows would be written twice).
+    #[error("recording body index {0} twice")]
+    DuplicateBody(usize),
 }
 
 /// Which rows a trajectory holds: every `every`-th step (step 0 always), and all bodies or
@@ -80,7 +91,7 @@ impl TrajectoryStats {
 /// [`CSV_HEADER`] line, then one row per recorded body for step 0 and for every
 /// `record.every`-th step.
 ///
-/// - `px..pz` is `Transform::translation`, `q*` the rotation (glam order), `v*` the linear and
+/// - `px..pz` is `Pose::translation`, `q*` the rotation (glam order), `v*` the linear and
 ///   `w*` the world-frame angular velocity; `time` is `step × dt`, with `dt` read from the
 ///   world's [`PhysicsSettings`] when the call starts (so it cannot disagree with the step the
 ///   schedule takes, nor be NaN).
@@ -120,11 +131,23 @@ pub fn write_trajectory(
             .iter()
             .map(|(name, e)| (*e, csv_text_cell(name).into_owned()))
             .collect(),
-        Some(indices) => indices
-            .iter()
-            .filter_map(|&i| scene.bodies.get(i))
-            .map(|(name, e)| (*e, csv_text_cell(name).into_owned()))
-            .collect(),
+        Some(indices) => {
+            let mut seen = vec![false; scene.bodies.len()];
+            let mut recorded = Vec::with_capacity(indices.len());
+            for &index in indices {
+                let Some((name, e)) = scene.bodies.get(index) else {
+                    return Err(TrajectoryError::NoSuchBody {
+                        index,
+                        bodies: scene.bodies.len(),
+                    });
+                };
+                if std::mem::replace(&mut seen[index], true) {
+                    return Err(TrajectoryError::DuplicateBody(index));
+                }
+                recorded.push((*e, csv_text_cell(name).into_owned()));
+            }
+            recorded
+        }
     };
     let mut stats = TrajectoryStats {
         rows: 0,
@@ -220,7 +243,7 @@ fn write_rows(
         if body.contains::<Rejected>() {
             continue;
         }
-        let (Some(t), Some(v)) = (body.get::<Transform>(), body.get::<Velocity>()) else {
+        let (Some(t), Some(v)) = (body.get::<Pose>(), body.get::<Velocity>()) else {
             continue;
         };
         let q = t.rotation;
@@ -296,6 +319,35 @@ mod tests {
         })
         .unwrap_err();
         assert!(matches!(err, TrajectoryError::NoSettings), "{err}");
+    }
+
+    /// An index past the end or named twice is an error before anything is written (it was
+    /// a header-only file, or duplicate rows).
+    #[test]
+    fn a_selection_of_missing_or_repeated_bodies_is_refused() {
+        for (bodies, expected) in [
+            (
+                vec![0, 3],
+                TrajectoryError::NoSuchBody {
+                    index: 3,
+                    bodies: 3,
+                },
+            ),
+            (vec![1, 0, 1], TrajectoryError::DuplicateBody(1)),
+        ] {
+            let mut built = chain();
+            let mut out = Vec::new();
+            let record = Recording {
+                every: NonZeroU64::MIN,
+                bodies: Some(bodies),
+            };
+            let err = write_trajectory(&mut built, 2, &record, &mut out, |_, _| {
+                ControlFlow::Continue(())
+            })
+            .unwrap_err();
+            assert_eq!(err.to_string(), expected.to_string());
+            assert!(out.is_empty(), "nothing written: {out:?}");
+        }
     }
 
     #[test]

@@ -13,11 +13,9 @@ fn plan_of(name: &str) -> (String, usize) {
         .join(format!("{name}.toml"));
     let mut built = load_scene(&path).unwrap().build();
     let world: &mut World = &mut built.world;
-    built.physics.schedule.initialize(world).unwrap();
-    (
-        PhysicsPlan::for_world(world).to_string(),
-        built.physics.schedule.systems_len(),
-    )
+    assert_eq!(&PhysicsPlan::for_world(world), built.physics.plan());
+    let plan = built.physics.plan();
+    (plan.to_string(), plan.stages().len())
 }
 
 #[test]

@@ -285,3 +285,67 @@ fn scene_accessors_and_body_states() {
     assert_eq!(bodies[0].linear_damping, 0.5);
     assert_eq!(bodies[0].gravity_scale, 1.0);
 }
+
+/// A model TOML cannot hold (its integers are signed 64-bit) is an error, not a text no reader
+/// accepts; a NaN the model holds (models are checked only when parsed) still reads back.
+#[test]
+fn a_model_toml_cannot_hold_is_an_error() {
+    let path = scenes_dir().join("projectile.toml");
+    let scene = load_scene(&path).unwrap();
+    let mut model = scene.file().clone();
+    model.world.steps = u64::MAX;
+    let err = tumble_scene::to_toml_string(&model).unwrap_err();
+    assert!(
+        matches!(err, tumble_scene::SaveError::NotReadable(_)),
+        "{err}"
+    );
+    assert!(err.to_string().contains("would not read back"), "{err}");
+    model.world.steps = i64::MAX as u64;
+    assert!(tumble_scene::to_toml_string(&model).is_ok());
+    model.world.dt = f64::NAN;
+    let text = tumble_scene::to_toml_string(&model).unwrap();
+    assert!(text.contains("nan"), "{text}");
+}
+
+/// A rotation read from a file is normalized by the engine's own arithmetic (f64, one
+/// rounding), not by glam's `Quat::normalize`, whose SIMD and scalar (`enhanced-determinism`)
+/// builds round differently: the same file gives the same bits in every build. Quaternions a
+/// little off unit length, as files written with a few digits hold them.
+#[test]
+fn file_rotations_are_normalized_by_the_engine() {
+    use tumble_core::math::{Quat, Real, quat_normalize};
+    use tumble_ecs::prelude::Pose;
+
+    let mut seed = 0x2545_f491_4f6c_dd1d_u64;
+    let mut next = || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+    };
+    let mut text = String::from("name = \"rotations\"\n[world]\ndt = 0.01\nsteps = 1\n");
+    let mut given = Vec::new();
+    for i in 0..500 {
+        let q = [next(), next(), next(), next()];
+        let norm = q.iter().map(|x| x * x).sum::<f64>().sqrt();
+        // Within the accepted tolerance of unit length, by up to ~3e-7.
+        let off = 1.0 + 3e-7 * next();
+        let q = q.map(|x| x / norm * off);
+        text.push_str(&format!(
+            "[[bodies]]\nname = \"b{i}\"\nmass = 1.0\ninertia = [1.0, 2.0, 3.0]\n\
+             rotation = [{}, {}, {}, {}]\n",
+            q[0], q[1], q[2], q[3]
+        ));
+        given.push(Quat::from_array(q.map(|x| x as Real)));
+    }
+    let built = Scene::parse("rotations.toml", &text).unwrap().build();
+    for ((name, entity), q) in built.bodies.iter().zip(&given) {
+        let pose = built.world.get::<Pose>(*entity).unwrap();
+        let expected = quat_normalize(*q);
+        assert_eq!(
+            pose.rotation.to_array().map(Real::to_bits),
+            expected.to_array().map(Real::to_bits),
+            "{name}"
+        );
+    }
+}

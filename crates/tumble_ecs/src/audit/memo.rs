@@ -12,7 +12,7 @@ use bevy_ecs::entity::Entity;
 use tumble_core::math::Real;
 
 use super::{Link, same_end};
-use crate::components::{MassProps, Transform, Velocity, kinetic_energy_f64};
+use crate::components::{MassProps, Pose, Velocity, kinetic_energy_f64};
 
 /// The bits of `values`: equal bits are equal inputs to the energy functions (`==` on floats
 /// would call `−0` and `+0` equal and a NaN unequal to itself).
@@ -25,7 +25,7 @@ fn same_bits<const N: usize>(a: [Real; N], b: [Real; N]) -> bool {
 /// mass, principal moments and frame) and of its springs' anchors (translation, rotation).
 /// The inverse mass stands for the mass: one decides the other.
 #[inline(always)]
-fn body_inputs(pose: &Transform, velocity: &Velocity, mass: &MassProps) -> [Real; 21] {
+fn body_inputs(pose: &Pose, velocity: &Velocity, mass: &MassProps) -> [Real; 21] {
     let (t, q, v, w) = (
         pose.translation,
         pose.rotation,
@@ -75,7 +75,7 @@ impl BodyMemo {
     pub(super) fn measure(
         pass: u64,
         entity: Entity,
-        pose: &Transform,
+        pose: &Pose,
         velocity: &Velocity,
         mass: &MassProps,
     ) -> Self {
@@ -98,7 +98,7 @@ impl BodyMemo {
     pub(super) fn still(
         &self,
         entity: Entity,
-        pose: &Transform,
+        pose: &Pose,
         velocity: &Velocity,
         mass: &MassProps,
     ) -> bool {

@@ -90,8 +90,8 @@ use bevy_ecs::prelude::*;
 use tumble_core::math::{Real, Vec3, Widen};
 
 use crate::components::{
-    ForceAccumulator, Gravity, GravityScale, Kinematic, MassProps, PhysicsSettings, RigidBody,
-    Static, Transform, Velocity, kinetic_energy_f64,
+    ForceAccumulator, Gravity, GravityScale, Kinematic, MassProps, PhysicsSettings, Pose,
+    RigidBody, Static, Velocity, kinetic_energy_f64,
 };
 use crate::forces::{Spring, SpringEnd};
 use crate::stages::StageCursor;
@@ -135,9 +135,9 @@ const ROUND_OFF_ULPS: f64 = 64.0;
 #[derive(Debug, Clone, Copy)]
 struct Audited {
     entity: Entity,
-    start: (Transform, Velocity),
+    start: (Pose, Velocity),
     /// Pose at the end of the step (for the springs' energy).
-    end: Transform,
+    end: Pose,
     /// Every load except the springs: force and torque (world frame).
     load: (Vec3, Vec3),
     /// Mass (kg), for the springs' reduced mass.
@@ -378,7 +378,7 @@ impl EnergyLedger {
     }
 
     /// World anchor of an end, from the pose `pose` gives an audited body.
-    fn anchor(&self, end: End, pose: impl Fn(&Audited) -> Transform) -> Option<Vec3> {
+    fn anchor(&self, end: End, pose: impl Fn(&Audited) -> Pose) -> Option<Vec3> {
         match end {
             End::Audited(i, local) => Some(pose(&self.bodies[i]).transform_point(local)),
             End::Fixed(p) => Some(p),
@@ -387,7 +387,7 @@ impl EnergyLedger {
     }
 
     /// Elastic energy of a link with the bodies at the poses `pose` gives.
-    fn elastic(&self, link: &Link, pose: impl Fn(&Audited) -> Transform + Copy) -> Option<f64> {
+    fn elastic(&self, link: &Link, pose: impl Fn(&Audited) -> Pose + Copy) -> Option<f64> {
         let pa = self.anchor(link.a, pose)?;
         let pb = self.anchor(link.b, pose)?;
         Some(link.spring.elastic_energy(pa, pb))
@@ -493,7 +493,7 @@ impl EnergyLedger {
     fn start_kinetic(
         &self,
         i: usize,
-        (entity, t, v, m): (Entity, &Transform, &Velocity, &MassProps),
+        (entity, t, v, m): (Entity, &Pose, &Velocity, &MassProps),
     ) -> (f64, bool) {
         match self.measured_bodies.get(i) {
             Some(Some(memo)) if memo.pass == self.end_passes && memo.still(entity, t, v, m) => {
@@ -547,7 +547,7 @@ impl EnergyLedger {
 type Ends<'w, 's> = Query<
     'w,
     's,
-    (&'static Transform, Has<Static>, Has<Kinematic>),
+    (&'static Pose, Has<Static>, Has<Kinematic>),
     (With<RigidBody>, Without<Rejected>),
 >;
 
@@ -591,17 +591,8 @@ fn same_end(a: End, b: End) -> bool {
 }
 
 /// The bodies the audit watches, as its start pass reads them.
-type AuditedBodies<'w, 's> = Query<
-    'w,
-    's,
-    (
-        Entity,
-        &'static Transform,
-        &'static Velocity,
-        &'static MassProps,
-    ),
-    Dynamic,
->;
+type AuditedBodies<'w, 's> =
+    Query<'w, 's, (Entity, &'static Pose, &'static Velocity, &'static MassProps), Dynamic>;
 
 /// Start of an audited step (first in the plan): remembers each dynamic body's state, resolves
 /// the springs' ends, forms the spring groups and measures each group's `T + V`.
@@ -709,7 +700,7 @@ pub fn audit_external_loads(
     bodies: Query<
         (
             Entity,
-            &Transform,
+            &Pose,
             &ForceAccumulator,
             Option<&crate::stiff::ImplicitBody>,
         ),
@@ -757,7 +748,7 @@ pub fn audit_energy(
     bodies: Query<
         (
             Entity,
-            &Transform,
+            &Pose,
             &Velocity,
             &MassProps,
             Option<&GravityScale>,

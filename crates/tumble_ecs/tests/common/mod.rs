@@ -50,7 +50,7 @@ pub fn unit_body(
         .spawn((
             RigidBody,
             MassProps(mass),
-            Transform {
+            Pose {
                 translation: position,
                 rotation,
             },
