@@ -27,10 +27,11 @@ use tumble_core::math::Vec3;
 use serde::{Deserialize, Serialize};
 use tumble_core::{Integrator, KernelPath};
 use tumble_ecs::parallel::{Parallelism, pool_threads};
-use tumble_scene::output::{OutputError, create_directory, write_atomically};
+use tumble_scene::output::{OutputError, OutputSet, print_to_stdout};
 use tumble_scene::text::path_for_terminal;
 
 use crate::engines::{Ecs, Engine, Rapier, RawLoop, RunnerCheck};
+use crate::machines::RunSummary;
 use crate::measure::{Effort, compare};
 
 /// What to measure and where to write it (the arguments of `tumble bench` and `tumble-bench`).
@@ -330,9 +331,7 @@ pub fn run_bench(options: &BenchOptions, mut progress: impl FnMut(&str)) -> Benc
         schema: 3,
         pool_threads: pool_threads(),
         kernel_path: tumble_core::kernel_path().to_string(),
-        widest_kernel_path: KernelPath::available()
-            .last()
-            .map_or("portable".to_owned(), |p| p.to_string()),
+        widest_kernel_path: widest_kernel_path(),
         cpu: cpu_name(),
         date: humantime::format_rfc3339_seconds(started).to_string(),
         bandwidth_gb_s: bandwidth,
@@ -408,55 +407,86 @@ fn runner_check(n: usize, effort: &Effort) -> RunnerCheckCost {
 
 /// Runs the benchmark, prints the table, and writes the files the options ask for.
 ///
-/// The output directory is checked before the measurements (an existing non-directory is an
-/// error naming it); every file is written through [`tumble_scene::output::OutputFile`]
-/// (temporary file, rename as the last step).
+/// Every destination is checked before the measurements (an output directory that is a file or
+/// takes no new file, a run kept there that cannot be read, a README without this run's
+/// markers: each an error naming it). The files are written as one
+/// [`OutputSet`](tumble_scene::output::OutputSet): all of them, the README too, are written
+/// before any old one is replaced.
 pub fn run_and_write(options: &BenchOptions) -> Result<(), Box<dyn std::error::Error>> {
-    if let Some(dir) = &options.out {
-        create_directory(dir)?;
+    // Each machine class and forced path keeps its own files and README section, so a run on
+    // one machine never overwrites another's; the targets of all of them are tabulated after.
+    let name = machines::run_name(
+        &tumble_core::kernel_path().to_string(),
+        &widest_kernel_path(),
+    );
+    let kept_runs = match &options.out {
+        Some(dir) => {
+            for file in [format!("{name}.md"), format!("{name}.json")] {
+                OutputSet::check(&dir.join(file))?;
+            }
+            OutputSet::check(&dir.join(format!("{}.md", machines::SUMMARY_NAME)))?;
+            machines::read_runs(dir)?
+        }
+        None => Vec::new(),
+    };
+    if let Some(readme) = &options.readme {
+        updated_readme(readme, &name, "", "")?;
+        OutputSet::check(readme)?;
     }
     let results = run_bench(options, |line| eprintln!("… {line}"));
     let table = output::markdown(&results);
-    println!("{table}");
-    // Each machine class and forced path keeps its own files and README section, so a run on
-    // one machine never overwrites another's; the targets of all of them are tabulated after.
-    let name = machines::run_name(&results.kernel_path, &results.widest_kernel_path);
-    // Without an output directory there are no kept runs: the summary holds this one.
-    let mut summary = None;
-    if let Some(dir) = &options.out {
-        create_directory(dir)?;
-        write_atomically(&dir.join(format!("{name}.md")), table.as_bytes(), &[])?;
-        write_atomically(
-            &dir.join(format!("{name}.json")),
-            (serde_json::to_string_pretty(&results)? + "\n").as_bytes(),
-            &[],
-        )?;
-        let table = machines::targets_by_run(&machines::read_runs(dir)?);
-        let summary_file = dir.join(format!("{}.md", machines::SUMMARY_NAME));
-        write_atomically(&summary_file, table.as_bytes(), &[])?;
-        summary = Some(table);
-    }
-    if let Some(readme) = &options.readme {
-        let text = std::fs::read_to_string(readme).map_err(|e| OutputError::io(readme, e))?;
-        let mut updated = text;
-        for (section_name, section) in [
-            (name.as_str(), output::readme_section(&results)),
-            (
-                machines::SUMMARY_NAME,
-                summary.unwrap_or_else(|| {
-                    machines::targets_by_run(&[machines::RunSummary::from(&results)])
-                }),
-            ),
-        ] {
-            updated = tumble_scene::text::replace_between_markers(&updated, section_name, &section)
-                .ok_or_else(|| {
-                    format!(
-                        "{}: no <!-- {section_name}:begin --> … <!-- {section_name}:end --> markers",
-                        path_for_terminal(readme)
-                    )
-                })?;
+    let mut files = OutputSet::new();
+    let summary = match &options.out {
+        Some(dir) => {
+            files.add(&dir.join(format!("{name}.md")), table.as_bytes())?;
+            files.add(
+                &dir.join(format!("{name}.json")),
+                (serde_json::to_string_pretty(&results)? + "\n").as_bytes(),
+            )?;
+            let runs = machines::with_run(kept_runs, &name, RunSummary::from(&results));
+            let summary = machines::targets_by_run(&runs);
+            let summary_file = dir.join(format!("{}.md", machines::SUMMARY_NAME));
+            files.add(&summary_file, summary.as_bytes())?;
+            summary
         }
-        write_atomically(readme, updated.as_bytes(), &[])?;
+        // Without an output directory there are no kept runs: the summary holds this one.
+        None => machines::targets_by_run(&[RunSummary::from(&results)]),
+    };
+    if let Some(readme) = &options.readme {
+        let section = output::readme_section(&results);
+        files.add(
+            readme,
+            updated_readme(readme, &name, &section, &summary)?.as_bytes(),
+        )?;
     }
+    files.commit()?;
+    print_to_stdout(&format!("{table}\n"))?;
     Ok(())
+}
+
+/// The widest kernel path this CPU has (what a run names itself by).
+fn widest_kernel_path() -> String {
+    KernelPath::available()
+        .last()
+        .map_or("portable".to_owned(), |p| p.to_string())
+}
+
+/// The text of `readme` with this run's section (`name`) and the targets of every run replaced.
+fn updated_readme(
+    readme: &std::path::Path,
+    name: &str,
+    section: &str,
+    summary: &str,
+) -> Result<String, Box<dyn std::error::Error>> {
+    let mut updated = std::fs::read_to_string(readme).map_err(|e| OutputError::io(readme, e))?;
+    for (section_name, section) in [(name, section), (machines::SUMMARY_NAME, summary)] {
+        updated = tumble_scene::text::replace_between_markers(&updated, section_name, section)
+            .ok_or_else(|| {
+                format!(
+                    "{}: no <!-- {section_name}:begin --> … <!-- {section_name}:end --> markers",
+                    path_for_terminal(readme)
+                )
+            })?;
+    }
+    Ok(updated)
 }

@@ -3,9 +3,9 @@
 //! The machines this project is measured on change from session to session (an AVX-512 Xeon
 //! one day, an AVX2-only EPYC the next), and a target met on one can be missed on the other.
 //! So a run does not overwrite another machine's results: it is named after the widest kernel
-//! path of its CPU and the path it ran ([`run_name`]), and after writing its own JSON the bench
-//! reads every run kept in the output directory ([`read_runs`]) and tabulates their targets,
-//! one column per run ([`targets_by_run`]).
+//! path of its CPU and the path it ran ([`run_name`]); the bench reads every run kept in the
+//! output directory ([`read_runs`], before it measures), puts its own in place of its file's
+//! ([`with_run`]) and tabulates their targets, one column per run ([`targets_by_run`]).
 
 use std::path::{Path, PathBuf};
 
@@ -92,9 +92,9 @@ pub enum SummaryError {
     },
 }
 
-/// Every run kept in `dir`: the files `bench-*.json` other than the summary, in the order of
-/// their names (so the table's columns do not depend on the directory's order).
-pub fn read_runs(dir: &Path) -> Result<Vec<RunSummary>, SummaryError> {
+/// Every run kept in `dir` with its file stem: the files `bench-*.json` other than the summary,
+/// in the order of their names (so the table's columns do not depend on the directory's order).
+pub fn read_runs(dir: &Path) -> Result<Vec<(String, RunSummary)>, SummaryError> {
     let io = |path: &Path| {
         let path = path_for_terminal(path);
         move |source| SummaryError::Io { path, source }
@@ -116,12 +116,27 @@ pub fn read_runs(dir: &Path) -> Result<Vec<RunSummary>, SummaryError> {
         .iter()
         .map(|path| {
             let text = std::fs::read_to_string(path).map_err(io(path))?;
-            serde_json::from_str(&text).map_err(|source| SummaryError::Json {
+            let run = serde_json::from_str(&text).map_err(|source| SummaryError::Json {
                 path: path_for_terminal(path),
                 source,
-            })
+            })?;
+            let stem = path.file_stem().unwrap_or_default().to_string_lossy();
+            Ok((stem.into_owned(), run))
         })
         .collect()
+}
+
+/// The kept runs with `run` (whose file stem is `name`) in place of its old file's, in the
+/// order of their names.
+pub fn with_run(
+    mut kept: Vec<(String, RunSummary)>,
+    name: &str,
+    run: RunSummary,
+) -> Vec<RunSummary> {
+    kept.retain(|(stem, _)| stem != name);
+    kept.push((name.to_owned(), run));
+    kept.sort_by(|a, b| a.0.cmp(&b.0));
+    kept.into_iter().map(|(_, run)| run).collect()
 }
 
 /// `text` safe inside a markdown table cell: a `|` would end the cell, a line break the row.
@@ -248,8 +263,17 @@ mod tests {
         write("bench-targets.json", "not a run");
         write("other.json", "not a run either");
         let runs = read_runs(dir.path()).unwrap();
+        let stems: Vec<&str> = runs.iter().map(|(stem, _)| stem.as_str()).collect();
+        assert_eq!(stems, ["bench-avx2", "bench-avx512"]);
+        let runs = with_run(runs, "bench-avx2", run("avx2", "avx2", vec![]));
         let paths: Vec<&str> = runs.iter().map(|r| r.kernel_path.as_str()).collect();
         assert_eq!(paths, ["avx2", "avx512"]);
+        assert!(
+            runs[0].targets.is_empty(),
+            "the new run replaces the kept one"
+        );
+        let runs = with_run(Vec::new(), "bench-a", run("a", "a", vec![]));
+        assert_eq!(runs.len(), 1);
         write("bench-broken.json", "{");
         let error = read_runs(dir.path()).unwrap_err().to_string();
         assert!(

@@ -513,3 +513,93 @@ fn a_link_planted_by_another_user_in_a_sticky_directory_is_not_followed() {
             .starts_with(CSV_HEADER)
     );
 }
+
+/// Every destination of `report` and `bench` is checked before the work: a directory that takes
+/// no file, a read-only file of the set, a README without its markers. Each fails at once with
+/// one line naming it, and nothing that was there changes.
+#[cfg(unix)]
+#[test]
+fn report_and_bench_refuse_an_unwritable_destination_before_working() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = scratch_dir();
+    let readme = dir.path().join("README.md");
+    std::fs::write(&readme, "no markers here\n").unwrap();
+    let read_only = dir.path().join("kept");
+    std::fs::create_dir(&read_only).unwrap();
+    let report_md = read_only.join("report.md");
+    std::fs::write(&report_md, "old report").unwrap();
+    std::fs::set_permissions(&report_md, std::fs::Permissions::from_mode(0o444)).unwrap();
+    let bench_summary = read_only.join("bench-targets.md");
+    std::fs::write(&bench_summary, "old targets").unwrap();
+    std::fs::set_permissions(&bench_summary, std::fs::Permissions::from_mode(0o444)).unwrap();
+    let fresh = dir.path().join("fresh");
+    let cases: Vec<(&str, Vec<std::ffi::OsString>, String)> = vec![
+        (
+            "report",
+            vec!["--out".into(), "/proc/self/report".into()],
+            "error: /proc/self/report".into(),
+        ),
+        (
+            "bench",
+            vec!["--out".into(), "/proc/self/bench".into()],
+            "error: /proc/self/bench".into(),
+        ),
+        (
+            "report",
+            vec!["--out".into(), read_only.clone().into()],
+            format!("error: {}: is read-only", report_md.display()),
+        ),
+        (
+            "bench",
+            vec!["--out".into(), read_only.clone().into()],
+            format!("error: {}: is read-only", bench_summary.display()),
+        ),
+        (
+            "report",
+            vec![
+                "--out".into(),
+                fresh.clone().into(),
+                "--readme".into(),
+                readme.clone().into(),
+            ],
+            format!("error: {}: no <!-- report:begin -->", readme.display()),
+        ),
+        (
+            "bench",
+            vec!["--readme".into(), readme.clone().into()],
+            format!("error: {}: no <!-- bench-", readme.display()),
+        ),
+    ];
+    for (command, args, expected) in cases {
+        let mut child = tumble()
+            .args([command, "--quick"])
+            .args(&args)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        // The quick report and bench take tens of seconds: a refusal takes a moment.
+        let status = wait_at_most(&mut child, Duration::from_secs(20));
+        let mut message = String::new();
+        std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut message).unwrap();
+        let mut out = String::new();
+        std::io::Read::read_to_string(&mut child.stdout.take().unwrap(), &mut out).unwrap();
+        assert_eq!(status.code(), Some(1), "{command} {args:?}: {message}");
+        // One line: no progress line of a started measurement before it.
+        assert!(
+            message.starts_with(&expected) && message.lines().count() == 1,
+            "{command} {args:?}: {message}"
+        );
+        assert!(out.is_empty(), "{command} {args:?}: {out}");
+    }
+    assert_eq!(std::fs::read_to_string(&report_md).unwrap(), "old report");
+    assert_eq!(
+        std::fs::read_to_string(&bench_summary).unwrap(),
+        "old targets"
+    );
+    assert_eq!(
+        std::fs::read_to_string(&readme).unwrap(),
+        "no markers here\n"
+    );
+    assert_eq!(listing(&read_only), ["bench-targets.md", "report.md"]);
+}

@@ -3,7 +3,7 @@
 use std::path::{Path, PathBuf};
 
 use indicatif::{ProgressBar, ProgressStyle};
-use tumble_scene::output::{OutputError, create_directory, write_atomically};
+use tumble_scene::output::{OutputError, OutputSet, print_to_stdout};
 use tumble_scene::text::path_for_terminal;
 
 use crate::energy::{spins, traces};
@@ -34,11 +34,20 @@ pub struct ReportOptions {
 /// against rapier; writes
 /// `report.md`, `results.json` and the SVG plots; prints the headline table.
 ///
-/// The output directory is checked first (an existing non-directory is an error naming it,
-/// before minutes of work); every file is written through
-/// [`tumble_scene::output::OutputFile`] (temporary file, rename as the last step).
+/// Every destination is checked before minutes of work (an output directory that is a file or
+/// takes no new file, a read-only `report.md` or `results.json`, a README without its markers:
+/// each an error naming it). The files are written as one
+/// [`OutputSet`](tumble_scene::output::OutputSet): all of them, the README too, are written
+/// before any old one is replaced, so a failure leaves the old report whole.
 pub fn run_report(options: &ReportOptions) -> Result<(), Box<dyn std::error::Error>> {
-    create_directory(&options.out)?;
+    let out: &Path = &options.out;
+    for name in ["report.md", "results.json"] {
+        OutputSet::check(&out.join(name))?;
+    }
+    if let Some(readme) = &options.readme {
+        updated_readme(readme, "")?;
+        OutputSet::check(readme)?;
+    }
     let dts: Vec<f64> = if options.quick {
         [15.0, 30.0, 60.0, 120.0, 240.0, 480.0]
             .iter()
@@ -119,10 +128,8 @@ pub fn run_report(options: &ReportOptions) -> Result<(), Box<dyn std::error::Err
         springs,
         thin_plate,
     );
-    let out: &Path = &options.out;
-    create_directory(out)?;
     // The plots are drawn into a private directory (plotters opens its path as it is), then
-    // each is written into `out` by the same safe route as the other files.
+    // each joins the set by the same safe route as the other files.
     let staging = tempfile::Builder::new()
         .prefix(".tumble-plots-")
         .tempdir_in(out)
@@ -139,23 +146,22 @@ pub fn run_report(options: &ReportOptions) -> Result<(), Box<dyn std::error::Err
         &results.stability,
     )?);
     plots.push(plot_spring_energy(staging.path(), &results.springs)?);
+    let mut files = OutputSet::new();
     for plot in &plots {
         let drawn = staging.path().join(plot);
         // A scene without finite points gets no plot file (see `plot_scene`).
         if drawn.exists() {
             let bytes = std::fs::read(&drawn).map_err(|e| OutputError::io(&drawn, e))?;
-            write_atomically(&out.join(plot), &bytes, &[])?;
+            files.add(&out.join(plot), &bytes)?;
         }
     }
-    write_atomically(
+    files.add(
         &out.join("results.json"),
         serde_json::to_string_pretty(&results)?.as_bytes(),
-        &[],
     )?;
-    write_atomically(
+    files.add(
         &out.join("report.md"),
         markdown(&results, &plots).as_bytes(),
-        &[],
     )?;
     let headline = format!(
         "{}\nAt equal run time (each method run as long as `splitting` at Δt = 1/60 s, its error \
@@ -163,26 +169,33 @@ pub fn run_report(options: &ReportOptions) -> Result<(), Box<dyn std::error::Err
         headline_table(&results.work_precision),
         crate::output::equal_time_table(&results.work_precision)
     );
-    println!("{headline}");
     if let Some(readme) = &options.readme {
-        let text = std::fs::read_to_string(readme).map_err(|e| OutputError::io(readme, e))?;
-        let updated =
-            crate::output::replace_between_markers(&text, &headline).ok_or_else(|| {
-                format!(
-                    "{}: no <!-- report:begin --> … <!-- report:end --> markers",
-                    path_for_terminal(readme)
-                )
-            })?;
-        write_atomically(readme, updated.as_bytes(), &[])?;
-        println!(
-            "updated the headline table in {}",
-            path_for_terminal(readme)
-        );
+        files.add(readme, updated_readme(readme, &headline)?.as_bytes())?;
     }
-    println!(
-        "wrote {}/report.md, results.json and {} plots",
+    files.commit()?;
+    print_to_stdout(&format!("{headline}\n"))?;
+    if let Some(readme) = &options.readme {
+        print_to_stdout(&format!(
+            "updated the headline table in {}\n",
+            path_for_terminal(readme)
+        ))?;
+    }
+    print_to_stdout(&format!(
+        "wrote {}/report.md, results.json and {} plots\n",
         path_for_terminal(out),
         plots.len()
-    );
+    ))?;
     Ok(())
+}
+
+/// The text of `readme` with `headline` between its report markers.
+fn updated_readme(readme: &Path, headline: &str) -> Result<String, Box<dyn std::error::Error>> {
+    let text = std::fs::read_to_string(readme).map_err(|e| OutputError::io(readme, e))?;
+    let updated = crate::output::replace_between_markers(&text, headline).ok_or_else(|| {
+        format!(
+            "{}: no <!-- report:begin --> … <!-- report:end --> markers",
+            path_for_terminal(readme)
+        )
+    })?;
+    Ok(updated)
 }

@@ -24,7 +24,8 @@
 //! - a path that is one of the run's input files (same device and inode) is refused.
 //!
 //! Every error names the path the caller gave, made safe for a terminal
-//! ([`path_for_terminal`]).
+//! ([`path_for_terminal`]). Outputs of several files (the report, the benchmark) go through an
+//! [`OutputSet`]: all written before any is replaced.
 
 use std::fs::{File, Metadata, OpenOptions};
 use std::io::{self, Write};
@@ -34,6 +35,9 @@ use tempfile::NamedTempFile;
 use thiserror::Error;
 
 use crate::text::path_for_terminal;
+
+mod set;
+pub use set::OutputSet;
 
 /// Most symbolic links followed when resolving an output path (Linux's `MAXSYMLINKS`).
 pub const MAX_SYMLINKS: usize = 40;
@@ -233,23 +237,37 @@ impl OutputFile {
         temp.as_file()
             .sync_all()
             .map_err(|e| OutputError::io(&path, e))?;
-        // The output may have been replaced while we wrote: check again just before the rename.
-        if let Some(meta) = metadata_if_exists(&path, &target)? {
-            check_replaceable(&path, &target, &meta)?;
-        }
+        check_destination(&path, &target)?;
         temp.persist(&target)
             .map_err(|e| OutputError::io(&path, without_temp_path(e.error)))?;
         Ok(())
     }
 }
 
+impl OutputFile {
+    /// Checks again that the output may be replaced (it may have changed while we wrote).
+    pub(crate) fn check_destination(&self) -> Result<(), OutputError> {
+        check_destination(&self.path, &self.target)
+    }
+}
+
+/// The output may have been replaced while we wrote: checked again just before the rename.
+fn check_destination(path: &Path, target: &Path) -> Result<(), OutputError> {
+    match metadata_if_exists(path, target)? {
+        Some(meta) => check_replaceable(path, target, &meta),
+        None => Ok(()),
+    }
+}
+
+// Through the plain file: `NamedTempFile`'s own writes wrap an error with the temporary path,
+// which would hide the operating system's error code and name a file the user never saw.
 impl Write for OutputFile {
     fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
-        self.temp.write(buf)
+        self.temp.as_file_mut().write(buf)
     }
 
     fn flush(&mut self) -> io::Result<()> {
-        self.temp.flush()
+        self.temp.as_file_mut().flush()
     }
 }
 
@@ -259,6 +277,15 @@ pub fn write_atomically(path: &Path, bytes: &[u8], inputs: &[&Path]) -> Result<(
     file.write_all(bytes)
         .map_err(|e| OutputError::io(path, e))?;
     file.commit()
+}
+
+/// Writes `text` to standard output and flushes it: a pipe closed early or a full device is an
+/// error naming standard output, never a panic (as `println!` gives) and never a silent loss.
+pub fn print_to_stdout(text: &str) -> Result<(), OutputError> {
+    let mut out = io::stdout().lock();
+    out.write_all(text.as_bytes())
+        .and_then(|()| out.flush())
+        .map_err(|e| OutputError::io(Path::new("standard output"), e))
 }
 
 /// Makes sure `path` is a directory, creating it (and its parents) if absent; an existing
