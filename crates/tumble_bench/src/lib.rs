@@ -410,7 +410,7 @@ fn runner_check(n: usize, effort: &Effort) -> RunnerCheckCost {
 /// Every destination is checked before the measurements (an output directory that is a file or
 /// takes no new file, a run kept there that cannot be read, a README without this run's
 /// markers: each an error naming it). The files are written as one
-/// [`OutputSet`](tumble_scene::output::OutputSet): all of them, the README too, are written
+/// [`OutputSet`]: all of them, the README too, are written
 /// before any old one is replaced.
 pub fn run_and_write(options: &BenchOptions) -> Result<(), Box<dyn std::error::Error>> {
     // Each machine class and forced path keeps its own files and README section, so a run on

@@ -359,10 +359,12 @@ struct BodyPatterns {
 
 /// The comma-separated patterns of `--bodies`, each checked: shell globs as `globset` reads
 /// them (`*`, `?`, `[abc]`, `[a-z]`, `[!abc]` and `[^abc]` for "not one of", `{a,b}` is not
-/// available since `,` separates patterns, `\` escapes the next character).
+/// available since `,` separates patterns, `\` escapes the next character). Patterns are
+/// composed (Unicode form C) as the scene's names are, so `é` typed either way finds `é`.
 fn body_patterns(list: &str) -> Result<BodyPatterns, Failure> {
     let mut items = Vec::new();
     let mut set = GlobSetBuilder::new();
+    let list = tumble_scene::text::composed(list);
     for item in list.split(',') {
         let item = item.trim();
         if item.is_empty() {
@@ -371,7 +373,7 @@ fn body_patterns(list: &str) -> Result<BodyPatterns, Failure> {
                 format!(
                     "--bodies: an empty name in `{}`; expected names or patterns separated by \
                      commas",
-                    terminal_safe(list)
+                    terminal_safe(&list)
                 ),
             ));
         }

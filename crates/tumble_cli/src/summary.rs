@@ -86,13 +86,7 @@ impl Names {
 
 /// A planning-time warning, naming the body or spring as the scene does.
 pub fn warning_line(warning: &StabilityWarning, names: &Names) -> String {
-    let subject = match *warning {
-        StabilityWarning::StiffSpring { spring, .. } => spring,
-        StabilityWarning::ExplicitGyroscopic { body, .. } => body,
-        StabilityWarning::CoarsePosition { body, .. } => body,
-        StabilityWarning::InexactFreeRotation { body, .. } => body,
-        StabilityWarning::StiffRk4Rotation { body, .. } => body,
-    };
+    let subject = warning.subject();
     let text = warning.to_string();
     // `Display` starts with the entity ("spring 12v0: …"); say the scene's name instead.
     let detail = text.split_once(": ").map_or(text.as_str(), |(_, d)| d);

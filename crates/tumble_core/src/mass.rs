@@ -339,6 +339,16 @@ impl MassProperties {
         self.principal_inertia.cmpeq(Vec3::ZERO).any()
     }
 
+    /// The rates of a world angular velocity `ω` about the locked principal axes: `b = (R P)ᵀ ω`
+    /// with the components of unlocked axes set to 0. Every integrator holds these at 0, so
+    /// callers that take `ω` from outside (a scene file) refuse a nonzero one rather than let
+    /// the first step drop it.
+    pub fn locked_axis_rates(&self, body_rotation: Quat, world: Vec3) -> Vec3 {
+        let frame = quat_mul(body_rotation, self.principal_frame);
+        let b = quat_rotate(frame.inverse(), world);
+        Vec3::select(self.principal_inertia.cmpeq(Vec3::ZERO), b, Vec3::ZERO)
+    }
+
     /// Applies the world inverse inertia `(R P) I_b⁻¹ (R P)ᵀ` to a world vector, where
     /// `body_rotation` is `R` (body → world).
     #[inline]
@@ -478,6 +488,23 @@ mod tests {
         MassProperties::new(one(), Vec3::new(1.0, 2.0, past)).unwrap();
         // A thin plate built from its formula passes.
         MassProperties::solid_cuboid(one(), Vec3::new(1.0, 0.5, 1e-6)).unwrap();
+    }
+
+    #[test]
+    fn locked_axis_rates_are_the_body_rates_about_zero_moments() {
+        let props = MassProperties::new(Mass::new(1.0).unwrap(), Vec3::new(0.0, 0.0, 1.0)).unwrap();
+        let w = Vec3::new(1.0, 2.0, 3.0);
+        assert_eq!(
+            props.locked_axis_rates(Quat::IDENTITY, w),
+            Vec3::new(1.0, 2.0, 0.0)
+        );
+        // A quarter turn about z takes body x to world y: the body's rate about x is ω_y.
+        let quarter = Quat::from_rotation_z(core::f64::consts::FRAC_PI_2 as Real);
+        let rates = props.locked_axis_rates(quarter, w);
+        let expected = Vec3::new(2.0, -1.0, 0.0);
+        assert!((rates - expected).length() < 8.0 * Real::EPSILON, "{rates}");
+        let free = MassProperties::new(Mass::new(1.0).unwrap(), Vec3::ONE).unwrap();
+        assert_eq!(free.locked_axis_rates(quarter, w), Vec3::ZERO);
     }
 
     /// A zero moment is a locked axis, i.e. an infinite moment: the inequality is not checked.

@@ -139,15 +139,42 @@ pub enum StabilityWarning {
         /// `r ε / (2 s Δt)`, compared with [`POSITION_RESOLUTION_LIMIT`].
         relative_error: Real,
     },
+    /// A body that turns about a locked principal axis (a zero moment of inertia): every
+    /// integrator holds that rate at 0, so the first step drops it (not an instability, but the
+    /// motion is not the one given).
+    LockedAxisRate {
+        /// The body.
+        body: Entity,
+        /// `|b|`, the rates about its locked axes (rad/s), see
+        /// [`MassProperties::locked_axis_rates`](tumble_core::MassProperties::locked_axis_rates).
+        rate: Real,
+    },
 }
 
+/// Smallest rate about a locked axis, relative to `|ω|`, that [`check_stability`] reports: below
+/// it the rate is the rounding of a rotation written with a few digits, not a spin.
+pub const LOCKED_RATE_LIMIT: Real = 1e-5;
+
 impl StabilityWarning {
+    /// The spring or body warned of.
+    pub fn subject(&self) -> Entity {
+        match *self {
+            StabilityWarning::StiffSpring { spring, .. } => spring,
+            StabilityWarning::ExplicitGyroscopic { body, .. }
+            | StabilityWarning::InexactFreeRotation { body, .. }
+            | StabilityWarning::StiffRk4Rotation { body, .. }
+            | StabilityWarning::CoarsePosition { body, .. }
+            | StabilityWarning::LockedAxisRate { body, .. } => body,
+        }
+    }
+
     /// True for settings that make the integration diverge (stiff springs, explicit gyroscopic
     /// blow-ups); false for a limit of accuracy or precision.
     pub fn is_instability(&self) -> bool {
         !matches!(
             self,
             StabilityWarning::CoarsePosition { .. }
+                | StabilityWarning::LockedAxisRate { .. }
                 | StabilityWarning::InexactFreeRotation { .. }
                 | StabilityWarning::StiffRk4Rotation { .. }
         )
@@ -207,6 +234,12 @@ impl std::fmt::Display for StabilityWarning {
                 } else {
                     "; build with the `f64` feature (or move the origin closer)"
                 }
+            ),
+            StabilityWarning::LockedAxisRate { body, rate } => write!(
+                f,
+                "rigid body {body}: turns at {rate:.3e} rad/s about a locked principal axis (a \
+                 zero moment of inertia), a rate every integrator holds at 0: the first step \
+                 drops it; give it no rate about that axis, or a nonzero moment"
             ),
         }
     }
@@ -298,6 +331,12 @@ pub fn check_stability(world: &mut World) -> Vec<StabilityWarning> {
         Option<&GravityScale>,
     ), (With<RigidBody>, Without<Static>, Without<Kinematic>)>();
     for (body, t, v, m, scale) in moving.iter(world) {
+        if m.has_locked_axis() {
+            let rate = m.locked_axis_rates(t.rotation, v.angular).length();
+            if rate > LOCKED_RATE_LIMIT * v.angular.length() {
+                warnings.push(StabilityWarning::LockedAxisRate { body, rate });
+            }
+        }
         let distance = t.translation.length();
         let swing = v.angular.length() * (t.rotation * m.local_center_of_mass()).length();
         let fall = (gravity * scale.map_or(1.0, |s| s.0)).length() * dt;

@@ -37,7 +37,7 @@ pub struct ReportOptions {
 /// Every destination is checked before minutes of work (an output directory that is a file or
 /// takes no new file, a read-only `report.md` or `results.json`, a README without its markers:
 /// each an error naming it). The files are written as one
-/// [`OutputSet`](tumble_scene::output::OutputSet): all of them, the README too, are written
+/// [`OutputSet`]: all of them, the README too, are written
 /// before any old one is replaced, so a failure leaves the old report whole.
 pub fn run_report(options: &ReportOptions) -> Result<(), Box<dyn std::error::Error>> {
     let out: &Path = &options.out;

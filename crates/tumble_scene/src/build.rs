@@ -1,5 +1,6 @@
 //! A validated scene, and the world built from it.
 
+use std::borrow::Cow;
 use std::collections::HashMap;
 use std::num::NonZeroU32;
 use tumble_core::math::{Quat, REAL_NAME, Real, Vec3, quat_normalize};
@@ -154,7 +155,20 @@ impl Scene {
                     start = at;
                 }
             }
-            let line = crate::validate::line_at(text, start);
+            let line = match e.span() {
+                Some(_) => crate::validate::line_at(text, start),
+                // The reader gives no position for a key path nested too deep: find it.
+                None if e.message().contains("recursion") => {
+                    let line = crate::validate::line_of_longest_key(text);
+                    let message = format!(
+                        "{}: a key nested deeper than the TOML reader allows; expected the keys \
+                         of a scene file",
+                        e.message().replace('\n', " ")
+                    );
+                    return SceneError::at(file, line, "toml", message);
+                }
+                None => crate::validate::line_at(text, start),
+            };
             let message = e.message().replace('\n', " ");
             // The field is the key path at the error, when the text parses as TOML at all;
             // otherwise (a syntax error) the key on the offending line, when there is one.
@@ -208,7 +222,12 @@ impl Scene {
         Ok(self)
     }
 
-    fn validate(file: &str, locate: &dyn Locate, parsed: SceneFile) -> Result<Self, SceneError> {
+    fn validate(
+        file: &str,
+        locate: &dyn Locate,
+        mut parsed: SceneFile,
+    ) -> Result<Self, SceneError> {
+        compose_names(&mut parsed);
         let ck = Checker { file, locate };
         let world = validate_world(&ck, &parsed.world)?;
         if let Some(why) = bad_text(&parsed.name) {
@@ -463,19 +482,6 @@ fn validate_world(ck: &Checker<'_>, w: &WorldDef) -> Result<CheckedWorld, SceneE
             format!("expected a time step > 0, got {}", compact(w.dt)),
         ));
     }
-    if dt == 0.0 {
-        // Positive in the file, zero in the engine: the step underflows the precision.
-        return Err(ck.error(
-            "world",
-            None,
-            "dt",
-            format!(
-                "{} rounds to 0 in {REAL_NAME}; expected a step ≥ {:.1e} s",
-                compact(w.dt),
-                Real::from_bits(1)
-            ),
-        ));
-    }
     if w.steps == 0 || w.steps > MAX_STEPS {
         return Err(ck.error(
             "world",
@@ -688,6 +694,28 @@ fn validate_body(ck: &Checker<'_>, i: usize, b: &BodyDef) -> Result<ValidBody, S
             linear_energy + angular_energy,
         ));
     }
+    // A zero moment locks its axis and every integrator holds the rate about it at 0: a rate
+    // given there would vanish in the first step, so a file's is refused rather than dropped
+    // (the library's planner warns of it).
+    let locked = mass.locked_axis_rates(quat_normalize(rotation), angular);
+    if locked.length() > tumble_ecs::stability::LOCKED_RATE_LIMIT * angular.length() {
+        let axes: Vec<&str> = ["x", "y", "z"]
+            .into_iter()
+            .zip(locked.to_array())
+            .filter(|(_, rate)| *rate != 0.0)
+            .map(|(axis, _)| axis)
+            .collect();
+        return Err(ck.error(
+            t,
+            Some(i),
+            "angular_velocity",
+            format!(
+                "turns at {} rad/s about the locked principal axis {} (a zero moment of inertia                  holds the rate about its axis at 0); expected no rate about it",
+                compact(locked.length()),
+                axes.join(" and ")
+            ),
+        ));
+    }
     let gravity_scale = ck.scalar(t, Some(i), "gravity_scale", b.gravity_scale)?;
     let mut damping = Damping::default();
     for (key, value, out) in [
@@ -792,6 +820,47 @@ pub(crate) fn wrong_length(message: &str) -> Option<usize> {
     rest.trim().parse().ok()
 }
 
+/// Puts every name of the model (the scene's, the bodies', and those the forces refer to) in
+/// Unicode normalization form C, so that one name typed composed (`é`, U+00E9) and decomposed
+/// (`e` + U+0301) is one name: two bodies cannot differ by it alone, and a force finds its body
+/// either way. Names already composed (almost all) are not copied.
+fn compose_names(model: &mut SceneFile) {
+    let compose = |name: &mut String| {
+        if let Cow::Owned(composed) = crate::text::composed(name) {
+            *name = composed;
+        }
+    };
+    compose(&mut model.name);
+    for body in &mut model.bodies {
+        compose(&mut body.name);
+    }
+    for force in &mut model.forces {
+        match force {
+            ForceDef::Constant { body, .. } | ForceDef::Torque { body, .. } => compose(body),
+            ForceDef::Spring { a, b, .. } => {
+                compose(a);
+                if let Some(b) = b {
+                    compose(b);
+                }
+            }
+        }
+    }
+}
+
+/// Characters that print as nothing yet are neither whitespace nor format characters (those are
+/// refused by [`is_unsafe_char`]): the Hangul fillers, the Braille blank, the combining grapheme
+/// joiner, the Khmer inherent vowels, and the variation selectors. A name made only of these and
+/// whitespace would print blank.
+fn prints_blank(c: char) -> bool {
+    matches!(
+        c as u32,
+        0x115F | 0x1160 | 0x3164 | 0xFFA0 | 0x2800 | 0x034F | 0x17B4 | 0x17B5
+            | 0x180B..=0x180F
+            | 0xFE00..=0xFE0F
+            | 0xE0100..=0xE01EF
+    )
+}
+
 /// Longest scene or body name, in bytes.
 pub const MAX_NAME_BYTES: usize = 256;
 
@@ -802,6 +871,12 @@ pub const MAX_NAME_BYTES: usize = 256;
 fn bad_text(name: &str) -> Option<String> {
     if name.trim().is_empty() {
         return Some("expected a non-empty name".to_owned());
+    }
+    if name.chars().all(|c| c.is_whitespace() || prints_blank(c)) {
+        return Some(format!(
+            "name `{}` prints blank; expected a name with a visible character",
+            name.escape_unicode()
+        ));
     }
     if name.len() > MAX_NAME_BYTES {
         return Some(format!(

@@ -13,7 +13,7 @@ use std::path::Path;
 
 use crate::error::SceneError;
 use crate::format::SceneFile;
-use crate::json_locate::{Step, array_member_of_len, line_of};
+use crate::json_locate::{Step, array_member_of_len, line_of, number_at};
 use crate::validate::Locate;
 
 /// Where the JSON text can be read again to locate a field: the scene is parsed once, as a
@@ -50,6 +50,19 @@ impl Locate for JsonSource<'_> {
         path.extend(index.map(Step::Index));
         path.push(Step::Key(key));
         JsonSource::line(self, &path)
+    }
+
+    fn number_literal(
+        &self,
+        table: Option<&str>,
+        index: Option<usize>,
+        key: &str,
+    ) -> Option<String> {
+        let mut path = Vec::with_capacity(3);
+        path.extend(table.map(Step::Key));
+        path.extend(index.map(Step::Index));
+        path.push(Step::Key(key));
+        number_at(self.open()?, &path)
     }
 }
 

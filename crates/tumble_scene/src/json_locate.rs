@@ -34,6 +34,27 @@ pub fn line_of(input: impl Read, path: &[Step<'_>]) -> usize {
     line
 }
 
+/// The text of the number at `path` in the JSON read from `input`, as written; `None` when the
+/// path is not there or holds no number.
+pub fn number_at(input: impl Read, path: &[Step<'_>]) -> Option<String> {
+    let mut scan = Scanner::new(input);
+    scan.skip_space();
+    for step in path {
+        scan.enter(*step)?;
+    }
+    scan.skip_space();
+    let mut literal = String::new();
+    // A JSON number's characters; the longest literal worth quoting is short.
+    while let Some(b) = scan.peek().filter(|b| b"0123456789+-.eE".contains(b)) {
+        if literal.len() == 64 {
+            return None;
+        }
+        literal.push(char::from(b));
+        scan.bump();
+    }
+    (!literal.is_empty()).then_some(literal)
+}
+
 /// The key and line of the first member of the object at `path` whose value is an array of
 /// `len` elements: `serde_json` reports an array of the wrong length inside an internally
 /// tagged object (`forces`) with the object's path only.
@@ -320,6 +341,22 @@ mod tests {
         assert_eq!(line(&[Key("bodies"), Index(1), Key("mass")]), 10);
         // An escaped key is compared decoded.
         assert_eq!(line(&[Key("forces"), Index(0), Key("type")]), 13);
+    }
+
+    #[test]
+    fn numbers_are_read_as_written() {
+        let text = "{\"world\": {\"dt\": 1e-400, \"steps\": 10},\n \"bodies\": [{\"mass\": -0.0}]}";
+        let at = |path: &[Step<'_>]| number_at(text.as_bytes(), path);
+        assert_eq!(
+            at(&[Step::Key("world"), Step::Key("dt")]).as_deref(),
+            Some("1e-400")
+        );
+        assert_eq!(
+            at(&[Step::Key("bodies"), Step::Index(0), Step::Key("mass")]).as_deref(),
+            Some("-0.0")
+        );
+        assert_eq!(at(&[Step::Key("world"), Step::Key("gone")]), None);
+        assert_eq!(at(&[Step::Key("world")]), None);
     }
 
     #[test]

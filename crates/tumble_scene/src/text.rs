@@ -10,6 +10,17 @@ use std::borrow::Cow;
 /// Longest user string echoed whole, in characters; longer ones are cut with an ellipsis.
 pub const MAX_ECHO_CHARS: usize = 200;
 
+/// `name` in Unicode normalization form C (composed: `é` as U+00E9, not `e` + U+0301), the form
+/// every name of a loaded scene is kept in; borrowed when it already is (almost always).
+pub fn composed(name: &str) -> Cow<'_, str> {
+    use unicode_normalization::{UnicodeNormalization, is_nfc};
+    if is_nfc(name) {
+        Cow::Borrowed(name)
+    } else {
+        Cow::Owned(name.nfc().collect())
+    }
+}
+
 /// Whether `c` must not be printed raw: C0/C1 controls (Unicode `Cc`, which includes newline,
 /// ESC, BEL and DEL), the format characters (`Cf`: bidi embeddings, overrides and isolates,
 /// zero-width joiners and spaces, the BOM, soft hyphen, …), and the line and paragraph

@@ -16,6 +16,30 @@ pub fn line_at(text: &str, at: usize) -> usize {
         .count()
 }
 
+/// The 1-based line of the longest dotted key (a header `[a.b.c]` or a key `a.b.c = …`): where
+/// a reader's error without a position ("recursion limit", a key path nested too deep) arose.
+/// Dots inside quoted key parts and everything after `=` or `#` are not counted.
+pub fn line_of_longest_key(text: &str) -> usize {
+    let mut deepest = (0, 1);
+    for (i, line) in text.lines().enumerate() {
+        let mut dots = 0;
+        let mut quote = None;
+        for c in line.chars() {
+            match (quote, c) {
+                (None, '"' | '\'') => quote = Some(c),
+                (Some(q), _) if c == q => quote = None,
+                (None, '=' | '#') => break,
+                (None, '.') => dots += 1,
+                _ => {}
+            }
+        }
+        if dots > deepest.0 {
+            deepest = (dots, i + 1);
+        }
+    }
+    deepest.1
+}
+
 /// Finds the line of `key` inside `table` (the `index`-th element when `table` is an array of
 /// tables), from the spans of the parsed document, so that headers with comments, inline tables,
 /// dotted and quoted keys and multi-line strings are all located correctly. Falls back to the
@@ -37,6 +61,49 @@ pub fn line_of(text: &str, table: &str, index: Option<usize>, key: &str) -> usiz
         return line_at(text, k.span().start);
     }
     line_at(text, scope.span().start)
+}
+
+/// The text of the number at `table[index].key` (`key` at the top level without a table), as
+/// written; `None` when it is not a number or not there.
+pub fn number_literal_of(
+    text: &str,
+    table: Option<&str>,
+    index: Option<usize>,
+    key: &str,
+) -> Option<String> {
+    let doc = DeTable::parse(text).ok()?;
+    let scope = match table {
+        Some(table) => {
+            let entry = doc.get_ref().get(table)?;
+            match (index, entry.get_ref()) {
+                (Some(i), DeValue::Array(items)) => items.get(i)?.get_ref(),
+                (None, value) => value,
+                _ => return None,
+            }
+        }
+        None => return number_text(doc.get_ref().get(key)?.get_ref()),
+    };
+    match scope {
+        DeValue::Table(fields) => number_text(fields.get(key)?.get_ref()),
+        _ => None,
+    }
+}
+
+fn number_text(value: &DeValue<'_>) -> Option<String> {
+    match value {
+        DeValue::Float(f) => Some(f.as_str().to_owned()),
+        DeValue::Integer(i) => Some(i.as_str().to_owned()),
+        _ => None,
+    }
+}
+
+/// Whether the number written as `literal` is not zero but reads as 0 in `f64` (`1e-400`):
+/// a reader rounds it to 0 without a word, and a check of the 0 must say why it saw 0.
+pub fn underflows_f64(literal: &str) -> bool {
+    let digits: String = literal.chars().filter(|&c| c != '_').collect();
+    let mantissa = digits.split(['e', 'E']).next().unwrap_or("");
+    digits.parse::<f64>().is_ok_and(|x| x == 0.0)
+        && mantissa.contains(|c: char| matches!(c, '1'..='9'))
 }
 
 /// The dotted path (e.g. `bodies[1].mass`) of the deepest key or value whose span holds byte
@@ -147,6 +214,18 @@ pub trait Locate {
     /// The 1-based line of `table[index].key` (`table.key` without an index, the top-level
     /// `key` without a table); 0 when no line can be told.
     fn line(&self, table: Option<&str>, index: Option<usize>, key: &str) -> usize;
+
+    /// The number at `table[index].key` as written in the text (for messages about a value the
+    /// reader changed, such as `1e-400` read as 0); `None` when it cannot be told.
+    fn number_literal(
+        &self,
+        table: Option<&str>,
+        index: Option<usize>,
+        key: &str,
+    ) -> Option<String> {
+        let _ = (table, index, key);
+        None
+    }
 }
 
 /// TOML text.
@@ -166,6 +245,15 @@ impl Locate for TomlText<'_> {
                 })
                 .unwrap_or(1),
         }
+    }
+
+    fn number_literal(
+        &self,
+        table: Option<&str>,
+        index: Option<usize>,
+        key: &str,
+    ) -> Option<String> {
+        number_literal_of(self.0, table, index, key)
     }
 }
 
@@ -200,13 +288,34 @@ impl Checker<'_> {
             None => format!("{table}.{key}"),
         };
         let line = self.locate.line(Some(table), index, key);
+        let message = self.with_underflow(Some(table), index, key, message.into());
         SceneError::at(self.file, line, field, message)
     }
 
     /// An error at the top-level key `key` (e.g. the scene `name`).
     pub fn top_error(&self, key: &str, message: impl Into<String>) -> SceneError {
         let line = self.locate.line(None, None, key);
+        let message = self.with_underflow(None, None, key, message.into());
         SceneError::at(self.file, line, key, message)
+    }
+
+    /// `message`, and when the field's number underflowed to 0 as the file was read, a word
+    /// about it: the check saw 0 where the file has `1e-400`. Looked up only on this error path.
+    fn with_underflow(
+        &self,
+        table: Option<&str>,
+        index: Option<usize>,
+        key: &str,
+        message: String,
+    ) -> String {
+        match self.locate.number_literal(table, index, key) {
+            Some(literal) if underflows_f64(&literal) => format!(
+                "{message} (the file's `{}` is below the smallest f64, {:e}, and reads as 0)",
+                crate::text::terminal_safe(&literal),
+                f64::from_bits(1)
+            ),
+            _ => message,
+        }
     }
 
     /// A finite number that fits in the engine precision ([`Real`]).
@@ -226,6 +335,18 @@ impl Checker<'_> {
             ));
         }
         let y = x as Real;
+        if y == 0.0 && x != 0.0 {
+            return Err(self.error(
+                table,
+                index,
+                key,
+                format!(
+                    "{} rounds to 0 in {REAL_NAME}; expected 0 or a magnitude ≥ {:.1e}",
+                    compact(x),
+                    Real::from_bits(1)
+                ),
+            ));
+        }
         if !y.is_finite() {
             return Err(self.error(
                 table,

@@ -267,3 +267,15 @@ fn a_consumed_build_is_the_same_world_as_a_borrowed_one() {
         );
     }
 }
+
+/// A number below the smallest `f64` reads as 0; the error says so, quoting the file.
+#[test]
+fn a_number_that_underflows_is_named_as_written() {
+    let e = json_error("{\"name\": \"x\",\n \"world\": {\"dt\": 1e-400, \"steps\": 10}}");
+    assert_eq!((e.line, e.field.as_str()), (2, "world.dt"), "{e}");
+    assert!(
+        e.message
+            .contains("got 0 (the file's `1e-400` is below the smallest f64"),
+        "{e}"
+    );
+}

@@ -349,3 +349,54 @@ fn file_rotations_are_normalized_by_the_engine() {
         );
     }
 }
+
+/// A rate about the free axes of a body with a locked axis loads and is kept, even when the
+/// rotation is written with seven digits (the locked rate is then rounding, not a spin).
+#[test]
+fn a_spin_about_the_free_axes_of_a_locked_body_is_kept() {
+    // 30° about x: body y (locked) points along (0, cos 30°, sin 30°), body z along
+    // (0, −sin 30°, cos 30°); ω is 4 rad/s about body z.
+    let text = r#"
+name = "locked"
+[world]
+dt = 0.01
+steps = 10
+[[bodies]]
+name = "plate"
+mass = 1.0
+inertia = [1.0, 0.0, 1.0]
+rotation = [0.258819, 0.0, 0.0, 0.9659258]
+angular_velocity = [0.0, -2.0, 3.4641016]
+"#;
+    let scene = tumble_scene::Scene::parse("locked.toml", text).unwrap();
+    let mut built = scene.build();
+    built.step();
+    let given = scene.body_states()[0].state.angular_velocity;
+    let w = built
+        .world
+        .get::<tumble_ecs::components::Velocity>(built.bodies[0].1)
+        .unwrap()
+        .angular;
+    assert!(
+        (w - given).length() < 1e-5 * given.length(),
+        "{w} from {given}"
+    );
+}
+
+/// Names are kept composed (Unicode form C): a force naming its body decomposed finds it, and
+/// the body's name is written composed.
+#[test]
+fn a_name_typed_decomposed_is_the_composed_name() {
+    let text = "name = \"cafe\u{301}\"\n[world]\ndt = 0.01\nsteps = 10\n[[bodies]]\n\
+                name = \"caf\u{e9}\"\nmass = 1.0\ninertia = [1.0, 1.0, 1.0]\n[[forces]]\n\
+                type = \"torque\"\nbody = \"cafe\u{301}\"\ntorque = [0.0, 0.0, 1.0]\n";
+    let scene = Scene::parse("names.toml", text).unwrap();
+    assert_eq!(scene.name(), "caf\u{e9}");
+    assert_eq!(scene.body_states()[0].name, "caf\u{e9}");
+    assert_eq!(scene.forces().len(), 1);
+    assert_eq!(tumble_scene::text::composed("cafe\u{301}"), "caf\u{e9}");
+    assert!(matches!(
+        tumble_scene::text::composed("plain"),
+        std::borrow::Cow::Borrowed(_)
+    ));
+}
