@@ -30,6 +30,8 @@ pub fn install() {
 fn on_signal() {
     let again = INTERRUPTED.swap(true, Ordering::SeqCst);
     if again || !POLLED.load(Ordering::SeqCst) {
+        // No destructor runs from here: remove what an unwinding exit would have removed.
+        tumble_scene::output::remove_live_temporary_files();
         std::process::exit(i32::from(exit::INTERRUPTED));
     }
 }

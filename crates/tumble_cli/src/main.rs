@@ -8,6 +8,7 @@ mod exit;
 mod generate;
 mod interrupt;
 mod logging;
+mod memory;
 mod run;
 mod stdout;
 mod summary;
@@ -63,6 +64,9 @@ const BUNDLED: &[(&str, &str)] = &[
     ),
     ("cloth", include_str!("../../../scenes/cloth.toml")),
 ];
+
+#[global_allocator]
+static ALLOCATOR: memory::ExitWhenExhausted = memory::ExitWhenExhausted;
 
 fn main() -> ExitCode {
     let cli = match Cli::try_parse() {

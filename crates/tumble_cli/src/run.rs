@@ -519,8 +519,8 @@ fn human_bytes(bytes: u64) -> String {
 /// the state is still finite). Precision warnings are printed and do not refuse the run.
 pub fn stability_gate(built: &mut BuiltScene, names: &Names, allow: bool) -> Result<(), Failure> {
     let warnings = check_stability(&mut built.world);
-    for warning in &warnings {
-        tracing::warn!(target: "tumble", "{}", warning_line(warning, names));
+    for line in warning_lines(&warnings, names, tracing::enabled!(tracing::Level::INFO)) {
+        tracing::warn!(target: "tumble", "{line}");
     }
     let unstable = warnings.iter().filter(|w| w.is_instability()).count();
     if unstable == 0 {
@@ -539,6 +539,47 @@ pub fn stability_gate(built: &mut BuiltScene, names: &Names, allow: bool) -> Res
     // The runner re-plans with the audit on its next step.
     built.world.insert_resource(EnergyAudit::Always);
     Ok(())
+}
+
+/// Most warnings of one kind printed at the default verbosity; `-v` prints them all.
+const WARNINGS_PER_KIND: usize = 5;
+
+/// The lines for `warnings`: all of them when `all`, else the first [`WARNINGS_PER_KIND`] of
+/// each kind and a count of the rest (a scene of 10⁵ bodies far from the origin would otherwise
+/// print 10⁵ lines).
+fn warning_lines(warnings: &[StabilityWarning], names: &Names, all: bool) -> Vec<String> {
+    let mut kinds: Vec<(std::mem::Discriminant<StabilityWarning>, usize)> = Vec::new();
+    let mut lines = Vec::new();
+    for warning in warnings {
+        let kind = std::mem::discriminant(warning);
+        let seen = match kinds.iter_mut().find(|(k, _)| *k == kind) {
+            Some((_, count)) => count,
+            None => {
+                kinds.push((kind, 0));
+                &mut kinds.last_mut().expect("just pushed").1
+            }
+        };
+        *seen += 1;
+        if all || *seen <= WARNINGS_PER_KIND {
+            lines.push(warning_line(warning, names));
+        }
+    }
+    if !all {
+        for (kind, count) in kinds {
+            if count > WARNINGS_PER_KIND {
+                let first = warnings
+                    .iter()
+                    .find(|w| std::mem::discriminant(*w) == kind)
+                    .expect("counted");
+                lines.push(format!(
+                    "… and {} more with the same warning as {} (-v lists them all)",
+                    count - WARNINGS_PER_KIND,
+                    names.of(first.subject())
+                ));
+            }
+        }
+    }
+    lines
 }
 
 /// Logs every quarantine recorded since the first `reported` errors, with the step it happened

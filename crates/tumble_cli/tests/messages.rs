@@ -349,3 +349,47 @@ fn an_unknown_scene_name_says_what_exists() {
         assert_eq!(stderr.lines().count(), 1, "{stderr}");
     }
 }
+
+/// Many bodies with the same planning warning print five lines and a count, not one line
+/// each; `-v` prints them all.
+#[test]
+fn repeated_warnings_are_counted_not_listed() {
+    let dir = common::scratch_dir();
+    let scene = dir.path().join("many.json");
+    let generated = tumble_run(&[
+        "gen",
+        "many",
+        "--n",
+        "20000",
+        "--steps",
+        "1",
+        "--out",
+        scene.to_str().unwrap(),
+    ]);
+    assert!(generated.status.success());
+    let warnings = |verbose: bool| {
+        let mut args = vec!["run", scene.to_str().unwrap()];
+        if verbose {
+            args.push("-v");
+        }
+        let output = tumble_run(&args);
+        assert!(output.status.success(), "{}", stderr(&output));
+        stderr(&output)
+            .lines()
+            .filter(|l| l.contains("WARN"))
+            .map(str::to_owned)
+            .collect::<Vec<_>>()
+    };
+    let all = warnings(true);
+    assert!(all.len() > 6, "{all:?}");
+    let counted = warnings(false);
+    assert_eq!(counted.len(), 6, "{counted:?}");
+    assert_eq!(counted[..5], all[..5]);
+    assert!(
+        counted[5].ends_with(&format!(
+            "… and {} more with the same warning as body `b24` (-v lists them all)",
+            all.len() - 5
+        )),
+        "{counted:?}"
+    );
+}

@@ -603,3 +603,40 @@ fn report_and_bench_refuse_an_unwritable_destination_before_working() {
     );
     assert_eq!(listing(&read_only), ["bench-targets.md", "report.md"]);
 }
+
+/// Memory exhausted under a limit (`ulimit -v`) is one `error:` line and exit code 1, not an
+/// abort: the output is untouched and no temporary file is left.
+#[cfg(unix)]
+#[test]
+fn exhausted_memory_is_an_error_line_and_leaves_nothing() {
+    let dir = scratch_dir();
+    let scene = dir.path().join("big.json");
+    let generated = tumble()
+        .args(["gen", "many", "--n", "100000", "--steps", "2", "--out"])
+        .arg(&scene)
+        .output()
+        .unwrap();
+    assert!(generated.status.success(), "{}", stderr(&generated));
+    let out = dir.path().join("out.csv");
+    std::fs::write(&out, "old").unwrap();
+    // Room for the program (about 10 MB here), not for the 100 000 bodies (about 50 MB).
+    let output = Command::new("sh")
+        .arg("-c")
+        .arg("ulimit -v 40000 && exec \"$0\" \"$@\"")
+        .arg(env!("CARGO_BIN_EXE_tumble"))
+        .arg("run")
+        .arg(&scene)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    let message = stderr(&output);
+    assert_eq!(output.status.code(), Some(1), "{message}");
+    let last = message.lines().last().unwrap_or_default();
+    assert!(
+        last.starts_with("error: out of memory: an allocation of ") && last.ends_with(" use"),
+        "{message}"
+    );
+    assert_eq!(std::fs::read_to_string(&out).unwrap(), "old");
+    assert_eq!(listing(dir.path()), ["big.json", "out.csv"]);
+}

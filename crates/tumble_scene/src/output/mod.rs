@@ -36,7 +36,9 @@ use thiserror::Error;
 
 use crate::text::path_for_terminal;
 
+mod live;
 mod set;
+pub use live::remove_live_temporary_files;
 pub use set::OutputSet;
 
 /// Most symbolic links followed when resolving an output path (Linux's `MAXSYMLINKS`).
@@ -151,6 +153,8 @@ pub struct OutputFile {
     temp: NamedTempFile,
     target: PathBuf,
     path: PathBuf,
+    // Declared after `temp`, so dropped after it: the file is gone before it leaves the list.
+    _live: live::LiveTemporary,
 }
 
 impl OutputFile {
@@ -207,10 +211,12 @@ impl OutputFile {
                 .set_permissions(meta.permissions())
                 .map_err(|e| OutputError::io(path, e))?;
         }
+        let _live = live::LiveTemporary::register(temp.path());
         Ok(Self {
             temp,
             target,
             path: path.to_owned(),
+            _live,
         })
     }
 
@@ -232,7 +238,12 @@ impl OutputFile {
     /// Flushes the data to disk and renames the temporary file over the output. On error the
     /// temporary file is removed and the output is left as it was.
     pub fn commit(self) -> Result<(), OutputError> {
-        let Self { temp, target, path } = self;
+        let Self {
+            temp,
+            target,
+            path,
+            _live,
+        } = self;
         // Durable before visible: after a crash the output is the old file or the whole new one.
         temp.as_file()
             .sync_all()
