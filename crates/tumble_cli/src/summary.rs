@@ -153,8 +153,10 @@ pub fn totals(world: &mut World) -> (f64, DVec3) {
         energy -= mass * scale.map_or(1.0, |s| s.0.widen()) * g.dot(x);
         momentum += x.cross(mass * lin) + spin;
     }
-    let springs: Vec<Spring> = world.query::<&Spring>().iter(world).copied().collect();
-    for s in springs {
+    // Read in place: a copy of every spring would cost a large scene its size again.
+    let mut springs = world.query::<&Spring>();
+    let world: &World = world;
+    for s in springs.iter(world) {
         let point = |e: Entity, local: Vec3| world.get::<Pose>(e).map(|t| t.transform_point(local));
         let pb = match s.b {
             SpringEnd::World(p) => Some(p),

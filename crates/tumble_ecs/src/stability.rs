@@ -39,6 +39,17 @@
 //!   is raised when `e` exceeds [`FREE_ROTATION_ERROR_LIMIT`]: the run goes on (the motion stays
 //!   bounded, `|L|` exact), it is an accuracy limit like the one below.
 //!
+//!   `yoshida4` composes the same split in three stages, the largest `|c₀| h ≈ 1.70 h` long;
+//!   the composition cancels the error to fourth order only while it is small, so it is judged
+//!   by `e` of that stage against the looser [`COMPOSED_FREE_ROTATION_ERROR_LIMIT`].
+//!
+//! - **First-order gyroscopic term** (`lclamp`, `implicit-gyroscopic`). Stable, but each step
+//!   errs in the rate by `∝ (Ω h)²` (`Ω` the nutation frequency above), and the error accumulates:
+//!   over `T` the orientation drifts by `≈ c |ω| Ω² h T²` ([`first_order_drift`]; box
+//!   I = (1, 2, 3) at 1 rad/s and 60 Hz: 0.03–0.07 rad in 10 s, where `splitting` is 2e-5). A
+//!   warning naming `splitting` and `exact` is raised when the drift over [`ACCURACY_HORIZON`]
+//!   exceeds [`FIRST_ORDER_DRIFT_LIMIT`].
+//!
 //! - **`rk4` at constant `L`** integrates `q̇ = ½ ω(q) q` with `ω(q) = R I⁻¹ Rᵀ L`. A trial
 //!   orientation off the true path by `δ` tilts `L` into the body's thinnest axis and spins it
 //!   at `|L| δ / I_min`: the equation is stiff with rate `|L|/I_min`, the spin the body would
@@ -88,6 +99,20 @@ pub const FREE_ROTATION_ERROR_LIMIT: Real = 1e-2;
 /// `|L| Δt / I_min` above which `rk4`'s constant-`L` rotation goes wrong (module docs).
 pub const RK4_STIFFNESS_LIMIT: Real = 0.5;
 
+/// The split free rotation's relative error per stage (as [`FREE_ROTATION_ERROR_LIMIT`], at the
+/// largest stage `|c₀| h ≈ 1.70 h` of the triple jump) above which `yoshida4` is warned of. The
+/// composition cancels the split's error to fourth order only while it is small: measured over
+/// 10 s (f32, I at the triangle limit), 7.7 % per stage gives 1e-3–5e-3 rad, 31 % gives
+/// 0.04–0.2 rad.
+pub const COMPOSED_FREE_ROTATION_ERROR_LIMIT: Real = 0.15;
+
+/// Orientation error over [`ACCURACY_HORIZON`] (rad) above which a first-order gyroscopic method
+/// (`lclamp`, `implicit-gyroscopic`) is warned of (module docs).
+pub const FIRST_ORDER_DRIFT_LIMIT: Real = 0.02;
+
+/// The span over which [`FIRST_ORDER_DRIFT_LIMIT`] is judged (s).
+pub const ACCURACY_HORIZON: Real = 10.0;
+
 /// A setting outside the selected integrator's stable region, or beyond what the precision can
 /// resolve.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -127,6 +152,18 @@ pub enum StabilityWarning {
         /// `|L| Δt / I_min`.
         stiffness: Real,
     },
+    /// A spin whose gyroscopic term a first-order method (`lclamp`, `implicit-gyroscopic`)
+    /// integrates with an orientation drift over [`ACCURACY_HORIZON`] above
+    /// [`FIRST_ORDER_DRIFT_LIMIT`] (not an instability: the motion stays bounded, but wrong).
+    FirstOrderGyroscopic {
+        /// The body.
+        body: Entity,
+        /// The integrator.
+        integrator: Integrator,
+        /// The predicted orientation drift over [`ACCURACY_HORIZON`] (rad), see
+        /// [`first_order_drift`].
+        drift: Real,
+    },
     /// A body so far from the origin that rounding of its stored position eats a visible part
     /// of each step's motion (not an instability: the motion stays bounded, but wrong).
     CoarsePosition {
@@ -161,6 +198,7 @@ impl StabilityWarning {
         match *self {
             StabilityWarning::StiffSpring { spring, .. } => spring,
             StabilityWarning::ExplicitGyroscopic { body, .. }
+            | StabilityWarning::FirstOrderGyroscopic { body, .. }
             | StabilityWarning::InexactFreeRotation { body, .. }
             | StabilityWarning::StiffRk4Rotation { body, .. }
             | StabilityWarning::CoarsePosition { body, .. }
@@ -175,6 +213,7 @@ impl StabilityWarning {
             self,
             StabilityWarning::CoarsePosition { .. }
                 | StabilityWarning::LockedAxisRate { .. }
+                | StabilityWarning::FirstOrderGyroscopic { .. }
                 | StabilityWarning::InexactFreeRotation { .. }
                 | StabilityWarning::StiffRk4Rotation { .. }
         )
@@ -206,9 +245,24 @@ impl std::fmt::Display for StabilityWarning {
             } => write!(
                 f,
                 "rigid body {body}: integrator `{integrator}` splits its free rotation with a \
-                 relative error of {:.1} % per step in its spin (Δt²|ω_b ω_c||I_b − I_c|/I_a); \
+                 relative error of {:.1} % per {} in its spin (Δt²|ω_b ω_c||I_b − I_c|/I_a); \
                  use `exact`, exact at any spin, or a smaller time step",
-                100.0 * error_per_step
+                100.0 * error_per_step,
+                if integrator.composition().len() > 1 {
+                    "stage"
+                } else {
+                    "step"
+                }
+            ),
+            StabilityWarning::FirstOrderGyroscopic {
+                body,
+                integrator,
+                drift,
+            } => write!(
+                f,
+                "rigid body {body}: integrator `{integrator}` integrates its gyroscopic term to \
+                 first order, and at this spin its orientation drifts by about {drift:.2} rad in \
+                 {ACCURACY_HORIZON} s; use `splitting`, or `exact` for a thin or fast body"
             ),
             StabilityWarning::StiffRk4Rotation { body, stiffness } => write!(
                 f,
@@ -283,6 +337,28 @@ pub fn split_rotation_error(inertia: Vec3, omega: Vec3, dt: Real) -> Real {
     dt * dt * (w[b] * w[c]).abs() * (i[b] - i[c]).abs() / i[a]
 }
 
+/// The orientation drift over [`ACCURACY_HORIZON`] `T` (rad) of a first-order gyroscopic method
+/// on a body with principal moments `inertia` spinning at `omega`, with steps of `h`:
+/// `c |ω| Ω² h T²`, `Ω² = |ω|² ·` the nutation factor (module docs), from a relative error of
+/// `c' (Ω h)²` in the rate per step that accumulates over `T/h` steps and then in the angle.
+/// `c` as measured over 10 s on boxes, plates, rods and near-symmetric bodies at 0.5–32 rad/s,
+/// 60 and 240 Hz (f32): 0.03 for `lclamp`, 0.06 for `implicit-gyroscopic`, the upper ends of
+/// their scatter. `None` for a method without a first-order gyroscopic term.
+pub fn first_order_drift(
+    integrator: Integrator,
+    inertia: Vec3,
+    omega: Vec3,
+    h: Real,
+) -> Option<Real> {
+    let c = match integrator {
+        Integrator::Lclamp => 0.03,
+        Integrator::ImplicitGyroscopic => 0.06,
+        _ => return None,
+    };
+    let nutation2 = omega.length_squared() * nutation_factor(inertia);
+    Some(c * omega.length() * nutation2 * h * ACCURACY_HORIZON * ACCURACY_HORIZON)
+}
+
 /// Checks the world's springs and spins against the selected integrator's stable region.
 /// Springs stepped implicitly (see [`crate::stiff`]; classified here if needed) are never
 /// reported: the implicit step is stable at any stiffness.
@@ -353,23 +429,52 @@ pub fn check_stability(world: &mut World) -> Vec<StabilityWarning> {
             }
         }
     }
-    if matches!(
-        settings.integrator,
-        Integrator::Splitting | Integrator::SplittingXyz
-    ) {
-        // One substep's span: the split is applied once per stage.
-        let h = settings.dt() / settings.substeps.get() as Real;
+    let split_limit = match settings.integrator {
+        Integrator::Splitting | Integrator::SplittingXyz => Some(FREE_ROTATION_ERROR_LIMIT),
+        Integrator::Yoshida4 => Some(COMPOSED_FREE_ROTATION_ERROR_LIMIT),
+        _ => None,
+    };
+    if let Some(limit) = split_limit {
+        // The largest stage's span: the split is applied once per stage.
+        let largest = settings
+            .integrator
+            .composition()
+            .iter()
+            .fold(0.0, |m: Real, w| m.max(w.abs()));
+        let h = largest * settings.dt() / settings.substeps.get() as Real;
         let mut spins =
             world.query_filtered::<(Entity, &MassProps, &Pose, &Velocity), With<RigidBody>>();
         for (body, mass, transform, velocity) in spins.iter(world) {
             let principal = transform.rotation * mass.principal_frame();
             let omega = tumble_core::integrate::rotate_inv(principal, velocity.angular);
             let error_per_step = split_rotation_error(mass.principal_inertia(), omega, h);
-            if error_per_step > FREE_ROTATION_ERROR_LIMIT {
+            if error_per_step > limit {
                 warnings.push(StabilityWarning::InexactFreeRotation {
                     body,
                     integrator: settings.integrator,
                     error_per_step,
+                });
+            }
+        }
+    }
+    if matches!(
+        settings.integrator,
+        Integrator::Lclamp | Integrator::ImplicitGyroscopic
+    ) {
+        let h = settings.dt() / settings.substeps.get() as Real;
+        let mut spins = world.query_filtered::<(Entity, &MassProps, &Velocity), With<RigidBody>>();
+        for (body, mass, velocity) in spins.iter(world) {
+            let drift = first_order_drift(
+                settings.integrator,
+                mass.principal_inertia(),
+                velocity.angular,
+                h,
+            );
+            if let Some(drift) = drift.filter(|&d| d > FIRST_ORDER_DRIFT_LIMIT) {
+                warnings.push(StabilityWarning::FirstOrderGyroscopic {
+                    body,
+                    integrator: settings.integrator,
+                    drift,
                 });
             }
         }

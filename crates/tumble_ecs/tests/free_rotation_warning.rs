@@ -3,11 +3,14 @@
 //! what a run measures: the orientation error of `splitting` against `exact` over 10 s.
 
 use bevy_ecs::prelude::*;
+use tumble_core::math::Widen;
 use tumble_core::math::{Real, Vec3};
 use tumble_core::rotation::angle_between;
 use tumble_core::{BodyState, Integrator, Mass, MassProperties, Wrench};
 use tumble_ecs::prelude::*;
-use tumble_ecs::stability::{FREE_ROTATION_ERROR_LIMIT, split_rotation_error};
+use tumble_ecs::stability::{
+    FIRST_ORDER_DRIFT_LIMIT, FREE_ROTATION_ERROR_LIMIT, first_order_drift, split_rotation_error,
+};
 
 /// A thin asymmetric plate, as asymmetric as the triangle inequality allows.
 const PLATE: Vec3 = Vec3::new(0.01, 1.0, 1.01);
@@ -154,4 +157,81 @@ fn the_rule_takes_the_odd_axis_whatever_the_order() {
         split_rotation_error(Vec3::new(0.01, 1.0, 1.0), omega, 0.1),
         0.0
     );
+}
+
+fn warned_of(world: &mut World, integrator: Integrator) -> bool {
+    check_stability(world).iter().any(|w| {
+        let named = match w {
+            StabilityWarning::InexactFreeRotation { integrator: i, .. }
+            | StabilityWarning::FirstOrderGyroscopic { integrator: i, .. } => *i == integrator,
+            _ => false,
+        };
+        named && !w.is_instability() && w.to_string().contains("`exact`")
+    })
+}
+
+/// `yoshida4` is judged by the split error of its largest stage, against a looser limit: warned
+/// where it is off by more than the budget over 10 s, silent where it is far inside it.
+#[test]
+fn yoshida4_is_warned_about_on_a_fast_thin_plate_only() {
+    let dt = 1.0 / 60.0;
+    let direction = Vec3::new(0.3, 1.0, 0.5).normalize();
+    let fast = 32.0 * direction;
+    assert!(warned_of(
+        &mut world_with(PLATE, fast, dt, Integrator::Yoshida4),
+        Integrator::Yoshida4
+    ));
+    let error = error_of(Integrator::Yoshida4, PLATE, fast, dt);
+    assert!(
+        error > 0.02,
+        "warned, but yoshida4 is off by only {error:e} rad"
+    );
+    // Half the spin: a quarter of the per-stage error, and the composition holds.
+    let moderate = 16.0 * direction;
+    assert!(!warned_of(
+        &mut world_with(PLATE, moderate, dt, Integrator::Yoshida4),
+        Integrator::Yoshida4
+    ));
+    let error = error_of(Integrator::Yoshida4, PLATE, moderate, dt);
+    assert!(error < 0.02, "not warned, but off by {error:e} rad");
+}
+
+/// `lclamp` and `implicit-gyroscopic` are warned about where their first-order drift over 10 s
+/// exceeds the budget, and the prediction is of the size a run measures.
+#[test]
+fn first_order_gyroscopic_methods_are_warned_about_where_they_drift() {
+    let dt = 1.0 / 60.0;
+    let box_inertia = Vec3::new(1.0, 2.0, 3.0);
+    let direction = Vec3::new(0.3, 1.0, 0.5).normalize();
+    for integrator in [Integrator::Lclamp, Integrator::ImplicitGyroscopic] {
+        for (inertia, speed) in [(box_inertia, 1.0), (PLATE, 2.0), (box_inertia, 4.0)] {
+            let omega = speed * direction;
+            assert!(
+                warned_of(&mut world_with(inertia, omega, dt, integrator), integrator),
+                "{integrator} at {speed} rad/s"
+            );
+            let predicted = first_order_drift(integrator, inertia, omega, dt).unwrap();
+            let error = error_of(integrator, inertia, omega, dt);
+            assert!(
+                error > 0.01 && error < 10.0 * predicted.widen(),
+                "{integrator} at {speed} rad/s: predicted {predicted:e}, measured {error:e}"
+            );
+        }
+        // A slow spin: not warned, and the error is within the budget.
+        let slow = 0.5 * direction;
+        assert!(!warned_of(
+            &mut world_with(box_inertia, slow, dt, integrator),
+            integrator
+        ));
+        let error = error_of(integrator, box_inertia, slow, dt);
+        assert!(
+            error < FIRST_ORDER_DRIFT_LIMIT.widen(),
+            "{integrator}: {error:e}"
+        );
+    }
+    // `splitting` is not warned about by this rule at the same spins.
+    assert!(!warned_of(
+        &mut world_with(box_inertia, direction, dt, Integrator::Splitting),
+        Integrator::Splitting
+    ));
 }

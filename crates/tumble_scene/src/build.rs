@@ -348,6 +348,9 @@ impl Scene {
     /// their sum (a million bodies: ≈ 250 MB of file model, ≈ 200 MB of world).
     pub fn into_built(mut self) -> BuiltScene {
         let mut world = self.world_for_bodies();
+        // The forces' file model (names as strings) is not needed once checked: `self.forces`
+        // holds them by index. Dropped before the world grows.
+        drop(std::mem::take(&mut self.file.forces));
         let mut defs = std::mem::take(&mut self.file.bodies);
         let n = defs.len();
         // Popped from the back in file order; the vector is shrunk as it empties, which hands
