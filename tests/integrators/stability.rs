@@ -62,9 +62,15 @@ fn spring_warning_matches_divergence() {
                 "{integrator} at ωΔt = {omega_dt}: warned {warned}, diverged {blew_up}"
             );
             assert_eq!(warned, omega_dt >= 2.0);
-            // By default the stiff ones take the implicit step: no warning, no divergence.
+            // By default the stiff ones take the implicit step: no instability, no divergence,
+            // and one warning that says the implicit solve, not the integrator, steps them.
             let (mut world, body) = spring_world(omega_dt, integrator, SpringSolver::Auto);
-            assert!(check_stability(&mut world).is_empty());
+            let warnings = check_stability(&mut world);
+            assert!(warnings.iter().all(|w| !w.is_instability()), "{warnings:?}");
+            let implicit = warnings
+                .iter()
+                .any(|w| matches!(w, StabilityWarning::ImplicitGroups { integrator: i, .. } if *i == integrator));
+            assert_eq!(implicit, !warnings.is_empty(), "{warnings:?}");
             assert!(
                 !diverges(&mut world, body, 2000),
                 "{integrator} at ωΔt = {omega_dt}"

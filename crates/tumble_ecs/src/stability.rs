@@ -23,6 +23,11 @@
 //!   (≈ 32/(Ω²Δt)): I = (1, 2, 3) at 20 rad/s and 60 Hz gives 4.8 s (measured: 3.5 s). A warning
 //!   is raised when `t*` is shorter than [`EXPLICIT_GYROSCOPIC_HORIZON`].
 //!
+//! Bodies in stiff spring groups are stepped by the implicit spring solve ([`crate::stiff`]),
+//! not by the selected method: none of the method's checks below applies to them (the predictor
+//! never refuses a method for a body it would not step), and one
+//! [`StabilityWarning::ImplicitGroups`] says which method they get instead.
+//!
 //! One limit of the default method's accuracy (not its stability):
 //!
 //! - **Split free rotation.** `splitting` (and `splitting-xyz`) integrate the torque-free body as
@@ -78,6 +83,7 @@ use crate::components::{
     Gravity, GravityScale, Kinematic, MassProps, PhysicsSettings, Pose, RigidBody, Static, Velocity,
 };
 use crate::forces::{Spring, SpringEnd};
+use crate::stiff::ImplicitBody;
 
 /// `ω Δt` above which the symplectic position update of a spring diverges.
 pub const SPRING_LIMIT: Real = 2.0;
@@ -152,6 +158,18 @@ pub enum StabilityWarning {
         /// `|L| Δt / I_min`.
         stiffness: Real,
     },
+    /// Bodies in stiff spring groups (see [`crate::stiff`]), which the implicit spring solve
+    /// steps — translation and rotation, by the implicit midpoint rule — instead of the selected
+    /// integrator (not an instability: stable at any stiffness, but not the method asked for).
+    /// One warning for the world, naming the first such body.
+    ImplicitGroups {
+        /// The first body of an implicit group.
+        body: Entity,
+        /// Bodies in implicit groups.
+        bodies: usize,
+        /// The integrator they do not run.
+        integrator: Integrator,
+    },
     /// A spin whose gyroscopic term a first-order method (`lclamp`, `implicit-gyroscopic`)
     /// integrates with an orientation drift over [`ACCURACY_HORIZON`] above
     /// [`FIRST_ORDER_DRIFT_LIMIT`] (not an instability: the motion stays bounded, but wrong).
@@ -199,6 +217,7 @@ impl StabilityWarning {
             StabilityWarning::StiffSpring { spring, .. } => spring,
             StabilityWarning::ExplicitGyroscopic { body, .. }
             | StabilityWarning::FirstOrderGyroscopic { body, .. }
+            | StabilityWarning::ImplicitGroups { body, .. }
             | StabilityWarning::InexactFreeRotation { body, .. }
             | StabilityWarning::StiffRk4Rotation { body, .. }
             | StabilityWarning::CoarsePosition { body, .. }
@@ -214,6 +233,7 @@ impl StabilityWarning {
             StabilityWarning::CoarsePosition { .. }
                 | StabilityWarning::LockedAxisRate { .. }
                 | StabilityWarning::FirstOrderGyroscopic { .. }
+                | StabilityWarning::ImplicitGroups { .. }
                 | StabilityWarning::InexactFreeRotation { .. }
                 | StabilityWarning::StiffRk4Rotation { .. }
         )
@@ -252,6 +272,22 @@ impl std::fmt::Display for StabilityWarning {
                     "stage"
                 } else {
                     "step"
+                }
+            ),
+            StabilityWarning::ImplicitGroups {
+                body,
+                bodies,
+                integrator,
+            } => write!(
+                f,
+                "rigid body {body}: {} in stiff spring groups, stepped by the implicit spring \
+                 solve (implicit midpoint, translation and rotation), not by `{integrator}`; \
+                 springs = `explicit` steps them with `{integrator}` at a time step small \
+                 enough for their stiffness",
+                if bodies == 1 {
+                    "alone".to_owned()
+                } else {
+                    format!("and {} more bodies", bodies - 1)
                 }
             ),
             StabilityWarning::FirstOrderGyroscopic {
@@ -442,8 +478,10 @@ pub fn check_stability(world: &mut World) -> Vec<StabilityWarning> {
             .iter()
             .fold(0.0, |m: Real, w| m.max(w.abs()));
         let h = largest * settings.dt() / settings.substeps.get() as Real;
-        let mut spins =
-            world.query_filtered::<(Entity, &MassProps, &Pose, &Velocity), With<RigidBody>>();
+        let mut spins = world.query_filtered::<
+            (Entity, &MassProps, &Pose, &Velocity),
+            (With<RigidBody>, Without<ImplicitBody>),
+        >();
         for (body, mass, transform, velocity) in spins.iter(world) {
             let principal = transform.rotation * mass.principal_frame();
             let omega = tumble_core::integrate::rotate_inv(principal, velocity.angular);
@@ -462,7 +500,10 @@ pub fn check_stability(world: &mut World) -> Vec<StabilityWarning> {
         Integrator::Lclamp | Integrator::ImplicitGyroscopic
     ) {
         let h = settings.dt() / settings.substeps.get() as Real;
-        let mut spins = world.query_filtered::<(Entity, &MassProps, &Velocity), With<RigidBody>>();
+        let mut spins = world.query_filtered::<
+            (Entity, &MassProps, &Velocity),
+            (With<RigidBody>, Without<ImplicitBody>),
+        >();
         for (body, mass, velocity) in spins.iter(world) {
             let drift = first_order_drift(
                 settings.integrator,
@@ -481,8 +522,10 @@ pub fn check_stability(world: &mut World) -> Vec<StabilityWarning> {
     }
     if settings.integrator == Integrator::Rk4 {
         let h = settings.dt() / settings.substeps.get() as Real;
-        let mut spins =
-            world.query_filtered::<(Entity, &MassProps, &Pose, &Velocity), With<RigidBody>>();
+        let mut spins = world.query_filtered::<
+            (Entity, &MassProps, &Pose, &Velocity),
+            (With<RigidBody>, Without<ImplicitBody>),
+        >();
         for (body, mass, transform, velocity) in spins.iter(world) {
             let momentum = mass
                 .world_inertia_mul(transform.rotation, velocity.angular)
@@ -500,7 +543,10 @@ pub fn check_stability(world: &mut World) -> Vec<StabilityWarning> {
         settings.integrator,
         Integrator::SymplecticEuler | Integrator::SymplecticEulerLinear
     ) {
-        let mut spins = world.query_filtered::<(Entity, &MassProps, &Velocity), With<RigidBody>>();
+        let mut spins = world.query_filtered::<
+            (Entity, &MassProps, &Velocity),
+            (With<RigidBody>, Without<ImplicitBody>),
+        >();
         for (body, mass, velocity) in spins.iter(world) {
             let omega2 =
                 velocity.angular.length_squared() * nutation_factor(mass.principal_inertia());
@@ -515,6 +561,17 @@ pub fn check_stability(world: &mut World) -> Vec<StabilityWarning> {
                 }
             }
         }
+    }
+    // The implicit solve steps these bodies, not the selected method: the checks of the method
+    // above leave them out, and this says so.
+    let mut implicit = world.query_filtered::<Entity, With<ImplicitBody>>();
+    let mut bodies = implicit.iter(world);
+    if let Some(body) = bodies.next() {
+        warnings.push(StabilityWarning::ImplicitGroups {
+            body,
+            bodies: 1 + bodies.count(),
+            integrator: settings.integrator,
+        });
     }
     warnings
 }
