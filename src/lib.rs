@@ -52,9 +52,13 @@
 //! | `bevy_app` | no | `ecs::plugin::TumblePlugin`: the step in a Bevy app's `FixedUpdate` |
 //! | `f64` | no | double precision throughout: [`math::Real`] = `f64`, `Vec3` = `DVec3`, … |
 //! | `parry-f64` | no | shapes from parry3d-f64 (implies `f64`) |
+//! | `enhanced-determinism` | no | glam's `scalar-math`: no SIMD lane order anywhere (the default build already gives the same bits; pinned checksums hold in both) |
 //!
 //! `--no-default-features` is the bare integrator layer on `bevy_ecs` and `glam` only.
 
+// docs.rs builds with `--cfg docsrs` on nightly: feature-gated items are marked with the
+// features they need.
+#![cfg_attr(docsrs, feature(doc_cfg))]
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 

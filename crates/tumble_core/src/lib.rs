@@ -14,6 +14,10 @@
 //!   `R I_b⁻¹ Rᵀ` is applied by rotating into the principal frame, never inverted numerically.
 //! - A zero principal moment locks that axis (its inverse is 0), never NaN.
 
+// docs.rs builds with `--cfg docsrs` on nightly: feature-gated items are marked with the
+// features they need.
+#![cfg_attr(docsrs, feature(doc_cfg))]
+
 pub mod damping;
 pub mod elliptic;
 pub mod error;

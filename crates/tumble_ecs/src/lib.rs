@@ -8,6 +8,9 @@
 //! whenever the world changes, a fixed-step [`FixedStepper`](stepper::FixedStepper) and
 //! validation that keeps bad data out.
 
+// docs.rs builds with `--cfg docsrs` on nightly: feature-gated items are marked with the
+// features they need.
+#![cfg_attr(docsrs, feature(doc_cfg))]
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 // ECS queries name their filters inline, as bevy itself does.

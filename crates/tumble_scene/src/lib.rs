@@ -7,6 +7,9 @@
 //! Every error names the file, the line and the field and says what was expected; nothing is
 //! built from a file that fails validation.
 
+// docs.rs builds with `--cfg docsrs` on nightly: feature-gated items are marked with the
+// features they need.
+#![cfg_attr(docsrs, feature(doc_cfg))]
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
