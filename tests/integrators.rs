@@ -5,13 +5,13 @@
 mod several_stages;
 
 mod integrators {
-    pub mod batch;
-    pub mod convergence;
-    pub mod damping;
-    pub mod exact;
-    pub mod extremes;
-    pub mod gyroscopic;
-    pub mod harness;
-    pub mod stability;
-    pub mod stages;
+    pub(crate) mod batch;
+    pub(crate) mod convergence;
+    pub(crate) mod damping;
+    pub(crate) mod exact;
+    pub(crate) mod extremes;
+    pub(crate) mod gyroscopic;
+    pub(crate) mod harness;
+    pub(crate) mod stability;
+    pub(crate) mod stages;
 }

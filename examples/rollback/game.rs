@@ -9,7 +9,7 @@ use tumble::math::{Quat, Real, Vec3};
 use tumble::prelude::*;
 
 /// The GGRS types of the game: one byte of buttons per player per frame.
-pub struct GameConfig;
+pub(super) struct GameConfig;
 
 impl Config for GameConfig {
     type Input = u8;
@@ -19,7 +19,7 @@ impl Config for GameConfig {
 }
 
 /// The world, its runner and the entities the inputs act on.
-pub struct Game {
+pub(super) struct Game {
     /// The physics world.
     pub world: World,
     runner: PhysicsRunner,
@@ -35,7 +35,7 @@ pub struct Game {
 
 /// Player `player`'s buttons at `frame`: a fixed pseudo-random pattern that changes every few
 /// frames, so that the forces vary.
-pub fn buttons(player: usize, frame: i32) -> u8 {
+pub(super) fn buttons(player: usize, frame: i32) -> u8 {
     let x = (frame as u32 / 5)
         .wrapping_mul(0x9E37_79B9)
         .wrapping_add(player as u32 * 0x85EB_CA6B);
@@ -44,7 +44,7 @@ pub fn buttons(player: usize, frame: i32) -> u8 {
 
 impl Game {
     /// Ten bodies in a chain at 60 Hz with the given integrator.
-    pub fn new(integrator: Integrator) -> Self {
+    pub(super) fn new(integrator: Integrator) -> Self {
         let mut world = World::new();
         world.insert_resource(PhysicsSettings::new(1.0 / 60.0, integrator).expect("60 Hz"));
         world.insert_resource(Gravity(Vec3::new(0.0, -9.81, 0.0)));
@@ -105,7 +105,7 @@ impl Game {
 
     /// One frame with these inputs: bits 0–2 push the player's body along ±x, +y, ±z (through
     /// its accumulator, held over the step), bits 3–5 set its thruster, bit 6 twists it.
-    pub fn advance(&mut self, inputs: &[u8]) {
+    pub(super) fn advance(&mut self, inputs: &[u8]) {
         for (player, &bits) in inputs.iter().enumerate() {
             let on = |bit: u8| if bits & (1 << bit) != 0 { 1.0 } else { 0.0 };
             let push = Vec3::new(on(0) - on(2) * 0.5, 3.0 * on(1), on(2) - 0.5 * on(0));
@@ -128,7 +128,7 @@ impl Game {
 
     /// Fulfils GGRS's requests in order: save (a snapshot and the world checksum), load
     /// (restore in place) and advance.
-    pub fn handle(&mut self, requests: Vec<GgrsRequest<GameConfig>>) {
+    pub(super) fn handle(&mut self, requests: Vec<GgrsRequest<GameConfig>>) {
         for request in requests {
             match request {
                 GgrsRequest::SaveGameState { cell, frame } => {
@@ -157,7 +157,7 @@ impl Game {
     }
 
     /// How many times the plan had to be rebuilt (a rollback should not cause any).
-    pub fn replans(&self) -> u64 {
+    pub(super) fn replans(&self) -> u64 {
         self.runner.replans()
     }
 }
@@ -165,7 +165,7 @@ impl Game {
 /// Runs `frames` frames of the game in GGRS's `SyncTestSession`, which rolls back
 /// `check_distance` frames every frame, resimulates them and fails on any checksum that differs
 /// from the first time that frame was simulated. Returns the game at the end.
-pub fn sync_test(
+pub(super) fn sync_test(
     integrator: Integrator,
     frames: i32,
     check_distance: usize,
@@ -189,7 +189,7 @@ pub fn sync_test(
 }
 
 /// The same inputs without GGRS: every frame simulated once.
-pub fn straight(integrator: Integrator, frames: i32) -> Game {
+pub(super) fn straight(integrator: Integrator, frames: i32) -> Game {
     let mut game = Game::new(integrator);
     for frame in 0..frames {
         game.advance(&[buttons(0, frame), buttons(1, frame)]);

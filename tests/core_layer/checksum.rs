@@ -13,7 +13,7 @@ use super::util::{mass_props, run, world_with};
 /// gravity with one body scaled, damping on one, at 60 Hz. The plate's small moment makes the
 /// chain stiff for the planner's `auto` spring classification under most integrators, so their
 /// checksums cover the implicit spring solve too (`yoshida4` and `exact4` step it explicitly).
-pub fn reference_world(integrator: Integrator) -> World {
+pub(crate) fn reference_world(integrator: Integrator) -> World {
     let mut world = world_with(1.0 / 60.0, integrator);
     world.insert_resource(Gravity(Vec3::new(0.0, -9.81, 0.0)));
     let mut bodies = Vec::new();

@@ -6,7 +6,7 @@ use tumble::math::{Real, Vec3, to_f64};
 use tumble::prelude::*;
 
 /// Summary of a torque-free run.
-pub struct Run {
+pub(crate) struct Run {
     /// Sign changes of the body rate about the middle principal axis (y).
     pub flips: u32,
     /// Final / initial kinetic energy − 1.
@@ -24,12 +24,12 @@ pub struct Run {
 }
 
 /// Body-frame angular velocity for a body whose principal frame is its body frame.
-pub fn body_rate(state: &BodyState) -> Vec3 {
+pub(crate) fn body_rate(state: &BodyState) -> Vec3 {
     tumble::core::integrate::rotate_inv(state.rotation, state.angular_velocity)
 }
 
 /// Runs a torque-free body with principal moments `inertia` from body rate `omega0`.
-pub fn torque_free(
+pub(crate) fn torque_free(
     integrator: Integrator,
     inertia: Vec3,
     omega0: Vec3,

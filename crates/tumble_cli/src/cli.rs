@@ -11,7 +11,7 @@ use clap::{ArgAction, Parser, Subcommand};
 /// diverged, 4 predicted unstable (refused unless --allow-unstable), 130 interrupted.
 #[derive(Parser, Debug)]
 #[command(version)]
-pub struct Cli {
+pub(crate) struct Cli {
     /// More log output on stderr: -v info, -vv debug, -vvv trace (default: warnings).
     /// `RUST_LOG` directives take precedence.
     #[arg(short, long, action = ArgAction::Count, global = true)]
@@ -26,7 +26,7 @@ pub struct Cli {
 
 /// What `tumble gen` generates.
 #[derive(Subcommand, Debug)]
-pub enum GenKind {
+pub(crate) enum GenKind {
     /// Many tumbling bodies under gravity, on a grid.
     #[command(allow_negative_numbers = true)]
     Many {
@@ -49,7 +49,7 @@ pub enum GenKind {
 
 /// The subcommands.
 #[derive(Subcommand, Debug)]
-pub enum Command {
+pub(crate) enum Command {
     /// Run a scene file (or a bundled scene by name) and print a summary.
     #[command(allow_negative_numbers = true)]
     Run(RunArgs),
@@ -96,7 +96,7 @@ pub enum Command {
 
 /// The arguments of `tumble run`.
 #[derive(clap::Args, Debug)]
-pub struct RunArgs {
+pub(crate) struct RunArgs {
     /// Scene file, or the name of a bundled scene.
     pub scene: PathBuf,
     /// Override the number of steps.

@@ -18,7 +18,7 @@ use crate::exit::{self, Failure};
 
 /// How `tumble compare` runs the two engines.
 #[derive(Debug, Clone, Copy)]
-pub struct Settings {
+pub(crate) struct Settings {
     /// tumble's integrator.
     pub integrator: Integrator,
     /// rapier's gyroscopic term.
@@ -35,7 +35,7 @@ pub struct Settings {
 /// A body that either engine quarantined, or whose state went non-finite in either engine, is
 /// named on stderr and the command fails with [`exit::REJECTED`]: its differences are not a
 /// comparison.
-pub fn run(scene: &Scene, settings: Settings) -> Result<(), Failure> {
+pub(crate) fn run(scene: &Scene, settings: Settings) -> Result<(), Failure> {
     let Settings {
         integrator,
         gyroscopic,

@@ -6,18 +6,18 @@ use std::io::Write;
 use std::process::ExitCode;
 
 /// The command did what was asked.
-pub const SUCCESS: u8 = 0;
+pub(crate) const SUCCESS: u8 = 0;
 /// An error: bad input (scene file, flag value) or I/O (unreadable scene, unwritable output).
-pub const ERROR: u8 = 1;
+pub(crate) const ERROR: u8 = 1;
 /// A usage error found by the argument parser (unknown flag, missing value).
-pub const USAGE: u8 = 2;
+pub(crate) const USAGE: u8 = 2;
 /// The run finished, but a body was rejected (quarantined) or diverged.
-pub const REJECTED: u8 = 3;
+pub(crate) const REJECTED: u8 = 3;
 /// tumble predicts the step unstable for the scene: refused unless `--allow-unstable`.
-pub const UNSTABLE: u8 = 4;
+pub(crate) const UNSTABLE: u8 = 4;
 /// Interrupted by a signal that ends the process (SIGINT, SIGTERM, SIGHUP, SIGUSR1, …: see
 /// `interrupt`; 128 + SIGINT, as shells report it); nothing was written.
-pub const INTERRUPTED: u8 = 130;
+pub(crate) const INTERRUPTED: u8 = 130;
 
 /// A failed command: the one-line message for stderr and the exit code.
 #[derive(Debug)]

@@ -14,11 +14,11 @@ use crate::interrupt;
 
 /// Most bodies `gen many` writes in TOML: [`RECORD_BYTES_BOUND`] × this, plus the header,
 /// stays under [`MAX_SCENE_BYTES`], so the file loads.
-pub const MAX_BODIES: i64 = 200_000;
+pub(crate) const MAX_BODIES: i64 = 200_000;
 
 /// Most bodies `gen many` writes in JSON: [`JSON_RECORD_BYTES_BOUND`] × this, plus the
 /// header, stays under [`MAX_JSON_SCENE_BYTES`].
-pub const MAX_JSON_BODIES: i64 = 10_000_000;
+pub(crate) const MAX_JSON_BODIES: i64 = 10_000_000;
 
 /// A bound on the bytes of one body's record in TOML: 128 bytes of fixed text, the name (`b`
 /// and up to 8 digits), three grid coordinates of at most 4 digits (the grid side is ≤ 216 at
@@ -39,7 +39,7 @@ const _: () =
     assert!(MAX_JSON_BODIES as u64 * JSON_RECORD_BYTES_BOUND + 256 <= MAX_JSON_SCENE_BYTES);
 
 /// `n` and `steps` as `gen many` accepts them for a file in `syntax`.
-pub fn check_many(n: i64, steps: i64, syntax: SceneSyntax) -> Result<(u64, u64), Failure> {
+pub(crate) fn check_many(n: i64, steps: i64, syntax: SceneSyntax) -> Result<(u64, u64), Failure> {
     let (most, limit) = match syntax {
         SceneSyntax::Toml => (MAX_BODIES, MAX_SCENE_BYTES),
         SceneSyntax::Json => (MAX_JSON_BODIES, MAX_JSON_SCENE_BYTES),
@@ -72,7 +72,7 @@ pub fn check_many(n: i64, steps: i64, syntax: SceneSyntax) -> Result<(u64, u64),
 }
 
 /// A scene of `n` bodies ([`many_body`]) in TOML; `None` when interrupted.
-pub fn many_bodies(n: u64, steps: u64, guard: &interrupt::Guard) -> Option<String> {
+pub(crate) fn many_bodies(n: u64, steps: u64, guard: &interrupt::Guard) -> Option<String> {
     let w = many_world(steps);
     let [gx, gy, gz] = w.gravity.unwrap_or_default();
     let mut text = format!(
@@ -101,7 +101,7 @@ pub fn many_bodies(n: u64, steps: u64, guard: &interrupt::Guard) -> Option<Strin
 /// Writes the scene of `n` bodies ([`many_body`]) as JSON to `out`, one body per line (so that
 /// an error in a hand-edited copy names a useful line), without holding the text. Fails with
 /// [`std::io::ErrorKind::Interrupted`] when interrupted.
-pub fn write_many_json(
+pub(crate) fn write_many_json(
     n: u64,
     steps: u64,
     guard: &interrupt::Guard,
@@ -124,7 +124,7 @@ pub fn write_many_json(
 
 /// `tumble gen many`: the scene to `out` (a file, or stdout for `None` and `-`), in `format`
 /// (default: JSON for a file name ending in `.json`, else TOML).
-pub fn run(
+pub(crate) fn run(
     n: i64,
     steps: i64,
     out: Option<&Path>,
@@ -211,7 +211,7 @@ pub fn run(
 }
 
 /// `toml` or `json`, as `--format` spells it.
-pub fn syntax_name(syntax: SceneSyntax) -> &'static str {
+pub(crate) fn syntax_name(syntax: SceneSyntax) -> &'static str {
     match syntax {
         SceneSyntax::Toml => "toml",
         SceneSyntax::Json => "json",

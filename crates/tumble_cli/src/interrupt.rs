@@ -18,7 +18,7 @@ static POLLED: AtomicBool = AtomicBool::new(false);
 
 /// Installs the handler (once, at start-up). A failure to install is logged, not fatal: the
 /// signals then keep their default action.
-pub fn install() {
+pub(crate) fn install() {
     if let Err(e) = ctrlc::set_handler(on_signal) {
         tracing::warn!("cannot handle Ctrl-C ({e}); an interrupted run may leave a temporary file");
     }
@@ -68,18 +68,18 @@ fn install_other_signals() {
 }
 
 /// While alive, a signal sets the flag instead of exiting: the holder polls [`Guard::interrupted`].
-pub struct Guard(());
+pub(crate) struct Guard(());
 
 impl Guard {
     /// Starts polling.
-    pub fn poll() -> Self {
+    pub(crate) fn poll() -> Self {
         POLLED.store(true, Ordering::SeqCst);
         Self(())
     }
 
     /// Whether a signal arrived.
     #[inline]
-    pub fn interrupted(&self) -> bool {
+    pub(crate) fn interrupted(&self) -> bool {
         INTERRUPTED.load(Ordering::Relaxed)
     }
 }

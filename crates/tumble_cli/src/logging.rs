@@ -7,7 +7,7 @@ use tracing_subscriber::filter::LevelFilter;
 
 /// The level `-v`/`-q` ask for: warnings by default, `-v` info, `-vv` debug, `-vvv` trace,
 /// `-q` errors only.
-pub fn level(verbose: u8, quiet: bool) -> LevelFilter {
+pub(crate) fn level(verbose: u8, quiet: bool) -> LevelFilter {
     match (quiet, verbose) {
         (true, _) => LevelFilter::ERROR,
         (false, 0) => LevelFilter::WARN,
@@ -19,7 +19,7 @@ pub fn level(verbose: u8, quiet: bool) -> LevelFilter {
 
 /// Installs a `fmt` subscriber on stderr: `RUST_LOG` directives (ignored where malformed) over
 /// the default level from the flags; colour only on a terminal.
-pub fn init(verbose: u8, quiet: bool) {
+pub(crate) fn init(verbose: u8, quiet: bool) {
     let level = level(verbose, quiet);
     let filter = match std::env::var("RUST_LOG") {
         Ok(directives) if !directives.trim().is_empty() => EnvFilter::builder()

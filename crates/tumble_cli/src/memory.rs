@@ -25,7 +25,7 @@ use tumble_scene::output::remove_live_temporary_files;
 use crate::exit;
 
 /// [`System`], exiting with an `error:` line when an allocation fails.
-pub struct ExitWhenExhausted;
+pub(crate) struct ExitWhenExhausted;
 
 // SAFETY: every method forwards to `System` with the caller's arguments unchanged, so `System`'s
 // guarantees hold; a null result never returns (the process exits), which the contract allows.

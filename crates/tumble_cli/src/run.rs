@@ -24,7 +24,7 @@ use globset::{GlobBuilder, GlobSet, GlobSetBuilder};
 use crate::summary::{self, Names, quarantine_line, warning_line};
 
 /// Runs longer than this many body-steps show a progress bar (when stderr is a terminal).
-pub const PROGRESS_BODY_STEPS: f64 = 1e6;
+pub(crate) const PROGRESS_BODY_STEPS: f64 = 1e6;
 
 /// Steps between two updates of the progress bar: its cost stays invisible even for one body.
 const PROGRESS_EVERY: u64 = 1024;
@@ -97,7 +97,7 @@ fn count_up_to(
 }
 
 /// `tumble run`.
-pub fn run(args: RunArgs) -> Result<(), Failure> {
+pub(crate) fn run(args: RunArgs) -> Result<(), Failure> {
     let every = u64::try_from(args.every)
         .ok()
         .and_then(NonZeroU64::new)
@@ -436,7 +436,7 @@ fn select_bodies(
 
 /// The estimated CSV size: `(rows, bytes per row)`, the row size a bound for the usual
 /// magnitudes (see [`VALUE_BYTES`]).
-pub fn csv_estimate(built: &BuiltScene, steps: u64, record: &Recording) -> (u64, u64) {
+pub(crate) fn csv_estimate(built: &BuiltScene, steps: u64, record: &Recording) -> (u64, u64) {
     let recorded = steps / record.every.get() + 1;
     let bodies: Vec<&String> = match &record.bodies {
         None => built.bodies.iter().map(|(n, _)| n).collect(),
@@ -517,7 +517,11 @@ fn human_bytes(bytes: u64) -> String {
 /// Prints the planning-time predictions, naming bodies and springs; refuses a world predicted to
 /// diverge unless `allow` (then the run is energy-audited, so that a divergence is caught while
 /// the state is still finite). Precision warnings are printed and do not refuse the run.
-pub fn stability_gate(built: &mut BuiltScene, names: &Names, allow: bool) -> Result<(), Failure> {
+pub(crate) fn stability_gate(
+    built: &mut BuiltScene,
+    names: &Names,
+    allow: bool,
+) -> Result<(), Failure> {
     let warnings = check_stability(&mut built.world);
     for line in warning_lines(&warnings, names, tracing::enabled!(tracing::Level::INFO)) {
         tracing::warn!(target: "tumble", "{line}");

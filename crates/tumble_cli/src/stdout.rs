@@ -7,7 +7,7 @@ use std::io::{self, Write};
 use crate::exit::{self, Failure};
 
 /// The failure for a write to standard output that did not happen.
-pub fn failed(e: &io::Error) -> Failure {
+pub(crate) fn failed(e: &io::Error) -> Failure {
     Failure::new(
         exit::ERROR,
         format!("writing to standard output failed: {e}"),
@@ -15,12 +15,12 @@ pub fn failed(e: &io::Error) -> Failure {
 }
 
 /// Writes `text` to standard output and flushes it.
-pub fn print(text: &str) -> Result<(), Failure> {
+pub(crate) fn print(text: &str) -> Result<(), Failure> {
     write_all(&mut io::stdout().lock(), text).map_err(|e| failed(&e))
 }
 
 /// Writes `text` to `out` and flushes it.
-pub fn write_all(out: &mut impl Write, text: &str) -> io::Result<()> {
+pub(crate) fn write_all(out: &mut impl Write, text: &str) -> io::Result<()> {
     out.write_all(text.as_bytes())?;
     out.flush()
 }

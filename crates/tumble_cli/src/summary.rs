@@ -15,7 +15,7 @@ use tumble_scene::text::terminal_safe;
 /// Compact for a million bodies (about 20 bytes a body): the names are kept in one string and
 /// looked up by a binary search over the entities, and a message is formatted only when one is
 /// printed.
-pub struct Names {
+pub(crate) struct Names {
     /// `(entity, start, end)` of each body's name in `text`, sorted by entity.
     bodies: Vec<(Entity, u32, u32)>,
     /// Every body name, one after the other.
@@ -28,7 +28,7 @@ impl Names {
     /// Names for `world`, whose bodies are `bodies` (`(name, entity)` in file order). Force
     /// generators were spawned in file order after the bodies, so their entity order is the
     /// file order.
-    pub fn new(world: &mut World, bodies: &[(String, Entity)]) -> Self {
+    pub(crate) fn new(world: &mut World, bodies: &[(String, Entity)]) -> Self {
         let mut text = String::with_capacity(bodies.iter().map(|(name, _)| name.len()).sum());
         let mut spans = Vec::with_capacity(bodies.len());
         for (name, e) in bodies {
@@ -69,7 +69,7 @@ impl Names {
     }
 
     /// The name of `entity`, or its id when it is not part of the scene.
-    pub fn of(&self, entity: Entity) -> String {
+    pub(crate) fn of(&self, entity: Entity) -> String {
         if let Ok(i) = self.bodies.binary_search_by_key(&entity, |&(e, _, _)| e) {
             let (_, start, end) = self.bodies[i];
             return format!(
@@ -85,7 +85,7 @@ impl Names {
 }
 
 /// A planning-time warning, naming the body or spring as the scene does.
-pub fn warning_line(warning: &StabilityWarning, names: &Names) -> String {
+pub(crate) fn warning_line(warning: &StabilityWarning, names: &Names) -> String {
     let subject = warning.subject();
     let text = warning.to_string();
     // `Display` starts with the entity ("spring 12v0: …"); say the scene's name instead.
@@ -94,7 +94,12 @@ pub fn warning_line(warning: &StabilityWarning, names: &Names) -> String {
 }
 
 /// A quarantined body: which, when, why, and the last valid state it keeps.
-pub fn quarantine_line(error: &BodyError, step: u64, world: &World, names: &Names) -> String {
+pub(crate) fn quarantine_line(
+    error: &BodyError,
+    step: u64,
+    world: &World,
+    names: &Names,
+) -> String {
     let kept = match (
         world.get::<Pose>(error.entity),
         world.get::<Velocity>(error.entity),
@@ -128,7 +133,7 @@ fn quaternion(q: [tumble_core::math::Real; 4]) -> String {
 /// Total mechanical energy (J, f64): kinetic `Σ ½m|v|² + ½ωᵀIω`, elastic `Σ ½k(|d| − L₀)²` of
 /// the springs, and gravitational `−Σ m s g·x` (centre of mass; zero at the origin), and the
 /// total angular momentum about the origin `Σ (x × m v + I ω)`.
-pub fn totals(world: &mut World) -> (f64, DVec3) {
+pub(crate) fn totals(world: &mut World) -> (f64, DVec3) {
     let g = world
         .get_resource::<Gravity>()
         .map_or(DVec3::ZERO, |g| g.0.widen());
@@ -170,7 +175,7 @@ pub fn totals(world: &mut World) -> (f64, DVec3) {
 }
 
 /// Which totals a world conserves, and why not where it does not.
-pub struct Conserved {
+pub(crate) struct Conserved {
     /// `None` when the mechanical energy is conserved, else what changes it.
     pub energy: Option<&'static str>,
     /// `None` when the angular momentum about the origin is conserved, else what changes it.
@@ -180,7 +185,7 @@ pub struct Conserved {
 /// What the world's contents allow: damping (of bodies or springs) removes energy, constant
 /// forces and torques do work; gravity keeps the energy (it is counted) but turns the momentum,
 /// as do springs to fixed points and constant loads.
-pub fn conserved(world: &mut World) -> Conserved {
+pub(crate) fn conserved(world: &mut World) -> Conserved {
     let damped_bodies = world
         .query::<&Damping>()
         .iter(world)
@@ -226,7 +231,7 @@ pub fn conserved(world: &mut World) -> Conserved {
 
 /// `after` against `before` in words: the relative drift, or the absolute change from zero.
 /// Never prints NaN or infinity without saying why.
-pub fn drift(before: f64, after: f64, unit: &str) -> String {
+pub(crate) fn drift(before: f64, after: f64, unit: &str) -> String {
     if !(before.is_finite() && after.is_finite()) {
         return format!("not finite ({before:e} → {after:e} {unit}): a body's state overflowed");
     }

@@ -118,7 +118,7 @@ impl Comparison {
 }
 
 /// An exact solution: the state of body `i` at time `t`, when the scene has one.
-pub type ExactSolution<'a> = &'a dyn Fn(usize, f64) -> Option<BodyState>;
+pub(crate) type ExactSolution<'a> = &'a dyn Fn(usize, f64) -> Option<BodyState>;
 
 /// Runs `scene` in both engines for `options.steps` steps, recording after every step the
 /// largest per-body differences (and errors against `exact`, where it knows the body).

@@ -19,7 +19,7 @@ use crate::validate::Locate;
 /// Where the JSON text can be read again to locate a field: the scene is parsed once, as a
 /// stream, and the text is scanned a second time only when an error must be located.
 #[derive(Debug, Clone, Copy)]
-pub enum JsonSource<'a> {
+pub(crate) enum JsonSource<'a> {
     /// Text in memory.
     Text(&'a [u8]),
     /// A file, opened again when needed.
@@ -71,7 +71,7 @@ impl Locate for JsonSource<'_> {
 /// The parse tracks no field path: `serde_path_to_error` allocates every key it passes, which
 /// tripled the time of a million-body load. A document that fails is parsed again from
 /// `source` with the path tracked, to name the field.
-pub fn parse(
+pub(crate) fn parse(
     file: &str,
     mut input: impl BufRead,
     source: JsonSource<'_>,

@@ -12,7 +12,7 @@ use std::io::{BufRead, BufReader, Read};
 
 /// One step of a path into a JSON document.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Step<'a> {
+pub(crate) enum Step<'a> {
     /// The member of an object with this key.
     Key(&'a str),
     /// The element of an array at this index.
@@ -21,7 +21,7 @@ pub enum Step<'a> {
 
 /// The 1-based line of the deepest part of `path` found in the JSON read from `input`: the
 /// line of the last key or array element on the path that exists, or of the document's start.
-pub fn line_of(input: impl Read, path: &[Step<'_>]) -> usize {
+pub(crate) fn line_of(input: impl Read, path: &[Step<'_>]) -> usize {
     let mut scan = Scanner::new(input);
     scan.skip_space();
     let mut line = scan.line;
@@ -36,7 +36,7 @@ pub fn line_of(input: impl Read, path: &[Step<'_>]) -> usize {
 
 /// The text of the number at `path` in the JSON read from `input`, as written; `None` when the
 /// path is not there or holds no number.
-pub fn number_at(input: impl Read, path: &[Step<'_>]) -> Option<String> {
+pub(crate) fn number_at(input: impl Read, path: &[Step<'_>]) -> Option<String> {
     let mut scan = Scanner::new(input);
     scan.skip_space();
     for step in path {
@@ -58,7 +58,7 @@ pub fn number_at(input: impl Read, path: &[Step<'_>]) -> Option<String> {
 /// The key and line of the first member of the object at `path` whose value is an array of
 /// `len` elements: `serde_json` reports an array of the wrong length inside an internally
 /// tagged object (`forces`) with the object's path only.
-pub fn array_member_of_len(
+pub(crate) fn array_member_of_len(
     input: impl Read,
     path: &[Step<'_>],
     len: usize,

@@ -8,7 +8,7 @@ use tumble_core::math::{REAL_NAME, Real, Vec3};
 use crate::error::SceneError;
 
 /// The 1-based line holding byte offset `at` of `text`.
-pub fn line_at(text: &str, at: usize) -> usize {
+pub(crate) fn line_at(text: &str, at: usize) -> usize {
     let at = at.min(text.len());
     1 + text.as_bytes()[..at]
         .iter()
@@ -19,7 +19,7 @@ pub fn line_at(text: &str, at: usize) -> usize {
 /// The 1-based line of the longest dotted key (a header `[a.b.c]` or a key `a.b.c = …`): where
 /// a reader's error without a position ("recursion limit", a key path nested too deep) arose.
 /// Dots inside quoted key parts and everything after `=` or `#` are not counted.
-pub fn line_of_longest_key(text: &str) -> usize {
+pub(crate) fn line_of_longest_key(text: &str) -> usize {
     let mut deepest = (0, 1);
     for (i, line) in text.lines().enumerate() {
         let mut dots = 0;
@@ -44,7 +44,7 @@ pub fn line_of_longest_key(text: &str) -> usize {
 /// tables), from the spans of the parsed document, so that headers with comments, inline tables,
 /// dotted and quoted keys and multi-line strings are all located correctly. Falls back to the
 /// table (or element), then to line 1.
-pub fn line_of(text: &str, table: &str, index: Option<usize>, key: &str) -> usize {
+pub(crate) fn line_of(text: &str, table: &str, index: Option<usize>, key: &str) -> usize {
     let Ok(doc) = DeTable::parse(text) else {
         return 1;
     };
@@ -65,7 +65,7 @@ pub fn line_of(text: &str, table: &str, index: Option<usize>, key: &str) -> usiz
 
 /// The text of the number at `table[index].key` (`key` at the top level without a table), as
 /// written; `None` when it is not a number or not there.
-pub fn number_literal_of(
+pub(crate) fn number_literal_of(
     text: &str,
     table: Option<&str>,
     index: Option<usize>,
@@ -99,7 +99,7 @@ fn number_text(value: &DeValue<'_>) -> Option<String> {
 
 /// Whether the number written as `literal` is not zero but reads as 0 in `f64` (`1e-400`):
 /// a reader rounds it to 0 without a word, and a check of the 0 must say why it saw 0.
-pub fn underflows_f64(literal: &str) -> bool {
+pub(crate) fn underflows_f64(literal: &str) -> bool {
     let digits: String = literal.chars().filter(|&c| c != '_').collect();
     let mantissa = digits.split(['e', 'E']).next().unwrap_or("");
     digits.parse::<f64>().is_ok_and(|x| x == 0.0)
@@ -108,7 +108,7 @@ pub fn underflows_f64(literal: &str) -> bool {
 
 /// The dotted path (e.g. `bodies[1].mass`) of the deepest key or value whose span holds byte
 /// offset `at`, or `None` when the text does not parse or no key is there.
-pub fn path_at(text: &str, at: usize) -> Option<String> {
+pub(crate) fn path_at(text: &str, at: usize) -> Option<String> {
     let doc = DeTable::parse(text).ok()?;
     let mut path = String::new();
     table_path(doc.get_ref(), at, &mut path).then_some(path)
@@ -150,7 +150,7 @@ fn value_path(value: &DeValue<'_>, at: usize, path: &mut String) -> bool {
 /// (`[[forces]]`) is reported by toml at the table's header, because serde buffers tagged
 /// tables; the offending array is the first one of that length in the table, hence the first
 /// after the header.
-pub fn array_of_len_after(text: &str, from: usize, len: usize) -> Option<usize> {
+pub(crate) fn array_of_len_after(text: &str, from: usize, len: usize) -> Option<usize> {
     fn search(
         value: &toml::Spanned<DeValue<'_>>,
         from: usize,
@@ -184,7 +184,7 @@ pub fn array_of_len_after(text: &str, from: usize, len: usize) -> Option<usize> 
 /// key inside an internally tagged table (`[[forces]]`, also under a deeply nested header such
 /// as `[forces.x.y.z]`) at the table's header; the key itself is the first of that name after
 /// it.
-pub fn key_after(text: &str, from: usize, name: &str) -> Option<usize> {
+pub(crate) fn key_after(text: &str, from: usize, name: &str) -> Option<usize> {
     fn search(table: &DeTable<'_>, from: usize, name: &str, best: &mut Option<usize>) {
         for (k, v) in table.iter() {
             let start = k.span().start;
@@ -210,7 +210,7 @@ pub fn key_after(text: &str, from: usize, name: &str) -> Option<usize> {
 }
 
 /// Finds the line of a field in a scene's text, for an error message.
-pub trait Locate {
+pub(crate) trait Locate {
     /// The 1-based line of `table[index].key` (`table.key` without an index, the top-level
     /// `key` without a table); 0 when no line can be told.
     fn line(&self, table: Option<&str>, index: Option<usize>, key: &str) -> usize;
@@ -229,7 +229,7 @@ pub trait Locate {
 }
 
 /// TOML text.
-pub struct TomlText<'a>(pub &'a str);
+pub(crate) struct TomlText<'a>(pub &'a str);
 
 impl Locate for TomlText<'_> {
     fn line(&self, table: Option<&str>, index: Option<usize>, key: &str) -> usize {
@@ -258,7 +258,7 @@ impl Locate for TomlText<'_> {
 }
 
 /// No text to point into (settings given apart from a file): errors name no line.
-pub struct NoText;
+pub(crate) struct NoText;
 
 impl Locate for NoText {
     fn line(&self, _: Option<&str>, _: Option<usize>, _: &str) -> usize {
@@ -267,7 +267,7 @@ impl Locate for NoText {
 }
 
 /// Context for the checks of one scene: the file name and where its fields stand.
-pub struct Checker<'a> {
+pub(crate) struct Checker<'a> {
     /// File name for messages.
     pub file: &'a str,
     /// Finds the line of a field.
@@ -276,7 +276,7 @@ pub struct Checker<'a> {
 
 impl Checker<'_> {
     /// An error at `table[index].key`.
-    pub fn error(
+    pub(crate) fn error(
         &self,
         table: &str,
         index: Option<usize>,
@@ -293,7 +293,7 @@ impl Checker<'_> {
     }
 
     /// An error at the top-level key `key` (e.g. the scene `name`).
-    pub fn top_error(&self, key: &str, message: impl Into<String>) -> SceneError {
+    pub(crate) fn top_error(&self, key: &str, message: impl Into<String>) -> SceneError {
         let line = self.locate.line(None, None, key);
         let message = self.with_underflow(None, None, key, message.into());
         SceneError::at(self.file, line, key, message)
@@ -319,7 +319,7 @@ impl Checker<'_> {
     }
 
     /// A finite number that fits in the engine precision ([`Real`]).
-    pub fn scalar(
+    pub(crate) fn scalar(
         &self,
         table: &str,
         index: Option<usize>,
@@ -363,7 +363,7 @@ impl Checker<'_> {
     }
 
     /// A vector of finite [`Real`] numbers.
-    pub fn vec3(
+    pub(crate) fn vec3(
         &self,
         table: &str,
         index: Option<usize>,

@@ -26,7 +26,7 @@ fn atan_reduced(t: f64) -> f64 {
 }
 
 /// `atan x` for every finite `x` (NaN gives NaN, `±∞` gives `±π/2`).
-pub fn atan(x: f64) -> f64 {
+pub(crate) fn atan(x: f64) -> f64 {
     let (sign, a) = if x < 0.0 { (-1.0, -x) } else { (1.0, x) };
     let (base, a) = if a > 1.0 {
         (FRAC_PI_2, -1.0 / a)
@@ -45,7 +45,7 @@ pub fn atan(x: f64) -> f64 {
 }
 
 /// `atan2(y, x)` in `(−π, π]`, from [`atan`].
-pub fn atan2(y: f64, x: f64) -> f64 {
+pub(crate) fn atan2(y: f64, x: f64) -> f64 {
     if x > 0.0 {
         atan(y / x)
     } else if x < 0.0 {

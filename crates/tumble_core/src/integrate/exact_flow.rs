@@ -435,7 +435,7 @@ impl Moving {
 /// The exact torque-free flow over `h` of the principal orientation `Q` and body momentum `m` of
 /// `body`, given the reciprocal principal moments `r` (`0` on a locked axis); see the module docs.
 /// `L = Q m` is unchanged, and so are `E` and `|m|`, to round-off.
-pub fn exact_free_flow(body: &mut FreeBody, r: DVec3, h: f64) {
+pub(super) fn exact_free_flow(body: &mut FreeBody, r: DVec3, h: f64) {
     if is_steady(body.m, r) {
         return steady_flow(body, r, h);
     }
@@ -449,7 +449,7 @@ pub fn exact_free_flow(body: &mut FreeBody, r: DVec3, h: f64) {
 /// (square roots, divisions, the Landen levels; see
 /// [`jacobi_sn_cn_dn_complement_pair`]). Bodies off the common path (steady, or a span that is
 /// not short) take it one by one.
-pub fn exact_free_flow_pair(bodies: [&mut FreeBody; 2], r: [DVec3; 2], h: f64) {
+pub(super) fn exact_free_flow_pair(bodies: [&mut FreeBody; 2], r: [DVec3; 2], h: f64) {
     let [a, b] = bodies;
     if is_steady(a.m, r[0]) || is_steady(b.m, r[1]) {
         exact_free_flow(a, r[0], h);

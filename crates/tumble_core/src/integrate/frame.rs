@@ -21,7 +21,7 @@ pub(crate) fn reciprocal<T: Lane>(moment: T) -> T {
 /// `q v q* / |q|²` in f64: `((w² − b·b) v + 2 (b·v) b + 2w (b × v)) / (w² + b·b)`, `q = (b, w)`;
 /// a rotation even when `q` is not exactly unit.
 #[inline]
-pub fn rotate64(q: DQuat, v: DVec3) -> DVec3 {
+pub(super) fn rotate64(q: DQuat, v: DVec3) -> DVec3 {
     let b = DVec3::new(q.x, q.y, q.z);
     let w = q.w;
     let b2 = b.dot(b);
@@ -51,14 +51,14 @@ pub fn rotate_inv(q: Quat, v: Vec3) -> Vec3 {
 
 /// Orientation of the principal axes in the world: `Q = q P`.
 #[inline]
-pub fn principal_orientation(state: &BodyState, mass: &MassProperties) -> Quat {
+pub(super) fn principal_orientation(state: &BodyState, mass: &MassProperties) -> Quat {
     crate::math::quat_mul(state.rotation, mass.principal_frame())
 }
 
 /// Removes the angular velocity about locked principal axes (zero moment ⇒ no rotation about
 /// that axis), for methods that update `ω` directly rather than through `L`.
 #[inline]
-pub fn clear_locked_axes(state: &mut BodyState, mass: &MassProperties) {
+pub(super) fn clear_locked_axes(state: &mut BodyState, mass: &MassProperties) {
     if !mass.has_locked_axis() {
         return;
     }

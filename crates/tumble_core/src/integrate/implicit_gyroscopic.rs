@@ -29,7 +29,7 @@ fn skew(a: Vec3) -> Mat3 {
 
 /// One Newton step of the implicit gyroscopic update, in the principal frame.
 #[inline]
-pub fn implicit_gyroscopic_rate(omega: Vec3, inertia: Vec3, dt: Real) -> Vec3 {
+pub(super) fn implicit_gyroscopic_rate(omega: Vec3, inertia: Vec3, dt: Real) -> Vec3 {
     let momentum = inertia * omega;
     let residual = dt * omega.cross(momentum);
     let jacobian = Mat3::from_diagonal(inertia)
@@ -44,7 +44,7 @@ pub fn implicit_gyroscopic_rate(omega: Vec3, inertia: Vec3, dt: Real) -> Vec3 {
 
 /// One step of the `implicit-gyroscopic` method.
 #[inline]
-pub fn implicit_gyroscopic(
+pub(super) fn implicit_gyroscopic(
     state: &mut BodyState,
     mass: &MassProperties,
     wrench: &Wrench,

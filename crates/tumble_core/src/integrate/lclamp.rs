@@ -19,7 +19,7 @@ use crate::state::{BodyState, Wrench};
 
 /// One step of the `lclamp` method.
 #[inline]
-pub fn lclamp(state: &mut BodyState, mass: &MassProperties, wrench: &Wrench, dt: Real) {
+pub(super) fn lclamp(state: &mut BodyState, mass: &MassProperties, wrench: &Wrench, dt: Real) {
     state.linear_velocity += (dt * mass.inv_mass()) * wrench.force;
     state.position += dt * state.linear_velocity;
     let q = principal_orientation(state, mass);

@@ -21,7 +21,7 @@ fn quat_rate(q: DQuat, momentum: DVec3, r: DVec3) -> DQuat {
 
 /// One RK4 step of the free rotation over `h` at constant world momentum.
 #[inline]
-pub fn rk4_free_flow(body: &mut FreeBody, r: DVec3, h: f64) {
+pub(super) fn rk4_free_flow(body: &mut FreeBody, r: DVec3, h: f64) {
     let momentum = rotate64(body.q, body.m);
     let q = body.q;
     let k1 = quat_rate(q, momentum, r);

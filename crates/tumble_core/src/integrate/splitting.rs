@@ -63,7 +63,7 @@ use crate::state::{BodyState, Wrench};
 /// The state a free flow advances: principal orientation `Q` (principal → world) and body
 /// momentum `m = Qᵀ L`, both f64.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct FreeBody {
+pub(super) struct FreeBody {
     /// Principal orientation `Q`.
     pub q: DQuat,
     /// Body momentum `m` in the principal frame.
@@ -74,7 +74,7 @@ impl FreeBody {
     /// Rotates the body by `angle` about its principal axis `axis` (0, 1, 2): `Q ← Q exp(θ eₐ)`,
     /// and the body momentum the opposite way, `m ← exp(−θ eₐ) m`, so `L = Q m` is unchanged.
     #[inline]
-    pub fn rotate_about_axis(&mut self, axis: usize, angle: f64) {
+    pub(super) fn rotate_about_axis(&mut self, axis: usize, angle: f64) {
         // tumble's own sine and cosine: the same bits on every platform.
         let (s, c) = super::sin_cos(0.5 * angle);
         // cos θ and sin θ from the half angle: one sin_cos per rotation.
@@ -98,7 +98,7 @@ impl FreeBody {
 
     /// Exact flow of `½ k mₐ²` for time `h`: rotation about axis `a` by `h k mₐ`.
     #[inline]
-    pub fn axis_flow(&mut self, axis: usize, k: f64, h: f64) {
+    pub(super) fn axis_flow(&mut self, axis: usize, k: f64, h: f64) {
         if k != 0.0 {
             self.rotate_about_axis(axis, h * k * self.m[axis]);
         }
@@ -107,11 +107,11 @@ impl FreeBody {
 
 /// A free-flow approximation over `h`, given the reciprocal principal moments `r = 1/I_b`
 /// (0 on locked axes).
-pub type FreeFlow = fn(&mut FreeBody, DVec3, f64);
+pub(super) type FreeFlow = fn(&mut FreeBody, DVec3, f64);
 
 /// Strang splitting 1-2-3-2-1 of the free flow over `h` (`splitting-xyz`).
 #[inline]
-pub fn strang_free_flow(body: &mut FreeBody, r: DVec3, h: f64) {
+pub(super) fn strang_free_flow(body: &mut FreeBody, r: DVec3, h: f64) {
     let half = 0.5 * h;
     body.axis_flow(0, r.x, half);
     body.axis_flow(1, r.y, half);
@@ -122,13 +122,13 @@ pub fn strang_free_flow(body: &mut FreeBody, r: DVec3, h: f64) {
 
 /// The rotational part of a drift over `h` at constant world `L`, after the kick `L += J` of the
 /// angular impulse `J` (world frame; zero in a phase without a kick): a method's free rotation.
-pub type Rotation = fn(&mut BodyState, &MassProperties, Real, Vec3);
+pub(super) type Rotation = fn(&mut BodyState, &MassProperties, Real, Vec3);
 
 /// The free rotation of the `splitting` method over `h`: spherical bodies exactly about `ω`
 /// (`ω ∥ L` for them), the others through the lane kernel of the module `symmetric_kernel` —
 /// the same code the batched step runs, so one body gets the same bits alone or in a batch.
 #[inline]
-pub fn rotate_symmetric(state: &mut BodyState, mass: &MassProperties, h: Real) {
+pub(super) fn rotate_symmetric(state: &mut BodyState, mass: &MassProperties, h: Real) {
     if mass.is_spherical() {
         state.rotation = rotate_exact(state.rotation, state.angular_velocity, h);
         return;
@@ -141,7 +141,7 @@ pub fn rotate_symmetric(state: &mut BodyState, mass: &MassProperties, h: Real) {
 /// the kernel folds `J` into the body momentum (see `symmetric_kernel`); a spherical body takes
 /// it as `ω += I⁻¹ J` first, as every other method does.
 #[inline]
-pub fn rotate_symmetric_kicked(
+pub(super) fn rotate_symmetric_kicked(
     state: &mut BodyState,
     mass: &MassProperties,
     h: Real,
@@ -160,7 +160,7 @@ pub fn rotate_symmetric_kicked(
 
 /// The rotational part of a drift: the free flow over `h` at constant world `L`.
 #[inline]
-pub fn rotate_freely(state: &mut BodyState, mass: &MassProperties, h: Real, flow: FreeFlow) {
+pub(super) fn rotate_freely(state: &mut BodyState, mass: &MassProperties, h: Real, flow: FreeFlow) {
     if mass.is_spherical() {
         state.rotation = rotate_exact(state.rotation, state.angular_velocity, h);
         return;

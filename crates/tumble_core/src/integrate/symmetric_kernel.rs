@@ -31,9 +31,9 @@ use crate::mass::MassProperties;
 use crate::math::{Narrow, Quat, Real, Vec3, Widen};
 
 /// A quaternion `(x, y, z, w)` in lanes.
-pub type Quat4<T> = [T; 4];
+pub(super) type Quat4<T> = [T; 4];
 /// A vector in lanes.
-pub type Vec3L<T> = [T; 3];
+pub(super) type Vec3L<T> = [T; 3];
 
 /// Hamilton product `a b`.
 #[inline(always)]
@@ -155,7 +155,7 @@ impl<T: Lane> Free<T> {
 
 /// Inputs of the kernel for one body (`T = f64`) or a run of bodies (a [`Run`] type).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct SymmetricInput<T = f64> {
+pub(super) struct SymmetricInput<T = f64> {
     /// Body orientation `q`.
     pub rotation: Quat4<T>,
     /// World angular velocity `ω`.
@@ -195,7 +195,7 @@ impl SymmetricInput {
     /// Builds the inputs for one body, relabelled so that its odd axis is `x` (see the module
     /// documentation).
     #[inline]
-    pub fn new(rotation: Quat, omega: Vec3, mass: &MassProperties) -> Self {
+    pub(super) fn new(rotation: Quat, omega: Vec3, mass: &MassProperties) -> Self {
         let f = mass.principal_frame().widen();
         let (q, w) = (rotation.widen(), omega.widen());
         Self {
@@ -210,7 +210,7 @@ impl SymmetricInput {
 
     /// The same inputs after a kick of angular impulse `impulse` (world frame).
     #[inline]
-    pub fn with_impulse(self, impulse: Vec3) -> Self {
+    pub(super) fn with_impulse(self, impulse: Vec3) -> Self {
         let j = impulse.widen();
         Self {
             impulse: [j.x, j.y, j.z],
@@ -223,13 +223,13 @@ impl SymmetricInput {
 /// body `i`), in the engine precision: the kernel loads each component of all bodies with one
 /// vector load and widens it with one vector conversion (every value is exact in `Real`, the
 /// relabelling's `0, ±½, 1` included).
-pub type LaneInputs = SymmetricInput<[Real; LANES]>;
+pub(super) type LaneInputs = SymmetricInput<[Real; LANES]>;
 
 impl LaneInputs {
     /// Puts one body's inputs into lane `lane` (what [`SymmetricInput::new`] and
     /// [`with_impulse`](SymmetricInput::with_impulse) make of them).
     #[inline(always)]
-    pub fn set(
+    pub(super) fn set(
         &mut self,
         lane: usize,
         rotation: Quat,
@@ -267,7 +267,7 @@ impl LaneInputs {
 
     /// The inputs in lane `lane`.
     #[inline(always)]
-    pub fn get(&self, lane: usize) -> SymmetricInput {
+    pub(super) fn get(&self, lane: usize) -> SymmetricInput {
         SymmetricInput {
             rotation: self.rotation.map(|c| c[lane].widen()),
             omega: self.omega.map(|c| c[lane].widen()),
@@ -281,7 +281,7 @@ impl LaneInputs {
     /// Copies lane 0 into lanes `from..LANES` (the filler of a partial batch; lanes are
     /// independent, so any valid input will do).
     #[inline(always)]
-    pub fn fill_from_first(&mut self, from: usize) {
+    pub(super) fn fill_from_first(&mut self, from: usize) {
         let fill = |c: &mut [Real; LANES]| {
             let first = c[0];
             c[from..].fill(first);
@@ -381,7 +381,7 @@ impl<T: Lane> Flowing<T> {
 /// inputs' angular impulse when `kicks`: returns the new orientation (unit, f64) and world
 /// angular velocity. See the module documentation for the sequence.
 #[inline(always)]
-pub fn symmetric_rotation<T: Lane>(
+pub(super) fn symmetric_rotation<T: Lane>(
     input: &SymmetricInput<T>,
     h: T,
     kicks: bool,
@@ -429,7 +429,7 @@ pub(super) fn to_real(q: [f64; 4], w: [f64; 3]) -> (Quat, Vec3) {
 /// One body through the kernel (`f64` lanes), after the kick of its impulse when `kicks`: the
 /// new `(q, ω)`, rounded to the engine precision once.
 #[inline]
-pub fn rotate_symmetric_one(input: &SymmetricInput, h: Real, kicks: bool) -> (Quat, Vec3) {
+pub(super) fn rotate_symmetric_one(input: &SymmetricInput, h: Real, kicks: bool) -> (Quat, Vec3) {
     let (q, w) = symmetric_rotation::<f64>(input, h.widen(), kicks);
     to_real(q, w)
 }
@@ -439,7 +439,7 @@ pub fn rotate_symmetric_one(input: &SymmetricInput, h: Real, kicks: bool) -> (Qu
 /// bodies with one vector store, and a reader that picks one body's scalars out of them is
 /// served by store forwarding (four scalar stores read back as one vector stall instead).
 #[derive(Debug, Clone, Copy)]
-pub struct RotatedLanes {
+pub(super) struct RotatedLanes {
     /// New orientations: `rotation[k][i]` is component `k` (x, y, z, w) of body `i`.
     pub rotation: [[Real; LANES]; 4],
     /// New world angular velocities: `omega[k][i]` is component `k` of body `i`.
@@ -449,7 +449,7 @@ pub struct RotatedLanes {
 impl RotatedLanes {
     /// Body `i`'s new orientation and world angular velocity.
     #[inline(always)]
-    pub fn lane(&self, i: usize) -> (Quat, Vec3) {
+    pub(super) fn lane(&self, i: usize) -> (Quat, Vec3) {
         let [qx, qy, qz, qw] = &self.rotation;
         let [wx, wy, wz] = &self.omega;
         (
@@ -466,7 +466,7 @@ impl RotatedLanes {
 // loops (three of them, one per phase) it bloats them past what the instruction cache and the
 // register allocator handle well; one call per eight bodies costs nothing in comparison.
 #[inline(never)]
-pub fn rotate_symmetric_lanes(
+pub(super) fn rotate_symmetric_lanes(
     kernel: Kernel,
     inputs: &LaneInputs,
     h: [Real; LANES],

@@ -27,7 +27,7 @@ use crate::state::{BodyState, Wrench};
 /// scales a vector by `|q|²`, one ulp off unity) never touches `ω` itself: a torque-free spin
 /// about a principal axis keeps its rate to the bit.
 #[inline]
-pub fn explicit_gyroscopic_kick(
+pub(super) fn explicit_gyroscopic_kick(
     state: &mut BodyState,
     mass: &MassProperties,
     torque: Vec3,
@@ -51,7 +51,12 @@ fn linear_kick_drift(state: &mut BodyState, mass: &MassProperties, force: Vec3, 
 
 /// One step of the textbook symplectic Euler method with the exact rotation update.
 #[inline]
-pub fn symplectic_euler(state: &mut BodyState, mass: &MassProperties, wrench: &Wrench, dt: Real) {
+pub(super) fn symplectic_euler(
+    state: &mut BodyState,
+    mass: &MassProperties,
+    wrench: &Wrench,
+    dt: Real,
+) {
     linear_kick_drift(state, mass, wrench.force, dt);
     explicit_gyroscopic_kick(state, mass, wrench.torque, dt);
     clear_locked_axes(state, mass);
@@ -60,7 +65,7 @@ pub fn symplectic_euler(state: &mut BodyState, mass: &MassProperties, wrench: &W
 
 /// One step of symplectic Euler with the linearized rotation update `q += ½Δt (ω,0) q`.
 #[inline]
-pub fn symplectic_euler_linear(
+pub(super) fn symplectic_euler_linear(
     state: &mut BodyState,
     mass: &MassProperties,
     wrench: &Wrench,

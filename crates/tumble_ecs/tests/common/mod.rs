@@ -8,7 +8,7 @@ use tumble_ecs::prelude::*;
 /// Ties `bodies` into a chain of springs of stiffness `k`: the first from its point
 /// `(-0.1, 0.05, 0)` to the world point `wall` (rest length 0.8 m), then each from its point
 /// `(0.1, 0.05, 0)` to the point `next_anchor` of the next (rest length `rest`).
-pub fn tie_chain(
+pub(crate) fn tie_chain(
     world: &mut World,
     bodies: &[Entity],
     wall: Vec3,
@@ -37,7 +37,7 @@ pub fn tie_chain(
 
 /// Spawns a body of unit mass with principal moments `inertia` at `position` and `rotation`,
 /// moving at `v` and turning at `w`.
-pub fn unit_body(
+pub(crate) fn unit_body(
     world: &mut World,
     position: Vec3,
     rotation: Quat,

@@ -5,7 +5,7 @@ use tumble_core::Integrator;
 
 /// `(integrator, substeps)` settings whose step runs more than one stage: `yoshida4`'s
 /// composition (its backward stage included), substeps of the plain step, and both at once.
-pub const SEVERAL_STAGES: [(Integrator, u32); 5] = [
+pub(crate) const SEVERAL_STAGES: [(Integrator, u32); 5] = [
     (Integrator::Yoshida4, 1),
     (Integrator::Splitting, 3),
     (Integrator::Splitting, 4),
