@@ -106,7 +106,7 @@ pub struct RunnerCheckCost {
     pub step: f64,
 }
 
-/// A target of issue #7 and whether this run met it.
+/// A speed target of the project and whether this run met it.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Target {
     /// What is measured.
@@ -164,7 +164,7 @@ pub struct BenchResults {
     pub rollback: Vec<rollback::RollbackRow>,
     /// Trajectory CSV writing throughput.
     pub csv: Vec<csv::CsvRow>,
-    /// The targets of issue #7 and of the stiff-springs issue.
+    /// The project's speed targets, free bodies and springs.
     pub targets: Vec<Target>,
 }
 

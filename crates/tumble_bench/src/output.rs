@@ -1,4 +1,4 @@
-//! The benchmark's outputs: a markdown table, the targets of issue #7, JSON, and the README
+//! The benchmark's outputs: a markdown table, the project's speed targets, JSON, and the README
 //! section.
 
 use std::fmt::Write;
@@ -35,8 +35,8 @@ fn target(name: &str, value: f64, relation: &str, bound: f64) -> Target {
     }
 }
 
-/// Evaluates the targets on the measured rows (those whose sizes were measured): issue #7's,
-/// with the bounds issue #19 raised where it states them.
+/// Evaluates the project's speed targets on the measured rows (those whose sizes were
+/// measured).
 pub fn targets(results: &BenchResults) -> Vec<Target> {
     let mut out = Vec::new();
     for integrator in [DEFAULT, "symplectic-euler"] {

@@ -83,89 +83,68 @@ pub enum PhysicsSet {
     Integrate,
 }
 
-/// One system of the physics step.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Stage {
-    /// [`hold_game_loads`].
-    HoldGameLoads,
-    /// [`audit_energy_start`].
-    AuditEnergyStart,
-    /// [`damp_springs_start`]: the spring dampers' flow over the first half step.
-    DampSpringsStart,
-    /// [`begin_stage`].
-    BeginStage,
-    /// [`apply_gravity`].
-    Gravity,
-    /// [`apply_constant_forces`].
-    ConstantForces,
-    /// [`apply_constant_torques`].
-    ConstantTorques,
-    /// [`apply_springs`].
-    Springs,
-    /// [`audit_external_loads`].
-    AuditExternalLoads,
-    /// [`solve_implicit_springs`].
-    SolveImplicitSprings,
-    /// [`integrate_with_forces`].
-    IntegrateWithForces,
-    /// [`integrate_without_forces`].
-    IntegrateWithoutForces,
-    /// [`discard_fixed_body_forces`].
-    DiscardFixedBodyForces,
-    /// [`damp_springs_end`]: the spring dampers' flow over the second half step, in reverse
-    /// order.
-    DampSpringsEnd,
-    /// [`audit_energy`].
-    AuditEnergy,
-    /// [`next_stage`].
-    NextStage,
+/// Declares [`Stage`] from one list, in the order a step runs the systems, each variant with its
+/// doc and its system's name: the order ([`Stage::ALL`]) and the names ([`Stage::name`]) are
+/// made from the same list and cannot drift apart.
+macro_rules! stages {
+    ($($(#[doc = $doc:expr])* $variant:ident => $name:literal,)*) => {
+        /// One system of the physics step.
+        #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+        pub enum Stage {
+            $($(#[doc = $doc])* $variant,)*
+        }
+
+        impl Stage {
+            /// Every stage, in the order a step runs them.
+            pub const ALL: [Stage; [$($name),*].len()] = [$(Stage::$variant),*];
+
+            /// How many stages there are (a plan holds each at most once).
+            pub const COUNT: usize = Self::ALL.len();
+
+            /// The system's name.
+            pub fn name(self) -> &'static str {
+                match self {
+                    $(Stage::$variant => $name,)*
+                }
+            }
+        }
+    };
 }
 
-impl Stage {
-    /// Every stage, in the order a step runs them.
-    pub const ALL: [Stage; 16] = [
-        Stage::HoldGameLoads,
-        Stage::AuditEnergyStart,
-        Stage::DampSpringsStart,
-        Stage::BeginStage,
-        Stage::Gravity,
-        Stage::ConstantForces,
-        Stage::ConstantTorques,
-        Stage::AuditExternalLoads,
-        Stage::Springs,
-        Stage::SolveImplicitSprings,
-        Stage::IntegrateWithForces,
-        Stage::IntegrateWithoutForces,
-        Stage::DiscardFixedBodyForces,
-        Stage::DampSpringsEnd,
-        Stage::AuditEnergy,
-        Stage::NextStage,
-    ];
-
-    /// How many stages there are (a plan holds each at most once).
-    pub const COUNT: usize = Self::ALL.len();
-
-    /// The system's name.
-    pub fn name(self) -> &'static str {
-        match self {
-            Stage::HoldGameLoads => "hold_game_loads",
-            Stage::NextStage => "next_stage",
-            Stage::AuditEnergyStart => "audit_energy_start",
-            Stage::AuditExternalLoads => "audit_external_loads",
-            Stage::AuditEnergy => "audit_energy",
-            Stage::DampSpringsStart => "damp_springs_start",
-            Stage::DampSpringsEnd => "damp_springs_end",
-            Stage::BeginStage => "begin_stage",
-            Stage::Gravity => "apply_gravity",
-            Stage::ConstantForces => "apply_constant_forces",
-            Stage::ConstantTorques => "apply_constant_torques",
-            Stage::Springs => "apply_springs",
-            Stage::SolveImplicitSprings => "solve_implicit_springs",
-            Stage::IntegrateWithForces => "integrate_with_forces",
-            Stage::IntegrateWithoutForces => "integrate_without_forces",
-            Stage::DiscardFixedBodyForces => "discard_fixed_body_forces",
-        }
-    }
+stages! {
+    /// [`hold_game_loads`].
+    HoldGameLoads => "hold_game_loads",
+    /// [`audit_energy_start`].
+    AuditEnergyStart => "audit_energy_start",
+    /// [`damp_springs_start`]: the spring dampers' flow over the first half step.
+    DampSpringsStart => "damp_springs_start",
+    /// [`begin_stage`].
+    BeginStage => "begin_stage",
+    /// [`apply_gravity`].
+    Gravity => "apply_gravity",
+    /// [`apply_constant_forces`].
+    ConstantForces => "apply_constant_forces",
+    /// [`apply_constant_torques`].
+    ConstantTorques => "apply_constant_torques",
+    /// [`audit_external_loads`].
+    AuditExternalLoads => "audit_external_loads",
+    /// [`apply_springs`].
+    Springs => "apply_springs",
+    /// [`solve_implicit_springs`].
+    SolveImplicitSprings => "solve_implicit_springs",
+    /// [`integrate_with_forces`].
+    IntegrateWithForces => "integrate_with_forces",
+    /// [`integrate_without_forces`].
+    IntegrateWithoutForces => "integrate_without_forces",
+    /// [`discard_fixed_body_forces`].
+    DiscardFixedBodyForces => "discard_fixed_body_forces",
+    /// [`damp_springs_end`]: the spring dampers' flow over the second half step, in reverse
+    /// order.
+    DampSpringsEnd => "damp_springs_end",
+    /// [`audit_energy`].
+    AuditEnergy => "audit_energy",
+    /// [`next_stage`].
+    NextStage => "next_stage",
 }
 
 /// Which systems a world needs, decided from its resources and entities.
