@@ -33,7 +33,7 @@ fn a_write_error_half_way_leaves_every_old_file() {
     for name in ["report.md", "results.json", "plot.svg"] {
         std::fs::write(dir.path().join(name), format!("old {name}")).unwrap();
     }
-    let status = Command::new("sh")
+    let child = Command::new("sh")
         .arg("-c")
         .arg(format!(
             "trap '' XFSZ; ulimit -f {LIMIT_BLOCKS} && exec \"$0\" \"$@\""
@@ -41,9 +41,17 @@ fn a_write_error_half_way_leaves_every_old_file() {
         .arg(std::env::current_exe().unwrap())
         .args(["--exact", "child_writes_past_the_limit", "--nocapture"])
         .env(CHILD_DIR, dir.path())
-        .status()
+        // Pipes, not the parent's stdout and stderr: those may be files (a CI log) already
+        // past the child's size limit, and the harness's own output would fail there.
+        .output()
         .unwrap();
-    assert!(status.success(), "the child failed: {status}");
+    assert!(
+        child.status.success(),
+        "the child failed: {}\n{}{}",
+        child.status,
+        String::from_utf8_lossy(&child.stdout),
+        String::from_utf8_lossy(&child.stderr)
+    );
     for name in ["report.md", "results.json", "plot.svg"] {
         let text = std::fs::read_to_string(dir.path().join(name)).unwrap();
         assert_eq!(text, format!("old {name}"));
