@@ -12,16 +12,17 @@ use tumble_scene::text::terminal_safe;
 /// Names of a built scene's entities: bodies by their `name`, force generators as
 /// `forces[i] (kind)` in file order.
 ///
-/// Compact for a million bodies (about 20 bytes a body): the names are kept in one string and
-/// looked up by a binary search over the entities, and a message is formatted only when one is
-/// printed.
+/// Compact for a million bodies (about 20 bytes a body, 24 a force): the names are kept in one
+/// string and looked up by a binary search over the entities, and a message (a force's name
+/// too) is formatted only when one is printed.
 pub(crate) struct Names {
     /// `(entity, start, end)` of each body's name in `text`, sorted by entity.
     bodies: Vec<(Entity, u32, u32)>,
     /// Every body name, one after the other.
     text: String,
-    /// `(entity, name)` of each force generator, sorted by entity.
-    forces: Vec<(Entity, String)>,
+    /// `(entity, index in the file, kind)` of each force generator, sorted by entity; its
+    /// name is formatted when printed.
+    forces: Vec<(Entity, usize, &'static str)>,
 }
 
 impl Names {
@@ -55,12 +56,12 @@ impl Names {
             })
             .collect();
         forces.sort_by_key(|(e, _)| e.index());
-        let mut forces: Vec<(Entity, String)> = forces
+        let mut forces: Vec<(Entity, usize, &'static str)> = forces
             .into_iter()
             .enumerate()
-            .map(|(i, (e, kind))| (e, format!("forces[{i}] ({kind})")))
+            .map(|(i, (e, kind))| (e, i, kind))
             .collect();
-        forces.sort_unstable_by_key(|(e, _)| *e);
+        forces.sort_unstable_by_key(|&(e, _, _)| e);
         Self {
             bodies: spans,
             text,
@@ -77,8 +78,11 @@ impl Names {
                 terminal_safe(&self.text[start as usize..end as usize])
             );
         }
-        match self.forces.binary_search_by_key(&entity, |(e, _)| *e) {
-            Ok(i) => self.forces[i].1.clone(),
+        match self.forces.binary_search_by_key(&entity, |&(e, _, _)| e) {
+            Ok(i) => {
+                let (_, index, kind) = self.forces[i];
+                format!("forces[{index}] ({kind})")
+            }
             Err(_) => format!("entity {entity}"),
         }
     }

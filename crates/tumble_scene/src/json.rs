@@ -43,13 +43,18 @@ impl JsonSource<'_> {
     }
 }
 
+/// The path of `table[index].key` (`key` at the top level without a table).
+fn field_path<'a>(table: Option<&'a str>, index: Option<usize>, key: &'a str) -> Vec<Step<'a>> {
+    let mut path = Vec::with_capacity(3);
+    path.extend(table.map(Step::Key));
+    path.extend(index.map(Step::Index));
+    path.push(Step::Key(key));
+    path
+}
+
 impl Locate for JsonSource<'_> {
     fn line(&self, table: Option<&str>, index: Option<usize>, key: &str) -> usize {
-        let mut path = Vec::with_capacity(3);
-        path.extend(table.map(Step::Key));
-        path.extend(index.map(Step::Index));
-        path.push(Step::Key(key));
-        JsonSource::line(self, &path)
+        JsonSource::line(self, &field_path(table, index, key))
     }
 
     fn number_literal(
@@ -58,11 +63,7 @@ impl Locate for JsonSource<'_> {
         index: Option<usize>,
         key: &str,
     ) -> Option<String> {
-        let mut path = Vec::with_capacity(3);
-        path.extend(table.map(Step::Key));
-        path.extend(index.map(Step::Index));
-        path.push(Step::Key(key));
-        number_at(self.open()?, &path)
+        number_at(self.open()?, &field_path(table, index, key))
     }
 }
 
