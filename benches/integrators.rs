@@ -7,6 +7,7 @@
 mod common;
 
 use criterion::{BenchmarkId, Criterion, Throughput};
+use tumble::core::integrate::{ExactSwitch, FreeFlow};
 use tumble::math::{Quat, Real, Vec3};
 
 use tumble::prelude::*;
@@ -69,6 +70,38 @@ fn step_all(c: &mut Criterion) {
                 b.iter(|| it.try_step_many(&mut states, &masses, &wrenches, 1.0 / 60.0));
             },
         );
+    }
+    // What the default free-flow check (`FreeFlow::Auto`) costs a body that keeps the split:
+    // the same batch with and without the switch, on bodies turning slowly enough that none
+    // switches (a third of the rates above).
+    let slow: Vec<BodyState> = states0
+        .iter()
+        .map(|s| BodyState {
+            angular_velocity: s.angular_velocity / 3.0,
+            ..*s
+        })
+        .collect();
+    let switch = ExactSwitch::new(Integrator::Splitting, FreeFlow::Auto, 1.0 / 60.0);
+    assert!(
+        slow.iter()
+            .zip(&masses)
+            .all(|(s, m)| !switch.unwrap().applies(s, m)),
+        "a body of the slow set would switch"
+    );
+    for (name, switch) in [("split", None), ("auto", switch)] {
+        group.bench_with_input(BenchmarkId::new("free_flow", name), &switch, |b, &sw| {
+            let mut states = slow.clone();
+            let wrenches = vec![Wrench::ZERO; n];
+            b.iter(|| {
+                Integrator::Splitting.try_step_many_switched(
+                    &mut states,
+                    &masses,
+                    &wrenches,
+                    1.0 / 60.0,
+                    sw,
+                )
+            });
+        });
     }
     group.finish();
 }

@@ -37,6 +37,10 @@
 //! derive macros name the crate `bevy_ecs` in the code they generate, so the re-export alone
 //! does not satisfy them.
 //!
+//! The guide (stepping, forces, springs, integrators, precision, determinism, the CLI, coming
+//! from avian or bevy_rapier, architecture) is in the repository's `docs/` directory, starting
+//! at `docs/README.md`.
+//!
 //! The crates: [`core`] (ECS-free math: state, mass properties, integrators, invariants) and
 //! [`ecs`] (components, systems, schedule). `glam`, `bevy_ecs` (and `parry3d` with the `parry`
 //! feature) are re-exported so versions always match.
@@ -86,3 +90,32 @@ pub mod prelude {
 #[doc = include_str!("../README.md")]
 #[cfg(doctest)]
 pub struct ReadmeDoctests;
+
+/// The guide's pages (`docs/`), their code blocks compiled and run as doc tests as the README's.
+#[cfg(doctest)]
+pub mod guide {
+    #[doc = include_str!("../docs/README.md")]
+    pub struct Index;
+    #[doc = include_str!("../docs/getting-started.md")]
+    pub struct GettingStarted;
+    #[doc = include_str!("../docs/stepping.md")]
+    pub struct Stepping;
+    #[doc = include_str!("../docs/forces.md")]
+    pub struct Forces;
+    #[doc = include_str!("../docs/springs.md")]
+    pub struct Springs;
+    #[doc = include_str!("../docs/integrators.md")]
+    pub struct Integrators;
+    #[doc = include_str!("../docs/precision.md")]
+    pub struct Precision;
+    #[doc = include_str!("../docs/determinism.md")]
+    pub struct Determinism;
+    #[doc = include_str!("../docs/cli.md")]
+    pub struct Cli;
+    #[doc = include_str!("../docs/performance.md")]
+    pub struct Performance;
+    #[doc = include_str!("../docs/coming-from.md")]
+    pub struct ComingFrom;
+    #[doc = include_str!("../docs/architecture.md")]
+    pub struct Architecture;
+}

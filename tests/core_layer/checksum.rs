@@ -180,33 +180,33 @@ fn pinned_checksums_of_the_reference_scene() {
 
 /// `f32` build (the default), with or without `enhanced-determinism`.
 const PINNED_F32: &[(&str, &str)] = &[
-    ("symplectic-euler", "1188b4ebf8952090bddbf32c201b87ed"),
+    ("symplectic-euler", "6203f683c01c96497bc936bcf95576d5"),
     (
         "symplectic-euler-linear",
-        "2f369ba1189950c1d4d1350576113394",
+        "426088e9a7039195e24fd304b33aa0d3",
     ),
-    ("lclamp", "f904b0983051068cf5988fc69beebc04"),
-    ("implicit-gyroscopic", "c642afbbef0a15d3698e14c057657091"),
-    ("splitting", "f9fd9ca67f02e12c3c5b40c93144f6b4"),
-    ("splitting-xyz", "c1e3530830711662d92212ac5957782a"),
+    ("lclamp", "7f6fc4b6512ecac289177f6e1708e66f"),
+    ("implicit-gyroscopic", "81cba1b220337d5c24bea0728914a51e"),
+    ("splitting", "eeb058f6046b0250a9c2196d0a8f8f6c"),
+    ("splitting-xyz", "16c8135b2e93689eeb2b58f040adfe40"),
     ("yoshida4", "ea227359d32e9094363db7a11b72e5f9"),
-    ("rk4", "9ab00cc60d57f129ed7cfa1c95ac9658"),
-    ("exact", "1c092be99e8f510715258f754dda1331"),
+    ("rk4", "e24f60f5f31faa6ae826fbaf9a985f3e"),
+    ("exact", "b288e9da6775bed14a971a5a097ae68d"),
     ("exact4", "2bcecce17b7e2aeb0ea173aacb683fbd"),
 ];
 /// `f64` build (with or without `enhanced-determinism`).
 const PINNED_F64: &[(&str, &str)] = &[
-    ("symplectic-euler", "d586e8092b90f976189b0b2867c03317"),
+    ("symplectic-euler", "5d51b24cd17df80ebd71491a54b6fff6"),
     (
         "symplectic-euler-linear",
-        "3be8d0dfdc8ece9e992fb4f3c3757fc3",
+        "8cd25156427d5ebc5a854fb51078f39e",
     ),
-    ("lclamp", "23a4deef6aaa4bb9e3e87b2c7f92aee0"),
-    ("implicit-gyroscopic", "ccf835346065b14500f1125168b7e1d2"),
-    ("splitting", "e9dea2bdb3962308aadf82252890d9bc"),
-    ("splitting-xyz", "6f016ffb8cb56fab17320850b1c2ebea"),
+    ("lclamp", "959f32e892a9619403e6c67af92a5a2d"),
+    ("implicit-gyroscopic", "da15a928ce3daaab0e31b6e0502057cc"),
+    ("splitting", "3ea9451fb452b3378549ed287c76ab76"),
+    ("splitting-xyz", "86629318f710c3f9589280c0a6d92f18"),
     ("yoshida4", "7fe2f6c503ece11d652ab72ea66c6776"),
-    ("rk4", "9bc8eafc089fc03c33d4ccce8d1829e0"),
-    ("exact", "f80a11da387fdf854f7f601485262e09"),
+    ("rk4", "3138f3acede4e34068719489b384b997"),
+    ("exact", "27efdba6df9e29a331625eb52d9afe84"),
     ("exact4", "1babf66e140375a74f7b561db2b2b869"),
 ];

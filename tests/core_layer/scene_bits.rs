@@ -162,11 +162,11 @@ const PINNED_F32: &[(&str, &str)] = &[
     ),
     (
         "splitting",
-        "e353864171ef74cc9c27c3c9200c0267 6463827a1f6b967584dadfe4adb8b816 261bc0725855f88309790a8cd3c44cd9",
+        "24d0eb56dec2733e6863e59ff4d4f51f 90ae1159d9710b80814d822cc4294d37 8701984ebda259a83b09d76a179e7669",
     ),
     (
         "splitting-xyz",
-        "20d272be221de2659c43b64a727cf3dc 08dc4c0ed52984d879f03eb18e51f0ea 673dc11d6dbfbbd2f92327ab97cd6c62",
+        "8014c0d258c2db0bf0ec18ce029b81de 200f4188448f36f0b7e004a640267c47 dd8876b49d7c603644476130b8aa92ec",
     ),
     (
         "yoshida4",
@@ -205,11 +205,11 @@ const PINNED_F64: &[(&str, &str)] = &[
     ),
     (
         "splitting",
-        "569a23bab6e87aab4e2ba47f1f703fcc 595b8ab7307f8e09f65ef5b92a464239 87e9e99924b5aad8482b0e8413daeaaa",
+        "7e31b771ee3ca695e79190a170e1a984 19b2ec993a3b4a5cecbbfb1549daef7f 26ec8e0f081fc66051c5bb2402389ec3",
     ),
     (
         "splitting-xyz",
-        "916567aea1f1dec13df104cb5a2b870b 178c8bd36bd2b9d0baf3e394b39e86da f3c02099497fbeb0c880986d50180c9d",
+        "e30414cc787b6fad76727aff4155dae1 e6ca56697bd65fe6732502bd0a981a32 57aa7f6cb3aa60d0ae27f8e2937f50b7",
     ),
     (
         "yoshida4",

@@ -3,6 +3,7 @@
 //! rapier 0.36.
 
 use std::sync::Mutex;
+use tumble_core::integrate::{ExactSwitch, FreeFlow};
 use tumble_core::math::{Real, Vec3};
 
 use tumble_core::{BodyState, Integrator, MassProperties, Wrench};
@@ -59,10 +60,18 @@ impl RawLoop {
 impl Engine for RawLoop {
     fn step(&mut self) {
         let (integrator, dt) = (self.integrator, self.dt);
+        // The free-flow switch a world's step makes by default (`FreeFlow::Auto`), so that the
+        // raw loop does the ECS's work and ECS/raw stays the cost of the layer alone.
+        let switch = ExactSwitch::new(integrator, FreeFlow::Auto, dt);
         let threads = self.parallelism.threads_for(self.states.len());
         if threads <= 1 {
-            let diverged =
-                integrator.try_step_many(&mut self.states, &self.masses, &self.wrenches, dt);
+            let diverged = integrator.try_step_many_switched(
+                &mut self.states,
+                &self.masses,
+                &self.wrenches,
+                dt,
+                switch,
+            );
             assert!(diverged.is_empty(), "benchmark bodies stay finite");
             return;
         }
@@ -77,7 +86,9 @@ impl Engine for RawLoop {
             for ((states, masses), wrenches) in parts {
                 let diverged = &diverged;
                 spawn(Box::new(move || {
-                    let bad = integrator.try_step_many(states, masses, wrenches, dt).len();
+                    let bad = integrator
+                        .try_step_many_switched(states, masses, wrenches, dt, switch)
+                        .len();
                     *diverged.lock().unwrap_or_else(|p| p.into_inner()) += bad;
                 }));
             }

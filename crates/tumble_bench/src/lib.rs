@@ -27,8 +27,7 @@ use tumble_core::math::Vec3;
 use serde::{Deserialize, Serialize};
 use tumble_core::{Integrator, KernelPath};
 use tumble_ecs::parallel::{Parallelism, pool_threads};
-use tumble_scene::output::{OutputError, OutputSet, print_to_stdout};
-use tumble_scene::text::path_for_terminal;
+use tumble_scene::output::{OutputSet, print_to_stdout, with_sections};
 
 use crate::engines::{Ecs, Engine, Rapier, RawLoop, RunnerCheck};
 use crate::machines::RunSummary;
@@ -55,7 +54,7 @@ pub struct BenchOptions {
     pub out: Option<PathBuf>,
     /// Also replace this run's section of this markdown file (between `<!-- <name>:begin -->`
     /// and `<!-- <name>:end -->`) and the table of every run's targets (`bench-targets`),
-    /// e.g. README.md.
+    /// e.g. `docs/performance.md`.
     #[arg(long)]
     pub readme: Option<PathBuf>,
 }
@@ -430,7 +429,7 @@ pub fn run_and_write(options: &BenchOptions) -> Result<(), Box<dyn std::error::E
         None => Vec::new(),
     };
     if let Some(readme) = &options.readme {
-        updated_readme(readme, &name, "", "")?;
+        with_sections(readme, &[(&name, ""), (machines::SUMMARY_NAME, "")])?;
         OutputSet::check(readme)?;
     }
     let results = run_bench(options, |line| eprintln!("… {line}"));
@@ -456,7 +455,11 @@ pub fn run_and_write(options: &BenchOptions) -> Result<(), Box<dyn std::error::E
         let section = output::readme_section(&results);
         files.add(
             readme,
-            updated_readme(readme, &name, &section, &summary)?.as_bytes(),
+            with_sections(
+                readme,
+                &[(&name, &section), (machines::SUMMARY_NAME, &summary)],
+            )?
+            .as_bytes(),
         )?;
     }
     files.commit()?;
@@ -469,24 +472,4 @@ fn widest_kernel_path() -> String {
     KernelPath::available()
         .last()
         .map_or("portable".to_owned(), |p| p.to_string())
-}
-
-/// The text of `readme` with this run's section (`name`) and the targets of every run replaced.
-fn updated_readme(
-    readme: &std::path::Path,
-    name: &str,
-    section: &str,
-    summary: &str,
-) -> Result<String, Box<dyn std::error::Error>> {
-    let mut updated = std::fs::read_to_string(readme).map_err(|e| OutputError::io(readme, e))?;
-    for (section_name, section) in [(name, section), (machines::SUMMARY_NAME, summary)] {
-        updated = tumble_scene::text::replace_between_markers(&updated, section_name, section)
-            .ok_or_else(|| {
-                format!(
-                    "{}: no <!-- {section_name}:begin --> … <!-- {section_name}:end --> markers",
-                    path_for_terminal(readme)
-                )
-            })?;
-    }
-    Ok(updated)
 }

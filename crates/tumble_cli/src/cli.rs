@@ -75,6 +75,11 @@ pub(crate) enum Command {
         /// `implicit` (default: the scene's `[world] springs`, else `auto`).
         #[arg(long)]
         springs: Option<OsString>,
+        /// Which free rotation tumble's split integrators give each body: `auto` (the exact
+        /// flow for a body while the split errs by more than 1 % a step) or `method` (default:
+        /// the scene's `[world] free_flow`, else `auto`).
+        #[arg(long)]
+        free_flow: Option<OsString>,
         /// How springs are built in rapier: `joint` (its `SpringJoint`, force-based model: what a
         /// rapier user picks; implicit, loses energy) or `force` (the spring force added with
         /// `add_force_at_point` every step: explicit, gains energy, diverges when stiff).
@@ -113,6 +118,11 @@ pub(crate) struct RunArgs {
     /// or `implicit`.
     #[arg(long)]
     pub springs: Option<OsString>,
+    /// Override which free rotation a split integrator (`splitting`, `splitting-xyz`,
+    /// `yoshida4`) gives each body: `auto` (the exact flow for a body while the split errs by
+    /// more than 1 % a step, said on stderr) or `method` (the integrator's own, for every body).
+    #[arg(long)]
+    pub free_flow: Option<OsString>,
     /// Override the substeps per step (1 to 1000): the forces are sampled in each.
     #[arg(long, allow_hyphen_values = true)]
     pub substeps: Option<i64>,

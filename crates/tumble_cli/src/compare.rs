@@ -5,7 +5,7 @@ use std::fmt::Write as _;
 use glam::DQuat;
 use tumble_core::math::{Narrow, Quat, Real, Vec3, Widen, to_f64};
 use tumble_core::{BodyState, Integrator};
-use tumble_ecs::prelude::SpringSolver;
+use tumble_ecs::prelude::{FreeFlow, SpringSolver};
 use tumble_rapier::{
     Comparison, ComparisonBody, ComparisonOptions, ComparisonScene, ComparisonSpring,
     ComparisonSpringEnd, Load, RapierSprings, compare,
@@ -27,6 +27,8 @@ pub(crate) struct Settings {
     pub springs: SpringSolver,
     /// rapier's springs: its `SpringJoint` or a force added by hand.
     pub rapier_springs: RapierSprings,
+    /// tumble's choice of free rotation for split methods.
+    pub free_flow: FreeFlow,
 }
 
 /// Builds the comparison and prints, per body, the largest difference to rapier and to the
@@ -41,6 +43,7 @@ pub(crate) fn run(scene: &Scene, settings: Settings) -> Result<(), Failure> {
         gyroscopic,
         springs,
         rapier_springs,
+        free_flow,
     } = settings;
     let comparison = comparison_scene(scene);
     let mut sprung = vec![false; comparison.bodies.len()];
@@ -109,6 +112,7 @@ pub(crate) fn run(scene: &Scene, settings: Settings) -> Result<(), Failure> {
         steps: scene.steps().min(1_000_000) as usize,
         springs,
         rapier_springs,
+        free_flow,
     };
     let result = compare(&comparison, &options, Some(&exact));
     let (tumble_springs, rapier_springs) = if comparison.springs.is_empty() {

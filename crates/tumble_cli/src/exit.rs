@@ -1,5 +1,5 @@
-//! Exit codes, in one place (the README's CLI section has the same table), and the error type
-//! every command returns.
+//! Exit codes, in one place (the guide's CLI page, `docs/cli.md`, has the same table), and the
+//! error type every command returns.
 
 use std::fmt;
 use std::io::Write;

@@ -244,11 +244,13 @@ fn dispatch(cli: Cli) -> Result<(), Failure> {
             integrator,
             gyroscopic,
             springs,
+            free_flow,
             rapier_springs,
             allow_unstable,
         } => {
             let integrator = integrator.map(|v| utf8("--integrator", v)).transpose()?;
             let springs = springs.map(|v| utf8("--springs", v)).transpose()?;
+            let free_flow = free_flow.map(|v| utf8("--free-flow", v)).transpose()?;
             let rapier_springs: tumble_rapier::RapierSprings =
                 utf8("--rapier-springs", rapier_springs)?.parse().map_err(
                     |e: tumble_rapier::UnknownRapierSprings| format!("--rapier-springs: {e}"),
@@ -269,6 +271,12 @@ fn dispatch(cli: Cli) -> Result<(), Failure> {
                     .map_err(|e: String| format!("--springs: {}", terminal_safe(&e)))?,
                 None => scene.settings().springs,
             };
+            let free_flow = match free_flow {
+                Some(name) => name
+                    .parse()
+                    .map_err(|e: String| format!("--free-flow: {}", terminal_safe(&e)))?,
+                None => scene.settings().free_flow,
+            };
             // The same planning-time predictions as `run`, for tumble's side of the comparison.
             let mut built = scene.build();
             {
@@ -277,6 +285,7 @@ fn dispatch(cli: Cli) -> Result<(), Failure> {
                     .resource_mut::<tumble_ecs::prelude::PhysicsSettings>();
                 settings.integrator = integrator;
                 settings.springs = springs;
+                settings.free_flow = free_flow;
             }
             let names = summary::Names::new(&mut built.world, &built.bodies);
             run::stability_gate(&mut built, &names, allow_unstable)?;
@@ -285,6 +294,7 @@ fn dispatch(cli: Cli) -> Result<(), Failure> {
                 gyroscopic: gyroscopic == "on",
                 springs,
                 rapier_springs,
+                free_flow,
             };
             compare::run(&scene, settings)
         }

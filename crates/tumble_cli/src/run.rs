@@ -43,6 +43,7 @@ fn override_error(
     steps: Option<u64>,
     integrator: bool,
     springs: bool,
+    free_flow: bool,
     substeps: bool,
 ) -> Failure {
     let flag = match e.field.as_str() {
@@ -50,6 +51,7 @@ fn override_error(
         "world.steps" if steps.is_some() => "--steps",
         "world.integrator" if integrator => "--integrator",
         "world.springs" if springs => "--springs",
+        "world.free_flow" if free_flow => "--free-flow",
         "world.substeps" if substeps => "--substeps",
         _ => return e.into(),
     };
@@ -77,6 +79,46 @@ fn stages_line(world: &World) -> Option<String> {
         settings.integrator,
         spans.join(", ")
     ))
+}
+
+/// Which method steps which bodies, as `--plan` prints it: the integrator, and the bodies the
+/// planner gives another step now (the exact free flow of a split method under
+/// `free_flow = auto`, the implicit spring solve for stiff spring groups), with the first of
+/// each by name.
+fn methods_line(world: &mut World, names: &Names) -> String {
+    let Some(settings) = world.get_resource::<PhysicsSettings>().copied() else {
+        return String::new();
+    };
+    let mut out = format!(
+        "method: `{}` (free flow `{}`)",
+        settings.integrator, settings.free_flow
+    );
+    for warning in tumble_ecs::stability::check_stability(world) {
+        match warning {
+            StabilityWarning::ExactFreeFlow { body, bodies, .. } => out.push_str(&format!(
+                "; {bodies} {} the exact free flow (`{}`) now, first {}",
+                if bodies == 1 {
+                    "body takes"
+                } else {
+                    "bodies take"
+                },
+                settings
+                    .integrator
+                    .exact_counterpart()
+                    .map_or("exact", |m| m.name()),
+                names.of(body)
+            )),
+            StabilityWarning::ImplicitGroups { body, bodies, .. } => out.push_str(&format!(
+                "; {bodies} {} in stiff spring groups, stepped by the implicit spring solve, \
+                 first {}",
+                if bodies == 1 { "body" } else { "bodies" },
+                names.of(body)
+            )),
+            _ => {}
+        }
+    }
+    out.push('\n');
+    out
 }
 
 /// The count given to `flag`, if any, checked to be in `1..=max`: an error `flag: expected 1
@@ -116,6 +158,10 @@ pub(crate) fn run(args: RunArgs) -> Result<(), Failure> {
         .springs
         .map(|v| crate::utf8("--springs", v))
         .transpose()?;
+    let free_flow = args
+        .free_flow
+        .map(|v| crate::utf8("--free-flow", v))
+        .transpose()?;
     let substeps = count_up_to("--substeps", args.substeps, MAX_SUBSTEPS.into(), "substeps")?;
     let patterns = args
         .bodies
@@ -129,6 +175,7 @@ pub(crate) fn run(args: RunArgs) -> Result<(), Failure> {
         || args.dt.is_some()
         || integrator.is_some()
         || springs.is_some()
+        || free_flow.is_some()
         || substeps.is_some()
     {
         // Overrides are applied to the world settings, then validated like the file's.
@@ -139,6 +186,8 @@ pub(crate) fn run(args: RunArgs) -> Result<(), Failure> {
         world.integrator = integrator.or(world.integrator);
         let springs_overridden = springs.is_some();
         world.springs = springs.or(world.springs);
+        let free_flow_overridden = free_flow.is_some();
+        world.free_flow = free_flow.or(world.free_flow);
         world.substeps = substeps.or(world.substeps);
         scene = scene.with_world(world).map_err(|e| {
             override_error(
@@ -147,6 +196,7 @@ pub(crate) fn run(args: RunArgs) -> Result<(), Failure> {
                 steps,
                 overridden,
                 springs_overridden,
+                free_flow_overridden,
                 substeps.is_some(),
             )
         })?;
@@ -159,6 +209,8 @@ pub(crate) fn run(args: RunArgs) -> Result<(), Failure> {
         if let Some(line) = stages_line(&built.world) {
             out.push_str(&format!("{line}\n"));
         }
+        let names = Names::new(&mut built.world, &built.bodies);
+        out.push_str(&methods_line(&mut built.world, &names));
         return crate::stdout::print(&out);
     }
     let record = Recording {
@@ -167,17 +219,30 @@ pub(crate) fn run(args: RunArgs) -> Result<(), Failure> {
             .map(|p| select_bodies(&p, &built.bodies))
             .transpose()?,
     };
+    let to_stdout = args.out.as_deref().is_some_and(crate::is_stdout);
+    // Created before the output file, dropped after it: a second signal while the temporary
+    // file is being removed cannot cut that short.
+    let guard = interrupt::Guard::poll();
+    // The output is checked (its place, the free space there) before anything is said about
+    // the run: a run that cannot be written fails with its one error line, and fast.
+    let mut out_file = match args.out.as_deref() {
+        Some(path) if !to_stdout => {
+            let inputs: Vec<&Path> = loaded.path.as_deref().into_iter().collect();
+            let file = OutputFile::create(path, &inputs)?;
+            if !args.force {
+                check_free_space(&file, &built, steps, &record)?;
+            }
+            Some(file)
+        }
+        _ => None,
+    };
     let names = Names::new(&mut built.world, &built.bodies);
     stability_gate(&mut built, &names, args.allow_unstable)?;
-    let to_stdout = args.out.as_deref().is_some_and(crate::is_stdout);
 
     let conserved = summary::conserved(&mut built.world);
     let before = summary::totals(&mut built.world);
     let mut reported = 0;
     let start = Instant::now();
-    // Created before the output file, dropped after it: a second signal while the temporary
-    // file is being removed cannot cut that short.
-    let guard = interrupt::Guard::poll();
     let bar = progress_bar(steps, built.bodies.len());
     let mut checksums: Vec<(u64, WorldChecksum)> = Vec::new();
     if args.checksum {
@@ -220,11 +285,9 @@ pub(crate) fn run(args: RunArgs) -> Result<(), Failure> {
             );
         }
         Some(path) => {
-            let inputs: Vec<&Path> = loaded.path.as_deref().into_iter().collect();
-            let mut file = OutputFile::create(path, &inputs)?;
-            if !args.force {
-                check_free_space(&file, &built, steps, &record)?;
-            }
+            let mut file = out_file
+                .take()
+                .expect("the output file is created above for every path but stdout");
             written = Some(
                 tumble_scene::write_trajectory(&mut built, steps, &record, &mut file, &mut on_step)
                     .map_err(|e| match e {

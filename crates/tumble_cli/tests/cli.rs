@@ -122,10 +122,14 @@ fn scenes_lists_the_bundled_scenes_and_plan_prints_the_systems() {
     );
     // The projectile's bodies have no accumulator: gravity needs no system of its own.
     let plan = plan_of("projectile");
+    let (systems, methods) = plan
+        .split_once("method: ")
+        .unwrap_or_else(|| panic!("{plan}"));
     assert!(
-        plan.trim_end().ends_with("integrate_without_forces"),
+        systems.trim_end().ends_with("integrate_without_forces"),
         "{plan}"
     );
+    assert_eq!(methods.trim_end(), "`splitting` (free flow `auto`)");
     assert!(!plan.contains("apply_gravity"), "{plan}");
 }
 
@@ -223,10 +227,11 @@ fn gen_many_writes_a_valid_scene() {
     assert!((big.stdout.len() as u64) < tumble_scene::MAX_SCENE_BYTES);
 }
 
-/// The bundled thin plate runs under `exact` without a word; under `splitting` it still runs,
-/// and the planner names `exact` on stderr.
+/// The bundled thin plate runs under `exact` without a word. Under `splitting` with the default
+/// `--free-flow auto` it takes the exact free flow, says so on stderr, and writes `exact`'s
+/// trajectory; with `--free-flow method` it keeps the split and the planner names `exact`.
 #[test]
-fn the_thin_plate_runs_exactly_and_splitting_is_told_to_use_exact() {
+fn the_thin_plate_runs_exactly_and_splitting_gives_way_or_is_told() {
     let out = tumble_run(&["run", "thin_plate"]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{stderr}");
@@ -234,12 +239,49 @@ fn the_thin_plate_runs_exactly_and_splitting_is_told_to_use_exact() {
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(stdout.contains("(exact)"), "{stdout}");
 
-    let out = tumble_run(&["run", "thin_plate", "--integrator", "splitting"]);
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "{stderr}");
+    let csv = |integrator: &str, free_flow: &str| {
+        let out = tumble_run(&[
+            "run",
+            "thin_plate",
+            "--integrator",
+            integrator,
+            "--free-flow",
+            free_flow,
+            "--out",
+            "-",
+        ]);
+        let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+        assert!(out.status.success(), "{stderr}");
+        (out.stdout, stderr)
+    };
+    let (exact, _) = csv("exact", "auto");
+    let (auto, stderr) = csv("splitting", "auto");
     assert!(
-        stderr.contains("body `plate`") && stderr.contains("use `exact`"),
+        stderr.contains("body `plate`") && stderr.contains("exact free flow"),
         "{stderr}"
+    );
+    assert!(
+        auto == exact,
+        "the plate under `auto` is not stepped as `exact` steps it"
+    );
+    let (split, stderr) = csv("splitting", "method");
+    assert!(
+        stderr.contains("body `plate`") && stderr.contains("`exact`"),
+        "{stderr}"
+    );
+    assert!(split != exact);
+    let out = tumble_run(&["run", "thin_plate", "--integrator", "splitting", "--plan"]);
+    let plan = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        plan.contains("1 body takes the exact free flow (`exact`) now, first body `plate`"),
+        "{plan}"
+    );
+    let out = tumble_run(&["run", "thin_plate", "--free-flow", "exactly"]);
+    assert!(!out.status.success());
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("--free-flow: expected one of"),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
     );
 }
 

@@ -22,6 +22,7 @@
 //! classification, scratch buffers) is left out.
 
 use bevy_ecs::prelude::*;
+use tumble_core::integrate::FreeFlow;
 use tumble_core::math::{Quat, Real, Vec3};
 use xxhash_rust::xxh3::Xxh3;
 
@@ -102,6 +103,11 @@ fn settings(world: &World, out: &mut Stream) {
         out.text(s.integrator.name());
         out.text(s.springs.name());
         out.bytes(&s.substeps.get().to_le_bytes());
+        // Only when not the default, so that the checksums of worlds that never set it stay
+        // what they were before the setting existed.
+        if s.free_flow != FreeFlow::default() {
+            out.text(s.free_flow.name());
+        }
     }
     let cursor = world
         .get_resource::<StageCursor>()

@@ -5,7 +5,7 @@ use bevy_ecs::prelude::*;
 use tumble_core::math::{Quat, Real, Vec3, Widen, quat_rotate};
 
 use std::num::NonZeroU32;
-use tumble_core::integrate::Stages;
+use tumble_core::integrate::{FreeFlow, Stages};
 use tumble_core::{BodyState, Integrator, InvalidInput, MassProperties};
 
 use crate::validate::revalidate_body_hook;
@@ -381,6 +381,13 @@ pub struct PhysicsSettings {
     /// faster than the step resolves (a stiff contact-like spring, a control loop), not for
     /// accuracy alone — `yoshida4` is the cheaper way to a small error.
     pub substeps: NonZeroU32,
+    /// Which free rotation a split method (`splitting`, `splitting-xyz`, `yoshida4`) gives each
+    /// body: under [`FreeFlow::Auto`] (the default) a body whose split free rotation would err by
+    /// more than [`SPLIT_ERROR_LIMIT`](tumble_core::integrate::SPLIT_ERROR_LIMIT) in a stage
+    /// (a fast spin, a thin body) takes the exact free flow of the same step for that stage
+    /// (`exact`, `exact4`), and the planner says which bodies do; [`FreeFlow::Method`] keeps
+    /// the method's own flow for every body (see [`tumble_core::integrate::FreeFlow`]).
+    pub free_flow: FreeFlow,
 }
 
 impl PhysicsSettings {
@@ -392,6 +399,7 @@ impl PhysicsSettings {
             integrator,
             springs: SpringSolver::Auto,
             substeps: NonZeroU32::MIN,
+            free_flow: FreeFlow::Auto,
         })
     }
 
@@ -405,6 +413,12 @@ impl PhysicsSettings {
     #[inline]
     pub fn stages(&self) -> Stages {
         Stages::new(self.integrator, self.substeps)
+    }
+
+    /// The same settings with split methods' free rotation chosen as `free_flow` says.
+    pub fn with_free_flow(mut self, free_flow: FreeFlow) -> Self {
+        self.free_flow = free_flow;
+        self
     }
 
     /// The same settings with springs stepped as `springs` says.
@@ -438,6 +452,8 @@ struct PhysicsSettingsData {
     springs: SpringSolver,
     #[serde(default = "one_substep")]
     substeps: NonZeroU32,
+    #[serde(default)]
+    free_flow: FreeFlow,
 }
 
 #[cfg(feature = "serde")]
@@ -451,7 +467,8 @@ impl TryFrom<PhysicsSettingsData> for PhysicsSettings {
     fn try_from(d: PhysicsSettingsData) -> Result<Self, InvalidInput> {
         Ok(PhysicsSettings::new(d.dt, d.integrator)?
             .with_springs(d.springs)
-            .with_substeps(d.substeps))
+            .with_substeps(d.substeps)
+            .with_free_flow(d.free_flow))
     }
 }
 
@@ -463,6 +480,7 @@ impl From<PhysicsSettings> for PhysicsSettingsData {
             integrator: s.integrator,
             springs: s.springs,
             substeps: s.substeps,
+            free_flow: s.free_flow,
         }
     }
 }
@@ -475,6 +493,7 @@ impl Default for PhysicsSettings {
             integrator: Integrator::default(),
             springs: SpringSolver::Auto,
             substeps: NonZeroU32::MIN,
+            free_flow: FreeFlow::Auto,
         }
     }
 }

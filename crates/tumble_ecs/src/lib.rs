@@ -63,5 +63,6 @@ pub mod prelude {
     pub use crate::stepper::{FixedStepper, FrameSteps, interpolate};
     pub use crate::stiff::SpringSolver;
     pub use crate::validate::{BodyError, BodyErrorKind, PhysicsErrors, Rejected};
+    pub use tumble_core::integrate::FreeFlow;
     pub use tumble_core::{Density, Integrator, Mass, MassProperties};
 }

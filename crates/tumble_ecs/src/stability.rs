@@ -28,25 +28,19 @@
 //! never refuses a method for a body it would not step), and one
 //! [`StabilityWarning::ImplicitGroups`] says which method they get instead.
 //!
-//! One limit of the default method's accuracy (not its stability):
+//! One limit of the default method's accuracy (not its stability), which the step itself
+//! takes care of by default:
 //!
-//! - **Split free rotation.** `splitting` (and `splitting-xyz`) integrate the torque-free body as
-//!   an exact symmetric top `S` plus a residual rotation about axis `c` (`R = ½ (r_c − r_b) m_c²`,
-//!   `b, c` the axes with the closest reciprocal moments `r = 1/I`, `a` the odd one). Their Strang
-//!   composition errs where `S` and `R` do not commute: the residual rotation by
-//!   `h (r_c − r_b) m_c` swings `m_b` into `m_a` and back, and what is left per step is
-//!   `δm_a ≈ h² ω_a (r_c − r_b) m_b m_c`, a relative error in the odd axis's rate of
-//!   `e = Δt² |ω_b ω_c| |I_b − I_c| / I_a` per step. A thin asymmetric plate (`I_a` small, its
-//!   asymmetry `|I_b − I_c| ≤ I_a` by the triangle inequality) spun about a tilted axis is where
-//!   `e` is largest; the orientation error over `T` seconds then measures ≈ `0.4–0.7 e T / s`
-//!   rad (f32; plates and needles `I = (0.01, 1, 1.01)`, `(1e-4, 1, 1.0001)`, `(0.1, 1, 1.1)`,
-//!   `(0.3, 1, 1.3)` at 1–10 rad/s, 60 and 240 Hz). A warning naming `exact` (exact at any spin)
-//!   is raised when `e` exceeds [`FREE_ROTATION_ERROR_LIMIT`]: the run goes on (the motion stays
-//!   bounded, `|L|` exact), it is an accuracy limit like the one below.
-//!
-//!   `yoshida4` composes the same split in three stages, the largest `|c₀| h ≈ 1.70 h` long;
-//!   the composition cancels the error to fourth order only while it is small, so it is judged
-//!   by `e` of that stage against the looser [`COMPOSED_FREE_ROTATION_ERROR_LIMIT`].
+//! - **Split free rotation.** `splitting`, `splitting-xyz` and `yoshida4` split the torque-free
+//!   rotation into an exact symmetric top and a residual rotation, which errs per step by a
+//!   relative `e = Δt² |ω_b ω_c| |I_b − I_c| / I_a` in the odd axis's rate (see
+//!   [`tumble_core::integrate::FreeFlow`] for the derivation and measurements). Under
+//!   [`FreeFlow::Auto`] (the default) a body above [`SPLIT_ERROR_LIMIT`]
+//!   ([`COMPOSED_SPLIT_ERROR_LIMIT`] on `yoshida4`'s largest stage) takes the exact free flow
+//!   in that stage, and one [`StabilityWarning::ExactFreeFlow`] names the bodies that do at
+//!   planning time; under [`FreeFlow::Method`] each such body is warned of
+//!   ([`StabilityWarning::InexactFreeRotation`]): the run goes on (the motion stays bounded,
+//!   `|L|` exact), with an accuracy limit like the ones below.
 //!
 //! - **First-order gyroscopic term** (`lclamp`, `implicit-gyroscopic`). Stable, but each step
 //!   errs in the rate by `∝ (Ω h)²` (`Ω` the nutation frequency above), and the error accumulates:
@@ -77,10 +71,12 @@
 
 use bevy_ecs::prelude::*;
 use tumble_core::Integrator;
-use tumble_core::math::{DOUBLE_PRECISION, REAL_NAME, Real, Vec3};
+use tumble_core::integrate::{ExactSwitch, FreeFlow};
+use tumble_core::math::{DOUBLE_PRECISION, REAL_NAME, Real, Vec3, Widen};
 
 use crate::components::{
-    Gravity, GravityScale, Kinematic, MassProps, PhysicsSettings, Pose, RigidBody, Static, Velocity,
+    Gravity, GravityScale, Kinematic, MassProps, PhysicsSettings, Pose, RigidBody, Static,
+    Velocity, body_state,
 };
 use crate::forces::{Spring, SpringEnd};
 use crate::stiff::ImplicitBody;
@@ -96,28 +92,16 @@ pub const EXPLICIT_GYROSCOPIC_HORIZON: Real = 600.0;
 /// passes without a warning.
 pub const POSITION_RESOLUTION_LIMIT: Real = 1e-3;
 
-/// Relative error per step of the odd axis's rate under the split free rotation,
-/// `Δt² |ω_b ω_c| |I_b − I_c| / I_a` (module docs), above which the planner names `exact`: 1 %
-/// per step, an orientation drift of about 5e-3 rad/s. An ordinary box (I = (1, 2, 3)) reaches it
-/// at ≈ 6 rad/s about two axes at 60 Hz.
-pub const FREE_ROTATION_ERROR_LIMIT: Real = 1e-2;
+pub use tumble_core::integrate::{
+    ACCURACY_HORIZON, COMPOSED_SPLIT_ERROR_LIMIT, SPLIT_DRIFT_TOLERANCE, SPLIT_ERROR_LIMIT,
+};
 
 /// `|L| Δt / I_min` above which `rk4`'s constant-`L` rotation goes wrong (module docs).
 pub const RK4_STIFFNESS_LIMIT: Real = 0.5;
 
-/// The split free rotation's relative error per stage (as [`FREE_ROTATION_ERROR_LIMIT`], at the
-/// largest stage `|c₀| h ≈ 1.70 h` of the triple jump) above which `yoshida4` is warned of. The
-/// composition cancels the split's error to fourth order only while it is small: measured over
-/// 10 s (f32, I at the triangle limit), 7.7 % per stage gives 1e-3–5e-3 rad, 31 % gives
-/// 0.04–0.2 rad.
-pub const COMPOSED_FREE_ROTATION_ERROR_LIMIT: Real = 0.15;
-
 /// Orientation error over [`ACCURACY_HORIZON`] (rad) above which a first-order gyroscopic method
 /// (`lclamp`, `implicit-gyroscopic`) is warned of (module docs).
 pub const FIRST_ORDER_DRIFT_LIMIT: Real = 0.02;
-
-/// The span over which [`FIRST_ORDER_DRIFT_LIMIT`] is judged (s).
-pub const ACCURACY_HORIZON: Real = 10.0;
 
 /// A setting outside the selected integrator's stable region, or beyond what the precision can
 /// resolve.
@@ -147,7 +131,7 @@ pub enum StabilityWarning {
         body: Entity,
         /// The integrator.
         integrator: Integrator,
-        /// `Δt² |ω_b ω_c| |I_b − I_c| / I_a`, compared with [`FREE_ROTATION_ERROR_LIMIT`].
+        /// `Δt² |ω_b ω_c| |I_b − I_c| / I_a`, compared with [`SPLIT_ERROR_LIMIT`].
         error_per_step: Real,
     },
     /// A body whose `rk4` rotation is stiff, `|L| Δt / I_min` above [`RK4_STIFFNESS_LIMIT`]
@@ -157,6 +141,24 @@ pub enum StabilityWarning {
         body: Entity,
         /// `|L| Δt / I_min`.
         stiffness: Real,
+    },
+    /// Bodies a split method gives the exact free flow under
+    /// [`FreeFlow::Auto`]: their split free rotation
+    /// would err by more than the limit in a stage (see [`tumble_core::integrate::FreeFlow`]).
+    /// Not a fault: what the planner chose, said so that the choice is never silent. One for
+    /// the world, naming the first such body; the choice is made again every stage, from each
+    /// body's state then.
+    ExactFreeFlow {
+        /// The first such body.
+        body: Entity,
+        /// How many bodies take the exact flow now.
+        bodies: usize,
+        /// The selected (split) integrator.
+        integrator: Integrator,
+        /// What the split would cost the first body, as [`ExactSwitch::measure`] judges it: the
+        /// predicted drift over [`ACCURACY_HORIZON`] (rad), or for a composition (`yoshida4`)
+        /// the relative error `e` of its largest stage.
+        measure: Real,
     },
     /// Bodies in stiff spring groups (see [`crate::stiff`]), which the implicit spring solve
     /// steps — translation and rotation, by the implicit midpoint rule — instead of the selected
@@ -218,6 +220,7 @@ impl StabilityWarning {
             StabilityWarning::ExplicitGyroscopic { body, .. }
             | StabilityWarning::FirstOrderGyroscopic { body, .. }
             | StabilityWarning::ImplicitGroups { body, .. }
+            | StabilityWarning::ExactFreeFlow { body, .. }
             | StabilityWarning::InexactFreeRotation { body, .. }
             | StabilityWarning::StiffRk4Rotation { body, .. }
             | StabilityWarning::CoarsePosition { body, .. }
@@ -234,6 +237,7 @@ impl StabilityWarning {
                 | StabilityWarning::LockedAxisRate { .. }
                 | StabilityWarning::FirstOrderGyroscopic { .. }
                 | StabilityWarning::ImplicitGroups { .. }
+                | StabilityWarning::ExactFreeFlow { .. }
                 | StabilityWarning::InexactFreeRotation { .. }
                 | StabilityWarning::StiffRk4Rotation { .. }
         )
@@ -266,13 +270,45 @@ impl std::fmt::Display for StabilityWarning {
                 f,
                 "rigid body {body}: integrator `{integrator}` splits its free rotation with a \
                  relative error of {:.1} % per {} in its spin (Δt²|ω_b ω_c||I_b − I_c|/I_a); \
-                 use `exact`, exact at any spin, or a smaller time step",
+                 use free_flow = `auto` (the exact flow where the split errs), `exact`, or a \
+                 smaller time step",
                 100.0 * error_per_step,
                 if integrator.composition().len() > 1 {
                     "stage"
                 } else {
                     "step"
                 }
+            ),
+            StabilityWarning::ExactFreeFlow {
+                body,
+                bodies,
+                integrator,
+                measure,
+            } => write!(
+                f,
+                "rigid body {body}{}: `{integrator}`'s split free rotation would {}; stepped \
+                 with the exact free flow (as `{}`) while that holds; free_flow = `method` \
+                 keeps the split",
+                if bodies == 1 {
+                    String::new()
+                } else {
+                    format!(" and {} more bodies", bodies - 1)
+                },
+                if integrator.composition().len() > 1 {
+                    format!(
+                        "err by {:.1} % a stage (Δt²|ω_b ω_c||I_b − I_c|/I_a > {:.0} %)",
+                        100.0 * measure,
+                        100.0 * COMPOSED_SPLIT_ERROR_LIMIT
+                    )
+                } else {
+                    format!(
+                        "drift by about {measure:.1e} rad in {ACCURACY_HORIZON} s (> \
+                         {SPLIT_DRIFT_TOLERANCE:.0e} rad, the {REAL_NAME} state's own rounding)"
+                    )
+                },
+                integrator
+                    .exact_counterpart()
+                    .map_or("exact", |exact| exact.name()),
             ),
             StabilityWarning::ImplicitGroups {
                 body,
@@ -351,27 +387,7 @@ fn nutation_factor(inertia: Vec3) -> Real {
         .fold(0.0, Real::max)
 }
 
-/// `Δt² |ω_b ω_c| |I_b − I_c| / I_a` of the split free rotation (module docs) for principal
-/// moments `inertia` and principal rates `omega`; `a` is the axis whose reciprocal moment is
-/// farthest from the other two (the pair `b, c` the split treats as a symmetric top). Zero for
-/// a body with a locked axis (its rates are held, see `exact`).
-pub fn split_rotation_error(inertia: Vec3, omega: Vec3, dt: Real) -> Real {
-    let i = inertia.to_array();
-    if i.iter().any(|&x| x <= 0.0) {
-        return 0.0;
-    }
-    let r = i.map(|x| 1.0 / x);
-    let w = omega.to_array();
-    // The odd axis: the one not in the closest pair of reciprocal moments.
-    let a = (0..3)
-        .min_by(|&x, &y| {
-            let gap = |k: usize| (r[(k + 1) % 3] - r[(k + 2) % 3]).abs();
-            gap(x).total_cmp(&gap(y))
-        })
-        .unwrap_or(0);
-    let (b, c) = ((a + 1) % 3, (a + 2) % 3);
-    dt * dt * (w[b] * w[c]).abs() * (i[b] - i[c]).abs() / i[a]
-}
+pub use tumble_core::integrate::split_rotation_error;
 
 /// The orientation drift over [`ACCURACY_HORIZON`] `T` (rad) of a first-order gyroscopic method
 /// on a body with principal moments `inertia` spinning at `omega`, with steps of `h`:
@@ -465,33 +481,69 @@ pub fn check_stability(world: &mut World) -> Vec<StabilityWarning> {
             }
         }
     }
-    let split_limit = match settings.integrator {
-        Integrator::Splitting | Integrator::SplittingXyz => Some(FREE_ROTATION_ERROR_LIMIT),
-        Integrator::Yoshida4 => Some(COMPOSED_FREE_ROTATION_ERROR_LIMIT),
-        _ => None,
-    };
-    if let Some(limit) = split_limit {
-        // The largest stage's span: the split is applied once per stage.
-        let largest = settings
-            .integrator
-            .composition()
-            .iter()
-            .fold(0.0, |m: Real, w| m.max(w.abs()));
-        let h = largest * settings.dt() / settings.substeps.get() as Real;
-        let mut spins = world.query_filtered::<
-            (Entity, &MassProps, &Pose, &Velocity),
-            (With<RigidBody>, Without<ImplicitBody>),
-        >();
-        for (body, mass, transform, velocity) in spins.iter(world) {
-            let principal = transform.rotation * mass.principal_frame();
-            let omega = tumble_core::integrate::rotate_inv(principal, velocity.angular);
-            let error_per_step = split_rotation_error(mass.principal_inertia(), omega, h);
-            if error_per_step > limit {
-                warnings.push(StabilityWarning::InexactFreeRotation {
-                    body,
-                    integrator: settings.integrator,
-                    error_per_step,
-                });
+    // The split methods' free rotation. Under `auto` the step judges each body itself
+    // (`ExactSwitch`) and gives the exact flow to those it would integrate badly: one notice
+    // names the bodies that take it now. Under `method` each body whose split errs by more
+    // than the limit a stage is warned of.
+    let substep = settings.dt() / settings.substeps.get() as Real;
+    let mut spins = world.query_filtered::<(Entity, &MassProps, &Pose, &Velocity), (
+        With<RigidBody>,
+        Without<ImplicitBody>,
+        Without<Static>,
+        Without<Kinematic>,
+    )>();
+    match settings.free_flow {
+        FreeFlow::Auto => {
+            if let Some(switch) = ExactSwitch::new(settings.integrator, FreeFlow::Auto, substep) {
+                let mut first: Option<(Entity, Real)> = None;
+                let mut count = 0;
+                for (body, mass, transform, velocity) in spins.iter(world) {
+                    let state = body_state(transform, velocity, mass);
+                    if switch.applies(&state, mass) {
+                        count += 1;
+                        first.get_or_insert((body, switch.measure(&state, mass) as Real));
+                    }
+                }
+                if let Some((body, measure)) = first {
+                    warnings.push(StabilityWarning::ExactFreeFlow {
+                        body,
+                        bodies: count,
+                        integrator: settings.integrator,
+                        measure,
+                    });
+                }
+            }
+        }
+        FreeFlow::Method => {
+            let limit = match settings.integrator {
+                Integrator::Splitting | Integrator::SplittingXyz => Some(SPLIT_ERROR_LIMIT),
+                Integrator::Yoshida4 => Some(COMPOSED_SPLIT_ERROR_LIMIT),
+                _ => None,
+            };
+            if let Some(limit) = limit {
+                // The largest stage's span: the split is applied once per stage.
+                let largest = settings
+                    .integrator
+                    .composition()
+                    .iter()
+                    .fold(0.0, |m: Real, w| m.max(w.abs()));
+                let h = largest * substep;
+                for (body, mass, transform, velocity) in spins.iter(world) {
+                    let principal = transform.rotation * mass.principal_frame();
+                    let omega = tumble_core::integrate::rotate_inv(principal, velocity.angular);
+                    let error_per_step = split_rotation_error(
+                        mass.principal_inertia().widen(),
+                        omega.widen(),
+                        h.widen(),
+                    ) as Real;
+                    if error_per_step > limit {
+                        warnings.push(StabilityWarning::InexactFreeRotation {
+                            body,
+                            integrator: settings.integrator,
+                            error_per_step,
+                        });
+                    }
+                }
             }
         }
     }

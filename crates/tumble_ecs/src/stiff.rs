@@ -339,8 +339,8 @@ pub struct ImplicitScratch {
     /// local to the group.
     springs: Vec<GroupSpring>,
     spring_start: Vec<usize>,
-    /// Each spring's group, before the springs are grouped.
-    pending: Vec<(usize, GroupSpring)>,
+    /// Each spring's group, in query order, before the springs are grouped.
+    pending: Vec<u32>,
     cursor: Vec<usize>,
     /// Per body, its index within its group.
     local: Vec<usize>,
@@ -434,53 +434,41 @@ pub fn solve_implicit_springs(
         s.members[s.cursor[g]] = i;
         s.cursor[g] += 1;
     }
+    // Two passes over the springs: one counts each group's springs, the other writes each in
+    // its group's slot. Resolving a spring twice is cheaper than keeping every resolved spring
+    // twice (a group of a million springs).
     s.pending.clear();
     for spring in &springs {
-        // Orient each spring so that its first end is an implicit body.
-        let (first, anchor_first, second) = match (ends_in(&s.index, spring), spring.b) {
-            ((Some(i), _), _) => (i, spring.anchor_a, spring.b),
-            ((None, Some(j)), SpringEnd::Body { anchor, .. }) => (
-                j,
-                anchor,
-                SpringEnd::Body {
-                    body: spring.a,
-                    anchor: spring.anchor_a,
-                },
-            ),
-            _ => continue,
-        };
-        let end = match second {
-            SpringEnd::World(p) => LinkEnd::Fixed(p),
-            SpringEnd::Body { body, anchor } => match s.index.get(&body) {
-                Some(&k) => LinkEnd::Body {
-                    index: s.local[k],
-                    anchor,
-                },
-                None => match others.get(body) {
-                    // A static, kinematic or quarantined body holds its anchor still.
-                    Ok(t) => LinkEnd::Fixed(t.transform_point(anchor)),
-                    Err(_) => continue,
-                },
-            },
-        };
-        let link = GroupSpring {
-            a: s.local[first],
-            anchor_a: anchor_first,
-            b: end,
-            stiffness: spring.stiffness,
-            rest_length: spring.rest_length,
-        };
-        s.pending.push((s.rank[s.group_of[first]], link));
+        if let Some((first, _)) = group_spring(&s.index, &s.local, &others, spring) {
+            s.pending.push(s.rank[s.group_of[first]] as u32);
+        }
     }
-    counting_starts(&mut s.spring_start, groups, s.pending.iter().map(|p| p.0));
-    // Sized by the pending springs, then each written to its group's slot.
+    counting_starts(
+        &mut s.spring_start,
+        groups,
+        s.pending.iter().map(|&g| g as usize),
+    );
     s.springs.clear();
-    s.springs.extend(s.pending.iter().map(|p| p.1));
+    // Every slot is written below (the counts are the same pass's); the filler never reaches
+    // the solver.
+    let filler = GroupSpring {
+        a: 0,
+        anchor_a: Vec3::ZERO,
+        b: LinkEnd::Fixed(Vec3::ZERO),
+        stiffness: 0.0,
+        rest_length: 0.0,
+    };
+    s.springs.resize(s.pending.len(), filler);
     s.cursor.clear();
     s.cursor.extend_from_slice(&s.spring_start[..groups]);
-    for &(g, link) in &s.pending {
-        s.springs[s.cursor[g]] = link;
-        s.cursor[g] += 1;
+    let mut k = 0;
+    for spring in &springs {
+        if let Some((_, link)) = group_spring(&s.index, &s.local, &others, spring) {
+            let g = s.pending[k] as usize;
+            k += 1;
+            s.springs[s.cursor[g]] = link;
+            s.cursor[g] += 1;
+        }
     }
     for g in 0..groups {
         let members = s.member_start[g]..s.member_start[g + 1];
@@ -524,6 +512,51 @@ pub fn solve_implicit_springs(
             }
         }
     }
+}
+
+/// A spring of an implicit group as the solver takes it, with the index of its first end (an
+/// implicit body), or `None` when the spring does not act this step (an end missing or
+/// rejected).
+fn group_spring(
+    index: &EntityHashMap<usize>,
+    local: &[usize],
+    others: &Query<&Pose, (With<RigidBody>, Without<ImplicitBody>)>,
+    spring: &Spring,
+) -> Option<(usize, GroupSpring)> {
+    // Orient each spring so that its first end is an implicit body.
+    let (first, anchor_first, second) = match (ends_in(index, spring), spring.b) {
+        ((Some(i), _), _) => (i, spring.anchor_a, spring.b),
+        ((None, Some(j)), SpringEnd::Body { anchor, .. }) => (
+            j,
+            anchor,
+            SpringEnd::Body {
+                body: spring.a,
+                anchor: spring.anchor_a,
+            },
+        ),
+        _ => return None,
+    };
+    let end = match second {
+        SpringEnd::World(p) => LinkEnd::Fixed(p),
+        SpringEnd::Body { body, anchor } => match index.get(&body) {
+            Some(&k) => LinkEnd::Body {
+                index: local[k],
+                anchor,
+            },
+            // A static, kinematic or quarantined body holds its anchor still.
+            None => LinkEnd::Fixed(others.get(body).ok()?.transform_point(anchor)),
+        },
+    };
+    Some((
+        first,
+        GroupSpring {
+            a: local[first],
+            anchor_a: anchor_first,
+            b: end,
+            stiffness: spring.stiffness,
+            rest_length: spring.rest_length,
+        },
+    ))
 }
 
 /// Fills `starts` (length `groups + 1`) with the prefix sums of how many of `keys` fall in each

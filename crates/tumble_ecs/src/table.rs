@@ -10,6 +10,7 @@ use std::sync::Mutex;
 
 use bevy_ecs::prelude::*;
 use tumble_core::damping::decrement;
+use tumble_core::integrate::ExactSwitch;
 use tumble_core::math::{Real, Vec3};
 use tumble_core::prefetch::prefetch;
 use tumble_core::{BodyBatch, BodyState, Integrator, MassProperties, StepPhase, Wrench};
@@ -152,6 +153,9 @@ pub(crate) struct StageTiming {
     damp_write: bool,
     /// The whole substep at once (`h` is the substep): [`Integrator::step_batch`].
     whole_substep: bool,
+    /// The switch of a split method to the exact free flow for fast spins
+    /// ([`PhysicsSettings::free_flow`]).
+    switch: Option<ExactSwitch>,
 }
 
 impl StageTiming {
@@ -172,6 +176,7 @@ impl StageTiming {
             damp_read: true,
             damp_write: true,
             whole_substep: true,
+            switch: ExactSwitch::new(settings.integrator, settings.free_flow, span.substep),
         })
     }
 
@@ -189,6 +194,7 @@ impl StageTiming {
             damp_read: phase != StepPhase::Finish && span.opens_substep,
             damp_write: phase != StepPhase::Begin && span.closes_substep,
             whole_substep: false,
+            switch: ExactSwitch::new(settings.integrator, settings.free_flow, span.substep),
         }
     }
 }
@@ -286,11 +292,13 @@ fn step_bodies(stage: &StageTiming, bodies: Bodies<'_>, errors: &mut Vec<BodyErr
         errors,
     };
     if stage.whole_substep {
-        stage.integrator.step_batch(&mut batch, stage.h);
+        stage
+            .integrator
+            .step_batch_switched(&mut batch, stage.h, stage.switch);
     } else {
         stage
             .integrator
-            .stage_batch(stage.phase, &mut batch, stage.h);
+            .stage_batch_switched(stage.phase, &mut batch, stage.h, stage.switch);
     }
     errors[found..].sort_by_key(|e| e.entity);
 }

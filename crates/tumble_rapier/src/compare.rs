@@ -5,7 +5,7 @@ use tumble_core::math::{Real, to_f64};
 
 use tumble_core::rotation::angle_between;
 use tumble_core::{BodyState, Integrator};
-use tumble_ecs::prelude::SpringSolver;
+use tumble_ecs::prelude::{FreeFlow, SpringSolver};
 
 use crate::rapier_side::RapierScene;
 use crate::rapier_springs::RapierSprings;
@@ -27,6 +27,9 @@ pub struct ComparisonOptions {
     pub springs: SpringSolver,
     /// How the springs are built in rapier (default: its `SpringJoint`).
     pub rapier_springs: RapierSprings,
+    /// Which free rotation tumble's split methods give each body
+    /// (`PhysicsSettings::free_flow`; default `auto`).
+    pub free_flow: FreeFlow,
 }
 
 impl Default for ComparisonOptions {
@@ -38,6 +41,7 @@ impl Default for ComparisonOptions {
             steps: 600,
             springs: SpringSolver::Auto,
             rapier_springs: RapierSprings::Joint,
+            free_flow: FreeFlow::Auto,
         }
     }
 }
@@ -127,7 +131,12 @@ pub fn compare(
     options: &ComparisonOptions,
     exact: Option<ExactSolution<'_>>,
 ) -> Comparison {
-    let mut tumble = TumbleScene::with_springs(scene, options.integrator, options.springs);
+    let mut tumble = TumbleScene::with_free_flow(
+        scene,
+        options.integrator,
+        options.springs,
+        options.free_flow,
+    );
     let mut rapier = RapierScene::with_springs(
         scene,
         options.gyroscopic,

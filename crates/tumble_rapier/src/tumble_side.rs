@@ -37,11 +37,27 @@ impl TumbleScene {
         integrator: Integrator,
         springs: SpringSolver,
     ) -> Self {
+        Self::with_free_flow(scene, integrator, springs, FreeFlow::Auto)
+    }
+
+    /// [`with_springs`](Self::with_springs) with split methods' free rotation chosen as
+    /// `free_flow` says (`PhysicsSettings::free_flow`): [`FreeFlow::Method`] measures the
+    /// method itself, [`FreeFlow::Auto`] what a world steps by default.
+    ///
+    /// # Panics
+    /// As [`with_springs`](Self::with_springs).
+    pub fn with_free_flow(
+        scene: &ComparisonScene,
+        integrator: Integrator,
+        springs: SpringSolver,
+        free_flow: FreeFlow,
+    ) -> Self {
         let mut world = World::new();
         world.insert_resource(
             PhysicsSettings::new(scene.dt, integrator)
                 .expect("comparison scenes have a valid dt")
-                .with_springs(springs),
+                .with_springs(springs)
+                .with_free_flow(free_flow),
         );
         if let Some(g) = scene.gravity {
             world.insert_resource(Gravity(g));

@@ -89,6 +89,7 @@ pub fn world(integrator: Integrator, dt: Real, substeps: u32) -> (World, [Entity
     let settings = PhysicsSettings::new(dt, integrator)
         .expect("a valid time step")
         .with_springs(SpringSolver::Explicit)
+        .with_free_flow(FreeFlow::Method)
         .with_substeps(NonZeroU32::new(substeps).expect("at least one substep"));
     world.insert_resource(settings);
     world.insert_resource(Gravity(v3(GRAVITY)));

@@ -507,11 +507,6 @@ pub fn plot_scene(
     })
 }
 
-/// Replaces the text between `<!-- report:begin -->` and `<!-- report:end -->` with `table`.
-pub fn replace_between_markers(text: &str, table: &str) -> Option<String> {
-    tumble_scene::text::replace_between_markers(text, "report", table)
-}
-
 /// Draws `|E(t)/E(0) − 1|` over time (log scale) for one long spin; returns the file name.
 pub fn plot_energy(
     dir: &Path,

@@ -3,7 +3,7 @@
 use std::path::{Path, PathBuf};
 
 use indicatif::{ProgressBar, ProgressStyle};
-use tumble_scene::output::{OutputError, OutputSet, print_to_stdout};
+use tumble_scene::output::{OutputError, OutputSet, print_to_stdout, with_sections};
 use tumble_scene::text::path_for_terminal;
 
 use crate::energy::{spins, traces};
@@ -45,7 +45,7 @@ pub fn run_report(options: &ReportOptions) -> Result<(), Box<dyn std::error::Err
         OutputSet::check(&out.join(name))?;
     }
     if let Some(readme) = &options.readme {
-        updated_readme(readme, "")?;
+        with_sections(readme, &[("report", "")])?;
         OutputSet::check(readme)?;
     }
     let dts: Vec<f64> = if options.quick {
@@ -170,7 +170,10 @@ pub fn run_report(options: &ReportOptions) -> Result<(), Box<dyn std::error::Err
         crate::output::equal_time_table(&results.work_precision)
     );
     if let Some(readme) = &options.readme {
-        files.add(readme, updated_readme(readme, &headline)?.as_bytes())?;
+        files.add(
+            readme,
+            with_sections(readme, &[("report", &headline)])?.as_bytes(),
+        )?;
     }
     files.commit()?;
     print_to_stdout(&format!("{headline}\n"))?;
@@ -186,16 +189,4 @@ pub fn run_report(options: &ReportOptions) -> Result<(), Box<dyn std::error::Err
         plots.len()
     ))?;
     Ok(())
-}
-
-/// The text of `readme` with `headline` between its report markers.
-fn updated_readme(readme: &Path, headline: &str) -> Result<String, Box<dyn std::error::Error>> {
-    let text = std::fs::read_to_string(readme).map_err(|e| OutputError::io(readme, e))?;
-    let updated = crate::output::replace_between_markers(&text, headline).ok_or_else(|| {
-        format!(
-            "{}: no <!-- report:begin --> … <!-- report:end --> markers",
-            path_for_terminal(readme)
-        )
-    })?;
-    Ok(updated)
 }

@@ -193,7 +193,8 @@ fn springs_world(dt: Real, integrator: Integrator, springs: SpringSolver) -> Wor
     w.insert_resource(
         PhysicsSettings::new(dt, integrator)
             .expect("valid dt")
-            .with_springs(springs),
+            .with_springs(springs)
+            .with_free_flow(FreeFlow::Method),
     );
     w
 }
@@ -394,7 +395,7 @@ fn stiff_chain(springs: SpringSolver, omega_dt: Real, steps: usize) -> Cell {
         tumble_rapier::presets::ChainStart::Stretched,
         1,
     );
-    let mut scene = TumbleScene::with_springs(&chain, integrator, springs);
+    let mut scene = TumbleScene::with_free_flow(&chain, integrator, springs, FreeFlow::Method);
     run(
         scene.world_mut(),
         steps,

@@ -7,7 +7,7 @@ use serde::Serialize;
 use tumble_core::invariants::{angular_momentum, kinetic_energy};
 use tumble_core::rotation::angle_between;
 use tumble_core::{BodyState, Integrator};
-use tumble_ecs::prelude::SpringSolver;
+use tumble_ecs::prelude::{FreeFlow, SpringSolver};
 use tumble_rapier::{
     ComparisonBody, ComparisonScene, ComparisonSpring, ComparisonSpringEnd, RapierScene,
     TumbleScene,
@@ -125,7 +125,8 @@ fn tumble_run(
     batch: usize,
 ) -> (BodyState, f64) {
     let scene = comparison_scene(case, dt, batch, true);
-    let mut world = TumbleScene::with_springs(&scene, integrator, SpringSolver::Explicit);
+    let mut world =
+        TumbleScene::with_free_flow(&scene, integrator, SpringSolver::Explicit, FreeFlow::Method);
     let start = Instant::now();
     for _ in 0..steps {
         world.step();

@@ -222,10 +222,11 @@ fn substeps_are_steps_of_the_substep_bit_for_bit() {
     }
 }
 
-/// The implicit spring step takes the torque of a force at a body point at mid-step, like a
-/// spring end's: with the linkage's springs stepped implicitly, `splitting` stays second order
-/// and `yoshida4` fourth (before the f32 floor), against the f64 reference. (Sampled at the
-/// start of the step instead, that torque made both first order.)
+/// The implicit spring step takes the torque of a force at a body point like a spring end's
+/// (mean arm, turned by `1 − [hΩ̄/2]×`): with the linkage's springs stepped implicitly,
+/// `splitting` stays second order and `yoshida4` fourth (before the f32 floor), against the f64
+/// reference. (Sampled at the start of the step with the start arm, that torque made both first
+/// order.)
 #[test]
 fn implicit_springs_keep_the_order_with_forces_at_points() {
     let exact = reference(HORIZON, REFERENCE_STEPS);

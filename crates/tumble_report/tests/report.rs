@@ -2,10 +2,11 @@
 //! documented shape.
 
 use tumble_core::Integrator;
-use tumble_report::output::{Machine, Results, replace_between_markers};
+use tumble_report::output::{Machine, Results};
 use tumble_report::reference::cases;
 use tumble_report::stability::matrix;
 use tumble_report::workprec::{Effort, Method, measure};
+use tumble_scene::text::replace_between_markers;
 
 const EFFORT: Effort = Effort {
     batch: 1,
@@ -166,10 +167,10 @@ fn stability_predictions_agree_with_the_matrix() {
 #[test]
 fn readme_markers_are_replaced() {
     let text = "intro\n<!-- report:begin -->\nold\n<!-- report:end -->\nrest";
-    let new = replace_between_markers(text, "| new |\n").unwrap();
+    let new = replace_between_markers(text, "report", "| new |\n").unwrap();
     assert_eq!(
         new,
         "intro\n<!-- report:begin -->\n| new |\n<!-- report:end -->\nrest"
     );
-    assert!(replace_between_markers("no markers", "x").is_none());
+    assert!(replace_between_markers("no markers", "report", "x").is_none());
 }

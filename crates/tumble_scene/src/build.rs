@@ -335,10 +335,12 @@ impl Scene {
     /// scene was parsed.
     pub fn build(&self) -> BuiltScene {
         let mut world = self.world_for_bodies();
+        let loaded = self.loaded_bodies();
         let bodies = self
             .valid_bodies()
             .zip(&self.file.bodies)
-            .map(|(body, def)| (def.name.clone(), spawn_body(&mut world, &body)))
+            .zip(&loaded)
+            .map(|((body, def), &loaded)| (def.name.clone(), spawn_body(&mut world, &body, loaded)))
             .collect();
         self.finish_build(world, bodies)
     }
@@ -348,6 +350,7 @@ impl Scene {
     /// their sum (a million bodies: ≈ 250 MB of file model, ≈ 200 MB of world).
     pub fn into_built(mut self) -> BuiltScene {
         let mut world = self.world_for_bodies();
+        let loaded = self.loaded_bodies();
         // The forces' file model (names as strings) is not needed once checked: `self.forces`
         // holds them by index. Dropped before the world grows.
         drop(std::mem::take(&mut self.file.forces));
@@ -361,7 +364,7 @@ impl Scene {
         let mut i = 0;
         while let Some(def) = defs.pop() {
             let body = checked_body(&self.file.name, i, &def);
-            bodies.push((def.name, spawn_body(&mut world, &body)));
+            bodies.push((def.name, spawn_body(&mut world, &body, loaded[i])));
             i += 1;
             if i % release_every == 0 {
                 defs.shrink_to_fit();
@@ -369,6 +372,28 @@ impl Scene {
         }
         drop(defs);
         self.finish_build(world, bodies)
+    }
+
+    /// Per body, whether a force generator names it. Such a body is spawned with its
+    /// [`ForceAccumulator`] (which the generator's hook would otherwise add): adding a component
+    /// moves the body to another table, and the table it leaves keeps its memory, so a world
+    /// whose bodies all get one would hold them twice.
+    fn loaded_bodies(&self) -> Vec<bool> {
+        let mut loaded = vec![false; self.file.bodies.len()];
+        for f in &self.forces {
+            match *f {
+                SceneForce::Constant { body, .. } | SceneForce::Torque { body, .. } => {
+                    loaded[body] = true;
+                }
+                SceneForce::Spring { a, b, .. } => {
+                    loaded[a] = true;
+                    if let Some(b) = b {
+                        loaded[b] = true;
+                    }
+                }
+            }
+        }
+        loaded
     }
 
     /// A world with the scene's resources, ready for its bodies.
@@ -447,9 +472,13 @@ fn checked_body(file: &str, i: usize, def: &BodyDef) -> ValidBody {
     })
 }
 
-/// Spawns one body with only the components it needs.
-fn spawn_body(world: &mut World, b: &ValidBody) -> Entity {
+/// Spawns one body with only the components it needs: a [`ForceAccumulator`] only when a force
+/// generator will name it (`loaded`).
+fn spawn_body(world: &mut World, b: &ValidBody, loaded: bool) -> Entity {
     let mut e = world.spawn((RigidBody, MassProps(b.mass), b.transform, b.velocity));
+    if loaded {
+        e.insert(ForceAccumulator::default());
+    }
     if b.gravity_scale != 1.0 {
         e.insert(GravityScale(b.gravity_scale));
     }
@@ -507,6 +536,12 @@ fn validate_world(ck: &Checker<'_>, w: &WorldDef) -> Result<CheckedWorld, SceneE
             .parse()
             .map_err(|e: String| ck.error("world", None, "springs", e))?,
     };
+    let free_flow = match &w.free_flow {
+        None => FreeFlow::default(),
+        Some(name) => name
+            .parse()
+            .map_err(|e: String| ck.error("world", None, "free_flow", e))?,
+    };
     let substeps = match w.substeps {
         None => NonZeroU32::MIN,
         Some(n) => u32::try_from(n)
@@ -525,7 +560,8 @@ fn validate_world(ck: &Checker<'_>, w: &WorldDef) -> Result<CheckedWorld, SceneE
     let settings = PhysicsSettings::new(dt, integrator)
         .map_err(|e| ck.error("world", None, "dt", e.to_string()))?
         .with_springs(springs)
-        .with_substeps(substeps);
+        .with_substeps(substeps)
+        .with_free_flow(free_flow);
     let gravity = w
         .gravity
         .map(|g| ck.vec3("world", None, "gravity", g))

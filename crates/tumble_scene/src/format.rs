@@ -36,6 +36,12 @@ pub struct WorldDef {
     /// `dt`), `explicit` or `implicit`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub springs: Option<String>,
+    /// Which free rotation a split integrator gives each body: `auto` (default: the exact free
+    /// flow for a body while its split errs by more than the limit, see
+    /// `tumble_core::integrate::FreeFlow`) or `method` (the integrator's own flow for every
+    /// body).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub free_flow: Option<String>,
     /// Substeps per step, `1..=`[`crate::MAX_SUBSTEPS`] (default 1): the force stage runs in
     /// each (see `PhysicsSettings::substeps`).
     #[serde(default, skip_serializing_if = "Option::is_none")]

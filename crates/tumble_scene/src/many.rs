@@ -32,6 +32,7 @@ pub fn many_world(steps: u64) -> WorldDef {
         steps,
         integrator: None,
         springs: None,
+        free_flow: None,
         substeps: None,
         gravity: Some([0.0, -9.81, 0.0]),
     }

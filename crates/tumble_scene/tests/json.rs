@@ -200,7 +200,7 @@ fn parse_errors_name_the_line_and_the_field() {
                 .to_owned(),
             2,
             "world.x",
-            "unknown field `x`, expected one of `dt`, `steps`, `integrator`, `springs`, `substeps`, `gravity`",
+            "unknown field `x`, expected one of `dt`, `steps`, `integrator`, `springs`, `free_flow`, `substeps`, `gravity`",
         ),
     ];
     for (text, line, field, message) in cases {

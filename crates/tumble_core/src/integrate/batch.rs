@@ -15,13 +15,13 @@
 use crate::math::{Quat, Real, Vec3};
 use std::borrow::Borrow;
 
-use super::Integrator;
 use super::exact_flow::{rotate_exactly, rotate_exactly_pair};
 use super::simd::{Kernel, LANES};
 use super::splitting::{
     drift_kick_drift_linear, drift_kick_drift_translation, free_rotation_span, kick_angular,
 };
 use super::symmetric_kernel::{LaneInputs, rotate_symmetric_lanes, rotate_symmetric_one};
+use super::{ExactSwitch, Integrator};
 use crate::mass::MassProperties;
 use crate::prefetch::prefetch;
 use crate::rotation::rotate_exact;
@@ -235,6 +235,7 @@ fn batched(
     phase: StepPhase,
     bodies: &mut impl BodyBatch,
     dt: Real,
+    switch: Option<ExactSwitch>,
     mut alone: impl FnMut(&mut BodyState, &MassProperties, &Wrench),
 ) {
     let h = free_rotation_span(phase, dt);
@@ -247,6 +248,14 @@ fn batched(
             continue;
         };
         let mass = bodies.mass(i);
+        if let Some(switch) = switch
+            && switch.applies(&next, mass)
+        {
+            let mut single = next;
+            switch.exact().stage(phase, &mut single, mass, &wrench, dt);
+            commit(bodies, i, &single);
+            continue;
+        }
         match drift_kick_drift_linear(phase, &mut next, mass, &wrench, dt) {
             Some(impulse) if mass.is_spherical() => {
                 kick_angular(&mut next, mass, impulse);
@@ -398,12 +407,25 @@ impl Integrator {
     /// [`KERNEL_ENV`](super::KERNEL_ENV) names a kernel path this CPU cannot run (see
     /// [`KernelPath::selected`](super::KernelPath::selected)).
     pub fn stage_batch(self, phase: StepPhase, bodies: &mut impl BodyBatch, h: Real) {
+        self.stage_batch_switched(phase, bodies, h, None);
+    }
+
+    /// [`stage_batch`](Self::stage_batch) with the bodies `switch` applies to stepped by its
+    /// exact counterpart ([`FreeFlow::Auto`](super::FreeFlow::Auto), judged body by body on the
+    /// state each stage starts from).
+    pub fn stage_batch_switched(
+        self,
+        phase: StepPhase,
+        bodies: &mut impl BodyBatch,
+        h: Real,
+        switch: Option<ExactSwitch>,
+    ) {
         let kernel = if self.rotates_on_symmetric_kernel() {
             Kernel::selected()
         } else {
             Kernel::Portable
         };
-        self.stage_batch_on(kernel, phase, bodies, h);
+        self.stage_batch_on(kernel, phase, bodies, h, switch);
     }
 
     /// [`stage_batch`](Self::stage_batch) with the SIMD lanes of the symmetric-top flow on
@@ -414,9 +436,11 @@ impl Integrator {
         phase: StepPhase,
         bodies: &mut impl BodyBatch,
         h: Real,
+        switch: Option<ExactSwitch>,
     ) {
-        let alone = |s: &mut BodyState, m: &MassProperties, w: &Wrench| {
-            self.stage(phase, s, m, w, h);
+        let alone = |s: &mut BodyState, m: &MassProperties, w: &Wrench| match switch {
+            Some(switch) if switch.applies(s, m) => switch.exact().stage(phase, s, m, w, h),
+            _ => self.stage(phase, s, m, w, h),
         };
         if self.is_exact_torque_free() {
             return match phase {
@@ -430,9 +454,9 @@ impl Integrator {
         }
         // One loop per phase, each with its phase a constant, as if written out three times.
         match phase {
-            StepPhase::Whole => batched(kernel, StepPhase::Whole, bodies, h, alone),
-            StepPhase::Begin => batched(kernel, StepPhase::Begin, bodies, h, alone),
-            StepPhase::Finish => batched(kernel, StepPhase::Finish, bodies, h, alone),
+            StepPhase::Whole => batched(kernel, StepPhase::Whole, bodies, h, switch, alone),
+            StepPhase::Begin => batched(kernel, StepPhase::Begin, bodies, h, switch, alone),
+            StepPhase::Finish => batched(kernel, StepPhase::Finish, bodies, h, switch, alone),
         }
     }
 
@@ -442,10 +466,24 @@ impl Integrator {
     /// [`Whole`](StepPhase::Whole) stage. The same contract as `stage_batch`; a composed step is
     /// checked once, at its end.
     pub fn step_batch(self, bodies: &mut impl BodyBatch, dt: Real) {
+        self.step_batch_switched(bodies, dt, None);
+    }
+
+    /// [`step_batch`](Self::step_batch) with the bodies `switch` applies to stepped by its exact
+    /// counterpart (see [`stage_batch_switched`](Self::stage_batch_switched)).
+    pub fn step_batch_switched(
+        self,
+        bodies: &mut impl BodyBatch,
+        dt: Real,
+        switch: Option<ExactSwitch>,
+    ) {
         if let [c] = self.composition() {
-            return self.stage_batch(StepPhase::Whole, bodies, c * dt);
+            return self.stage_batch_switched(StepPhase::Whole, bodies, c * dt, switch);
         }
-        let alone = |s: &mut BodyState, m: &MassProperties, w: &Wrench| self.step(s, m, w, dt);
+        let alone = |s: &mut BodyState, m: &MassProperties, w: &Wrench| match switch {
+            Some(switch) if switch.applies(s, m) => switch.exact().step(s, m, w, dt),
+            _ => self.step(s, m, w, dt),
+        };
         if self == Integrator::Exact4 {
             // Without torque its composed step is the translation of a whole stage over `dt`
             // and one exact rotation over `dt` (see `Integrator::step`): a whole stage's work.
@@ -480,8 +518,21 @@ impl Integrator {
         wrenches: &[Wrench],
         dt: Real,
     ) -> Vec<usize> {
+        self.try_step_many_switched(states, masses, wrenches, dt, None)
+    }
+
+    /// [`try_step_many`](Self::try_step_many) with the bodies `switch` applies to stepped by its
+    /// exact counterpart (see [`stage_batch_switched`](Self::stage_batch_switched)).
+    pub fn try_step_many_switched<M: Borrow<MassProperties>>(
+        self,
+        states: &mut [BodyState],
+        masses: &[M],
+        wrenches: &[Wrench],
+        dt: Real,
+        switch: Option<ExactSwitch>,
+    ) -> Vec<usize> {
         let mut slices = Slices::new(states, masses, Some(wrenches));
-        self.step_batch(&mut slices, dt);
+        self.step_batch_switched(&mut slices, dt, switch);
         slices.sorted_diverged()
     }
 

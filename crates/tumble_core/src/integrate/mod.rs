@@ -33,6 +33,11 @@ mod batch;
 mod exact_flow;
 pub use batch::{BodyBatch, StepPhase};
 mod frame;
+mod free_flow;
+pub use free_flow::{
+    ACCURACY_HORIZON, COMPOSED_SPLIT_ERROR_LIMIT, ExactSwitch, FreeFlow, SPLIT_DRIFT_TOLERANCE,
+    SPLIT_ERROR_LIMIT, split_orbit_error, split_rotation_drift, split_rotation_error,
+};
 mod implicit_gyroscopic;
 mod lclamp;
 mod rk4;
@@ -173,6 +178,18 @@ impl Integrator {
     /// True when the torque-free motion is exact to round-off at any step (`exact`, `exact4`).
     pub fn is_exact_torque_free(self) -> bool {
         matches!(self, Integrator::Exact | Integrator::Exact4)
+    }
+
+    /// The method with this one's drift–kick–drift step and composition and the exact free
+    /// flow in place of its split one (`splitting`, `splitting-xyz` → `exact`; `yoshida4` →
+    /// `exact4`): what [`FreeFlow::Auto`] steps a fast-spinning body with. `None` for a method
+    /// whose free rotation is not split.
+    pub fn exact_counterpart(self) -> Option<Integrator> {
+        match self {
+            Integrator::Splitting | Integrator::SplittingXyz => Some(Integrator::Exact),
+            Integrator::Yoshida4 => Some(Integrator::Exact4),
+            _ => None,
+        }
     }
 
     /// True when the method drifts half a stage before forces are sampled (see

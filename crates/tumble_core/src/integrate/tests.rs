@@ -221,7 +221,7 @@ fn every_kernel_path_the_cpu_has_gives_the_same_bits_as_the_scalar_step() {
         let mut batch = population();
         for _ in 0..20 {
             for phase in [StepPhase::Whole, StepPhase::Begin, StepPhase::Finish] {
-                integrator.stage_batch_on(kernel, phase, &mut batch, dt);
+                integrator.stage_batch_on(kernel, phase, &mut batch, dt, None);
             }
         }
         assert!(batch.diverged.is_empty());
@@ -249,5 +249,94 @@ fn exact_batches_give_the_same_bits_as_the_scalar_step() {
         }
         assert!(batch.diverged.is_empty());
         assert_eq!(bits(&batch.states), bits(&scalar.states), "{integrator}");
+    }
+}
+
+/// Under the free-flow switch every body steps as its own choice would step it alone (the exact
+/// counterpart where the switch applies, the method elsewhere), on every kernel path, in every
+/// phase and in a composed step: the choice is one per body and stage, and the batch does not
+/// change its bits. The population spins from slow to fast (rods among them), so both choices
+/// occur.
+#[test]
+fn the_free_flow_switch_steps_each_body_as_its_choice_on_every_kernel_path() {
+    let dt = 1.0 / 60.0;
+    for integrator in [
+        Integrator::Splitting,
+        Integrator::SplittingXyz,
+        Integrator::Yoshida4,
+    ] {
+        let switch = ExactSwitch::new(integrator, FreeFlow::Auto, dt).unwrap();
+        let mut scalar = population();
+        let (mut exact, mut split) = (0, 0);
+        for _ in 0..20 {
+            for (i, state) in scalar.states.iter_mut().enumerate() {
+                let (mass, wrench) = (&scalar.masses[i], &scalar.wrenches[i]);
+                let stage = |s: &BodyState| {
+                    if switch.applies(s, mass) {
+                        switch.exact()
+                    } else {
+                        integrator
+                    }
+                };
+                let chosen = stage(state);
+                if chosen == integrator {
+                    split += 1;
+                } else {
+                    exact += 1;
+                }
+                chosen.try_step(state, mass, wrench, dt).unwrap();
+                if let [c] = integrator.composition() {
+                    let h = c * dt;
+                    stage(state).try_begin_stage(state, mass, h).unwrap();
+                    stage(state)
+                        .try_finish_stage(state, mass, wrench, h)
+                        .unwrap();
+                }
+            }
+        }
+        assert!(
+            exact > 0 && split > 0,
+            "{integrator}: {exact} exact, {split} split"
+        );
+        for kernel in Kernel::available() {
+            let mut batch = population();
+            for _ in 0..20 {
+                integrator.step_batch_switched(&mut batch, dt, Some(switch));
+                if let [c] = integrator.composition() {
+                    for phase in [StepPhase::Begin, StepPhase::Finish] {
+                        integrator.stage_batch_on(kernel, phase, &mut batch, c * dt, Some(switch));
+                    }
+                }
+            }
+            assert!(batch.diverged.is_empty());
+            assert_eq!(
+                bits(&batch.states),
+                bits(&scalar.states),
+                "{integrator} on {}",
+                kernel.path()
+            );
+        }
+    }
+}
+
+/// The switch gives way only where the split is judged to cost more than the limit, and
+/// `FreeFlow::Method` or a method that is not split never switches.
+#[test]
+fn the_free_flow_switch_is_none_where_nothing_would_switch() {
+    for integrator in Integrator::ALL.iter().copied() {
+        assert!(ExactSwitch::new(integrator, FreeFlow::Method, 0.01).is_none());
+        assert_eq!(
+            ExactSwitch::new(integrator, FreeFlow::Auto, 0.01).is_some(),
+            integrator.exact_counterpart().is_some()
+        );
+        if let Some(exact) = integrator.exact_counterpart() {
+            // The counterpart shares the step's structure: its stages and where it samples.
+            assert_eq!(exact.composition(), integrator.composition());
+            assert_eq!(
+                exact.samples_forces_at_midpoint(),
+                integrator.samples_forces_at_midpoint()
+            );
+            assert!(exact.is_exact_torque_free());
+        }
     }
 }

@@ -21,25 +21,41 @@
 //! F̄ = −k (ℓ̄ − L₀)/ℓ̄ · d̄,   d̄ = (d₀ + d₁)/2,   ℓ̄ = (ℓ₀ + ℓ₁)/2
 //! ```
 //!
-//! on end `a` (and `−F̄` on end `b`). Its torque is taken in the mid-step frame `Q₀ S`
-//! (`S² = cay(hΩ̄)`, the half rotation): `T = b_m × (Q₀S)ᵀ F̄` with the arm
-//! `b_m = (S a + Sᵀ a)/2`. Since `b = S b_m` and `S` turns about `Ω̄`, `Ω̄·T = Ω̄·(b × Q₀ᵀF̄)`,
-//! so the torque does exactly the work below; and the mid-step frame is what makes the step
-//! symmetric (the same torque taken in the start frame `Q₀` would be first order).
+//! on end `a` (and `−F̄` on end `b`). Its torque about the body's centre of mass, in the
+//! principal frame, is
+//!
+//! ```text
+//! T = (1 − [hΩ̄/2]×) (b × Q₀ᵀF̄)
+//! ```
+//!
+//! with the mean arm `b`: the torque of `F̄` at the anchor's mean position, taken in the start
+//! frame and turned by `1 − [hΩ̄/2]×`, the factor that makes the rotation's momentum change
+//! exactly that torque's impulse in the world (below).
 //!
 //! **Why it conserves energy at any step.** The translational kinetic energy changes by
 //! `m v̄·(v₁ − v₀) = h v̄·ΣF`; the rotational by `½(Π₀ + Π₁)·I⁻¹(Π₁ − Π₀) = Ω̄·(Π₁ − Π₀) = h Ω̄·T`
 //! (the gyroscopic term is orthogonal to `Ω̄`). So the work on an anchor is
-//! `h v̄·F̄ + h Ω̄·T = F̄·(h v̄ + Q₀(h Ω̄ × b)) = F̄·Δp`, the anchor's exact displacement, and summed over both ends
+//! `h v̄·F̄ + h Ω̄·T = F̄·(h v̄ + Q₀(h Ω̄ × b)) = F̄·Δp` (`Ω̄·(Ω̄ × c) = 0`), the anchor's exact
+//! displacement, and summed over both ends
 //! `F̄·Δd = −k (ℓ̄ − L₀)/ℓ̄ · (ℓ₁² − ℓ₀²)/2 = −ΔV`. Kinetic plus elastic energy is therefore
 //! conserved exactly, for any stiffness and step, up to the solver's tolerance; a constant force
 //! through the centre of mass does exactly its work `h v̄·F`, and a constant world force at a
-//! body point ([`GroupBody::load_moment`]), whose torque is taken like a spring end's (arm
-//! `b_m`, force in the mid-step frame), exactly its work `F·Δp` (its torque taken in the start
-//! frame would be first order; the point's torque is left out of the Newton matrix, which only
-//! slows convergence where such loads rival the springs). Linear momentum is conserved too (the
-//! pair forces cancel). The scheme is symmetric (swapping the ends of the step and `h → −h`
-//! maps it to itself), hence second order. On a linear spring it is the implicit midpoint rule:
+//! body point ([`GroupBody::load_moment`]), whose torque is taken like a spring end's (mean
+//! arm, start frame, turned by `1 − [hΩ̄/2]×`), exactly its work `F·Δp` and the angular impulse
+//! `h p̄ × F` (the point's torque is left out of the Newton matrix, which only slows
+//! convergence where such loads rival the springs); a constant world torque `τ`, taken the same
+//! way, gives exactly the angular impulse `h τ`.
+//!
+//! **Why it conserves momentum.** Linear momentum: the pair forces cancel. Angular momentum
+//! `L = Σ x × m v + Q Π` (world): with `x̄ = x₀ + ½ h v̄` the translation adds `h x̄ × F` per body.
+//! The rotation adds `Q₁Π₁ − Q₀Π₀ = Q₀ (cay(hΩ̄) Π₁ − Π₀) = h Q₀ (1 − [hΩ̄/2]×)⁻¹ T` (from the
+//! momentum equation and `cay = (1 − [u]×)⁻¹(1 + [u]×)`, `u = hΩ̄/2`), which the factor in `T`
+//! turns into `h (Q₀ b) × F̄`: the torque of `F̄` at the arm `Q₀ b = (Q₀a + Q₁a)/2`. So an end
+//! adds `h (x̄ + Q₀ b) × F̄ = h p̄ × F̄`, `p̄ = (p₀ + p₁)/2` its anchor's mean position, and a spring
+//! between two bodies `h (p̄_a − p̄_b) × F̄ = h d̄ × F̄ = 0`, since `F̄` is along `d̄`. A group free
+//! of outside loads keeps `L` exactly, up to the solver's tolerance and the rounding of the
+//! state. The scheme is symmetric (swapping the ends of the step and `h → −h` maps it to
+//! itself: `T`'s world impulse `h (Q₀ b) × F̄` is symmetric in the ends), hence second order. On a linear spring it is the implicit midpoint rule:
 //! unit amplification and the phase `2 atan(ωh/2)` per step, so a spring far too stiff for the
 //! step oscillates slower than it should, bounded, with its energy kept.
 //!
@@ -49,10 +65,11 @@
 //! # The solve
 //!
 //! The unknowns `(v̄, Ω̄)` of all bodies of the group solve a nonlinear system by Newton's method
-//! with its exact matrix: the mass and gyroscopic blocks, each spring's coupling `¼ Gᵀ K G` with
+//! with its exact matrix: the mass and gyroscopic blocks, each spring's coupling `¼ Eᵀ K G` with
 //! `K = k ((1 − L₀/ℓ̄) 1 + (L₀/ℓ̄²) d̄ d₁ᵀ/ℓ₁)` (the discrete-gradient force's derivative, not
-//! symmetric and indefinite for a compressed spring) and `G` the anchor's Jacobian, and the
-//! turning of the torques' frame and arms with `Ω̄` (in closed form, `turning_torque_jacobian`).
+//! symmetric and indefinite for a compressed spring), `G` the anchor's Jacobian and `Eᵀ` the
+//! map of a force at the anchor to the body's force and torque, and the turning of the torques'
+//! factor and arms with `Ω̄` (in closed form, `turning_torque_jacobian`).
 //!
 //! Each Newton system is solved directly (module `springs::sparse`: block elimination in
 //! minimum-degree order, no fill on a chain or a tree); where a pivot is singular, by BiCGSTAB
@@ -83,10 +100,10 @@ pub struct GroupBody {
     pub load: Wrench,
     /// Forces of `load.force` that act at body points rather than through the centre of mass,
     /// as their moment `P = Σ aᵢ Fᵢᵀ` (`aᵢ` the point's arm from the centre of mass in the body
-    /// frame, `Fᵢ` the world force; in `f64`, zero for none). Their torque `Σ (R aᵢ) × Fᵢ` turns with the
-    /// body, so the solve takes it at mid-step like a spring end's (see the module docs): it
-    /// does exactly the work `Fᵢ·Δpᵢ` and keeps the step symmetric. `load.torque` must not
-    /// contain it.
+    /// frame, `Fᵢ` the world force; in `f64`, zero for none). Their torque `Σ (R aᵢ) × Fᵢ` turns
+    /// with the body, so the solve takes it like a spring end's (see the module docs): it does
+    /// exactly the work `Fᵢ·Δpᵢ` and keeps the step symmetric. `load.torque` must not contain
+    /// it.
     pub load_moment: DMat3,
 }
 
@@ -229,11 +246,9 @@ struct Link {
 #[derive(Debug, Clone, Copy, Default)]
 struct Linearized {
     /// Mean anchors `b = (a + cay(hΩ̄) a)/2` (principal frame at the start) of both ends: the
-    /// anchors' displacement is `h v̄ + Q₀ (hΩ̄ × b)`.
+    /// anchors' displacement is `h v̄ + Q₀ (hΩ̄ × b)`, and `b` is the torques' lever arm (see
+    /// `evaluate`).
     b: [DVec3; 2],
-    /// The same displacement seen from the mid-step frame `Q₀ S` (`S² = cay(hΩ̄)`): arms
-    /// `(S a + Sᵀ a)/2`, the torques' lever arms (see `evaluate`).
-    arm: [DVec3; 2],
     /// `−2 ∂F̄/∂d₁ = k ((1 − L₀/ℓ̄) 1 + (L₀/ℓ̄²) d̄ n₁ᵀ)` (world frame).
     k: DMat3,
     /// The force on end `a`, `F̄`.
@@ -268,10 +283,9 @@ pub struct ImplicitSpringSolver {
     ends_start: Vec<usize>,
     /// Scratch of the counting sort.
     cursor: Vec<usize>,
-    /// Per body, the half rotation `S` (`S² = cay(hΩ̄)`) as a matrix.
-    turn: Vec<DMat3>,
-    /// Per body, the mid-step frame `Q₀ S` as a matrix.
-    mid: Vec<DMat3>,
+    /// Per body, `F (1 − [hΩ̄/2]×)` (`F` masking locked axes): what turns the start-frame
+    /// torque `b × Q₀ᵀf` into the one the step applies (see `evaluate`).
+    unturn: Vec<DMat3>,
     /// Per body, `(1 − [hΩ̄/2]×)⁻¹`: the derivative of the Cayley rotation (see `evaluate`).
     cayley_derivative: Vec<DMat3>,
     krylov: Krylov,
@@ -305,8 +319,7 @@ impl Default for ImplicitSpringSolver {
             ends_of: Vec::new(),
             ends_start: Vec::new(),
             cursor: Vec::new(),
-            turn: Vec::new(),
-            mid: Vec::new(),
+            unturn: Vec::new(),
             cayley_derivative: Vec::new(),
             krylov: Krylov::default(),
             lu: BlockLu::default(),
@@ -352,41 +365,15 @@ fn cayley(w: DVec3) -> DQuat {
     DQuat::from_xyzw(half.x, half.y, half.z, 1.0).normalize()
 }
 
-/// `√c` for a unit quaternion with `w > −1` (always, for a Cayley rotation): `c + 1`
-/// The mid-step torque (principal frame) of the forces a body feels at its points, from their
-/// moment `P = Σ aᵢ Fᵢᵀ` (arms in the principal frame): `Σ ((S aᵢ + Sᵀ aᵢ)/2) × (Mᵀ Fᵢ)` with
-/// `M = Q₀ S` the mid-step frame, i.e. the axial vector of `X = A P M` with `A = (S + Sᵀ)/2`,
-/// `Tₖ = εₖₐᵦ Xₐᵦ`.
-fn point_torque(s: &Start, half: DQuat) -> DVec3 {
+/// The start-frame torque (principal frame) of the forces a body feels at its points, from
+/// their moment `P = Σ aᵢ Fᵢᵀ` (arms in the principal frame): `Σ (C aᵢ) × (Q₀ᵀ Fᵢ)` with the mean
+/// arm `C a = (a + cay(hΩ̄) a)/2`, i.e. the axial vector of `X = C P Q₀`, `Tₖ = εₖₐᵦ Xₐᵦ`.
+fn point_torque(s: &Start, cayley: &DMat3) -> DVec3 {
     if s.moment == DMat3::ZERO {
         return DVec3::ZERO;
     }
-    let turn = DMat3::from_quat(half);
-    let arm = 0.5 * (turn + turn.transpose());
-    let mid = s.r * turn;
-    s.free * crate::math::axial_vector(arm * s.moment * mid)
-}
-
-/// normalized, half the angle about the same axis, without trigonometry.
-#[inline]
-fn half_rotation(c: DQuat) -> DQuat {
-    DQuat::from_xyzw(c.x, c.y, c.z, c.w + 1.0).normalize()
-}
-
-/// `∂δθ/∂w` of the half rotation `S` of `cay(hw)` (see `half_rotation`), perturbed in its own
-/// frame (`dS = S [δθ]×`), without trigonometry: with `u = hw/2` and `σ = √(1 + |u|²)`, `S` is
-/// itself a Cayley rotation, `S = cay(g)` with `g = 2u/(1 + σ)` (its quaternion is
-/// `(u, 1 + σ)` normalized), and the Cayley map's right-trivialized derivative is
-/// `δθ = (1 − [g/2]×) dg / (1 + |g|²/4)`, with
-/// `dg = (2/(1 + σ)) du − 2/((1 + σ)² σ) u (u·du)`.
-fn half_turn_jacobian(h: f64, w: DVec3) -> DMat3 {
-    let u = 0.5 * h * w;
-    let sigma = (1.0 + u.length_squared()).sqrt();
-    let f = 2.0 / (1.0 + sigma);
-    let g = f * u;
-    let dg = f * DMat3::IDENTITY - (2.0 / ((1.0 + sigma) * (1.0 + sigma) * sigma)) * outer(u, u);
-    let right = (DMat3::IDENTITY - skew(0.5 * g)) * (1.0 / (1.0 + 0.25 * g.length_squared()));
-    (0.5 * h) * (right * dg)
+    let mean = 0.5 * (DMat3::IDENTITY + *cayley);
+    crate::math::axial_vector(mean * s.moment * s.r)
 }
 
 fn v3(z: &[f64]) -> DVec3 {
@@ -786,31 +773,27 @@ impl ImplicitSpringSolver {
     /// Jacobian) and returns its norm, scaled per body by `1/√m`, `1/√I`.
     fn evaluate(&mut self, h: f64) -> f64 {
         self.cayley.clear();
-        self.turn.clear();
-        self.mid.clear();
+        self.unturn.clear();
         self.cayley_derivative.clear();
         for (i, s) in self.starts.iter().enumerate() {
             let z = &self.z[6 * i..6 * i + 6];
             let vbar = v3(&z[..3]);
             let wbar = s.free * v3(&z[3..]);
-            let c = cayley(h * wbar);
-            let half = half_rotation(c);
-            let turn = DMat3::from_quat(half);
-            self.turn.push(turn);
-            self.cayley.push(turn * turn);
-            self.mid.push(s.r * turn);
+            let cay = DMat3::from_quat(cayley(h * wbar));
+            self.cayley.push(cay);
             // From (1 − [w/2]×) cay(w) a = (1 + [w/2]×) a: d(cay(w) a) = −(1 − [w/2]×)⁻¹ [b]× dw,
             // and (1 − [u]×)⁻¹ = 1 + ([u]× + [u]×²)/(1 + |u|²).
             let u = skew(0.5 * h * wbar);
             let uu = (0.5 * h * wbar).length_squared();
             self.cayley_derivative
                 .push(DMat3::IDENTITY + (u + u * u) * (1.0 / (1.0 + uu)));
+            self.unturn
+                .push(DMat3::from_diagonal(s.free) * (DMat3::IDENTITY - u));
             let r = &mut self.residual[6 * i..6 * i + 6];
             put(&mut r[..3], s.mass * (vbar - s.v) - 0.5 * h * s.force);
-            // External torque in the principal frame at mid-step (symmetric in the two ends),
-            // with the forces at body points taken like spring ends: arm (S a + Sᵀ a)/2 across
-            // the mid-step force.
-            let torque = self.mid[i].transpose() * s.torque + point_torque(s, half);
+            // External torque: the world torque and the forces at body points taken like spring
+            // ends (start frame, mean arm), turned by `1 − [hΩ̄/2]×` (see the module docs).
+            let torque = self.unturn[i] * (s.r.transpose() * s.torque + point_torque(s, &cay));
             let iw = s.inertia * wbar;
             let rot = iw - s.pi + 0.5 * h * wbar.cross(iw) - 0.5 * h * torque;
             // A locked axis has no equation of motion: its row pins Ω̄ to 0.
@@ -825,8 +808,6 @@ impl ImplicitSpringSolver {
                         let z = &self.z[6 * end.body..6 * end.body + 6];
                         let rotated = self.cayley[end.body] * end.local;
                         lin.b[e] = 0.5 * (end.local + rotated);
-                        let turn = &self.turn[end.body];
-                        lin.arm[e] = 0.5 * (*turn * end.local + turn.transpose() * end.local);
                         p1[e] = s.x + h * v3(&z[..3]) + s.r * rotated;
                     }
                     None => p1[e] = end.fixed,
@@ -851,7 +832,7 @@ impl ImplicitSpringSolver {
             for (e, end) in link.ends.iter().enumerate() {
                 if let Some(s) = self.starts.get(end.body) {
                     let f = if e == 0 { force } else { -force };
-                    let torque = s.free * lin.arm[e].cross(self.mid[end.body].transpose() * f);
+                    let torque = self.unturn[end.body] * lin.b[e].cross(s.r.transpose() * f);
                     let r = &mut self.residual[6 * end.body..6 * end.body + 6];
                     add(&mut r[..3], -0.5 * h * f);
                     add(&mut r[3..], -0.5 * h * torque);
@@ -868,28 +849,27 @@ impl ImplicitSpringSolver {
             .sum::<f64>()
     }
 
-    /// `∂τ/∂Ω̄` of the total torque on body `i` in its mid-step frame `M = Q₀S` (its springs'
-    /// forces and its load held at the current iterate's values): with the half rotation perturbed in its
-    /// own frame, `dS = S [δθ]×`, the pieces move as `d(Mᵀx) = [Mᵀx]× δθ`,
-    /// `d(S a) = −[S a]× S δθ`, `d(Sᵀa) = [Sᵀa]× δθ`, so
-    /// `∂τ/∂θ = [MᵀT]× + Σ ([arm]×[Mᵀf]× − ½[Mᵀf]× ([Sᵀa]× − [S a]× S))`, and
-    /// `δθ` from `half_turn_jacobian`.
+    /// `∂T/∂Ω̄` of the total torque on body `i` (its springs' forces and its loads held at the
+    /// current iterate's values): with `c = Σ b × Q₀ᵀf + Q₀ᵀτ + c_points` the start-frame torque
+    /// and `T = F (1 − [hΩ̄/2]×) c`, `∂T/∂Ω̄ = F (½h [c]× + (1 − [hΩ̄/2]×) ∂c/∂Ω̄)`, where the
+    /// mean arm turns with `Ω̄`, `∂b/∂Ω̄ = −½h D [b]×` (`D = (1 − [hΩ̄/2]×)⁻¹`, see `evaluate`), so
+    /// `∂(b × f₀)/∂Ω̄ = ½h [f₀]× D [b]×`. The forces at body points enter `c` but not its
+    /// derivative (see the module docs).
     fn turning_torque_jacobian(&self, h: f64, i: usize, w: DVec3) -> DMat3 {
         let s = &self.starts[i];
-        // The half rotation and the mid-step frame of the iterate, from its evaluation.
-        let turn = self.turn[i];
-        let to_mid = self.mid[i].transpose();
-        let mut by_theta = skew(to_mid * s.torque);
+        let to_start = s.r.transpose();
+        let mut c = to_start * s.torque + point_torque(s, &self.cayley[i]);
+        let mut by_turn = DMat3::ZERO;
         for &(link, e) in &self.ends_of[self.ends_start[i]..self.ends_start[i + 1]] {
-            let (end, lin) = (&self.links[link].ends[e], &self.lin[link]);
-            let f = if e == 0 { lin.force } else { -lin.force };
-            let y = skew(to_mid * f);
-            let (turned, back) = (turn * end.local, turn.transpose() * end.local);
-            let arm = 0.5 * (turned + back);
-            by_theta += skew(arm) * y - 0.5 * y * (skew(back) - skew(turned) * turn);
+            let lin = &self.lin[link];
+            let f0 = to_start * if e == 0 { lin.force } else { -lin.force };
+            let b = lin.b[e];
+            c += b.cross(f0);
+            by_turn += skew(f0) * self.cayley_derivative[i] * skew(b);
         }
         let free = DMat3::from_diagonal(s.free);
-        free * by_theta * half_turn_jacobian(h, w)
+        let unturn = DMat3::IDENTITY - skew(0.5 * h * w);
+        free * (0.5 * h) * (skew(c) + unturn * by_turn)
     }
 
     /// The mass and gyroscopic 6×6 block of body `i` at the current iterate.
@@ -924,12 +904,13 @@ impl ImplicitSpringSolver {
         h * v3(&du[..3]) + h * (s.r * turn)
     }
 
-    /// `Gᵀ f`: the generalized force of a world force `f` at the end (force; principal torque).
-    fn end_transpose(&self, h: f64, body: usize, arm: DVec3, f: DVec3) -> (DVec3, DVec3) {
+    /// `Eᵀ f`: the generalized force of a world force `f` at the end with mean arm `b`
+    /// (force; principal torque `F (1 − [hΩ̄/2]×) (b × Q₀ᵀ f)`, see `evaluate`).
+    fn end_transpose(&self, h: f64, body: usize, b: DVec3, f: DVec3) -> (DVec3, DVec3) {
         let s = &self.starts[body];
         (
             h * f,
-            h * s.free * arm.cross(self.mid[body].transpose() * f),
+            h * (self.unturn[body] * b.cross(s.r.transpose() * f)),
         )
     }
 
@@ -953,7 +934,7 @@ impl ImplicitSpringSolver {
             for (e, end) in link.ends.iter().enumerate() {
                 if end.body < self.starts.len() {
                     let (lin_part, rot_part) =
-                        self.end_transpose(h, end.body, lin.arm[e], if e == 0 { f } else { -f });
+                        self.end_transpose(h, end.body, lin.b[e], if e == 0 { f } else { -f });
                     let o = &mut out[6 * end.body..6 * end.body + 6];
                     add(&mut o[..3], lin_part);
                     add(&mut o[3..], rot_part);
@@ -968,9 +949,9 @@ impl ImplicitSpringSolver {
         let mut blocks = std::mem::take(&mut self.blocks);
         blocks.clear();
         blocks.extend((0..self.starts.len()).map(|i| self.body_block(h, i)));
-        // The torques turn with Ω̄ too (forces held): the mid-step frame M = Q₀S and the arms
-        // (S a + Sᵀa)/2 depend on Ω̄ through the half rotation S, a body's own 3×3 block (not
-        // symmetric); see `turning_torque_jacobian`.
+        // The torques turn with Ω̄ too (forces held): the factor 1 − [hΩ̄/2]× and the mean arms
+        // (a + cay(hΩ̄) a)/2 depend on Ω̄, a body's own 3×3 block (not symmetric); see
+        // `turning_torque_jacobian`.
         for (i, block) in blocks.iter_mut().enumerate() {
             let s = &self.starts[i];
             let w = s.free * v3(&self.z[6 * i + 3..6 * i + 6]);
@@ -1041,7 +1022,7 @@ impl ImplicitSpringSolver {
             let (a_in, b_in) = (a < len, b < len);
             let factors = |on: bool, body: usize, e: usize| {
                 if on {
-                    self.end_factors(h, body, lin.b[e], lin.arm[e])
+                    self.end_factors(h, body, lin.b[e])
                 } else {
                     EndFactors::default()
                 }
@@ -1074,16 +1055,16 @@ impl ImplicitSpringSolver {
     }
 
     /// The two 3×3 factors of a spring end's blocks of the Newton matrix (see [`add_coupling`]) on
-    /// body `i`, with mean anchor `b` and lever arm `arm` (see [`Linearized`]):
-    /// `G_turn = −h R C [b]× F`, how the body's turn moves the anchor (see `end_jacobian`), and
-    /// `E_turn = h F [arm]× Mᵀ`, the torque of a world force at the anchor (see
-    /// `end_transpose`); `F` masks locked axes, `M` is the mid-step frame.
-    fn end_factors(&self, h: f64, i: usize, b: DVec3, arm: DVec3) -> EndFactors {
+    /// body `i`, with mean anchor `b` (see [`Linearized`]): `G_turn = −h R D [b]× F`, how the
+    /// body's turn moves the anchor (see `end_jacobian`), and
+    /// `E_turn = h F (1 − [hΩ̄/2]×) [b]× Rᵀ`, the torque of a world force at the anchor (see
+    /// `end_transpose`); `F` masks locked axes, `R` is the start frame.
+    fn end_factors(&self, h: f64, i: usize, b: DVec3) -> EndFactors {
         let s = &self.starts[i];
         let free = DMat3::from_diagonal(s.free);
         EndFactors {
             move_by_turn: -h * (s.r * self.cayley_derivative[i] * skew(b)) * free,
-            torque_of_force: h * free * skew(arm) * self.mid[i].transpose(),
+            torque_of_force: h * self.unturn[i] * skew(b) * s.r.transpose(),
         }
     }
 

@@ -11,7 +11,6 @@
 use bevy_ecs::entity::Entity;
 use tumble_core::math::Real;
 
-use super::{Link, same_end};
 use crate::components::{MassProps, Pose, Velocity, kinetic_energy_f64};
 
 /// The bits of `values`: equal bits are equal inputs to the energy functions (`==` on floats
@@ -103,28 +102,5 @@ impl BodyMemo {
         mass: &MassProps,
     ) -> bool {
         self.entity == entity && same_bits(self.inputs, body_inputs(pose, velocity, mass))
-    }
-}
-
-/// A spring as the end of the last step measured it: the link (its stiffness, rest length and
-/// resolved ends are the inputs of its elastic energy besides its audited bodies' poses) and
-/// that energy.
-#[derive(Debug, Clone, Copy)]
-pub(super) struct SpringMemo {
-    /// The end pass that measured it.
-    pub(super) pass: u64,
-    pub(super) link: Link,
-    pub(super) elastic: Option<f64>,
-}
-
-impl SpringMemo {
-    /// True when `link` has the same inputs as the measured one, bit for bit, apart from its
-    /// audited bodies' poses (see [`BodyMemo::still`] for those).
-    #[inline]
-    pub(super) fn same_inputs(&self, link: &Link) -> bool {
-        let (a, b) = (&self.link.spring, &link.spring);
-        same_bits([a.stiffness, a.rest_length], [b.stiffness, b.rest_length])
-            && same_end(self.link.a, link.a)
-            && same_end(self.link.b, link.b)
     }
 }

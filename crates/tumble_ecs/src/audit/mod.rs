@@ -97,7 +97,7 @@ use crate::forces::{Spring, SpringEnd};
 use crate::stages::StageCursor;
 use crate::systems::Dynamic;
 use crate::validate::{BodyError, BodyErrorKind, Rejected, reject};
-use memo::{BodyMemo, SpringMemo};
+use memo::BodyMemo;
 
 /// Whether a world's steps are audited for energy created by the integrator (see the module
 /// docs). Insert it as a resource to override the default, [`EnergyAudit::Auto`].
@@ -144,8 +144,9 @@ struct Audited {
     mass: f64,
     /// Union–find parent.
     parent: usize,
-    /// The group's root, once the start pass has joined every spring's ends.
-    root: usize,
+    /// Its group's index in [`EnergyLedger::groups`], once the start pass has joined every
+    /// spring's ends.
+    group: usize,
     /// Unchanged since the end of the last step (bit for bit, [`memo`]).
     still: bool,
     /// Kinetic energy at the start of the step.
@@ -156,7 +157,7 @@ struct Audited {
 #[derive(Debug, Clone, Copy)]
 enum End {
     /// An audited body: its index and the body-local anchor.
-    Audited(usize, Vec3),
+    Audited(u32, Vec3),
     /// A fixed point (world anchor or static body), in world coordinates.
     Fixed(Vec3),
     /// A kinematic body: game code moves it and does work the audit cannot see.
@@ -165,21 +166,53 @@ enum End {
     Inactive,
 }
 
-/// A spring with its ends resolved once per step.
+/// A spring with its ends resolved once per step: the inputs of its elastic energy besides its
+/// audited bodies' poses, and that energy as the last end pass measured it ([`memo`]). Only
+/// these: a million springs are a million links.
 #[derive(Debug, Clone, Copy)]
 struct Link {
-    spring: Spring,
+    stiffness: Real,
+    rest_length: Real,
     a: End,
     b: End,
+    /// The end pass that measured `elastic` with these inputs (0: none did).
+    measured: u64,
+    /// The elastic energy that pass measured.
+    elastic: f64,
 }
 
 impl Link {
+    /// The spring `spring` with its ends resolved to `a` and `b`, not measured yet.
+    fn new(spring: &Spring, a: End, b: End) -> Self {
+        Self {
+            stiffness: spring.stiffness,
+            rest_length: spring.rest_length,
+            a,
+            b,
+            measured: 0,
+            elastic: 0.0,
+        }
+    }
+
     /// The audited bodies at its ends.
     fn audited_bodies(&self) -> impl Iterator<Item = usize> {
         [self.a, self.b].into_iter().filter_map(|end| match end {
-            End::Audited(i, _) => Some(i),
+            End::Audited(i, _) => Some(i as usize),
             _ => None,
         })
+    }
+
+    /// True when `other` has the same inputs, bit for bit, apart from its audited bodies'
+    /// poses (see [`BodyMemo::still`] for those).
+    fn same_inputs(&self, other: &Link) -> bool {
+        let bits = |l: &Link| [l.stiffness, l.rest_length].map(Real::to_bits);
+        bits(self) == bits(other) && same_end(self.a, other.a) && same_end(self.b, other.b)
+    }
+
+    /// `½ k (|d| − L₀)²` with the anchors at the world points `pa` and `pb` (J, `f64`).
+    fn elastic_energy(&self, pa: Vec3, pb: Vec3) -> f64 {
+        let stretch = (pa - pb).widen().length() - self.rest_length.widen();
+        0.5 * self.stiffness.widen() * stretch * stretch
     }
 }
 
@@ -237,8 +270,6 @@ pub struct EnergyLedger {
     end_passes: u64,
     /// The last end pass's kinetic energies, by body index, with their inputs ([`memo`]).
     measured_bodies: Vec<Option<BodyMemo>>,
-    /// The last end pass's elastic energies, by link index, with their inputs.
-    measured_springs: Vec<Option<SpringMemo>>,
     /// The groups were closed by an end pass since the last start: their end sums are the
     /// energies the bodies stand at now, if nothing changed ([`EnergyLedger::restart`]).
     closed: bool,
@@ -370,9 +401,11 @@ impl EnergyLedger {
     }
 
     /// The group (root index) a link belongs to, if it touches an audited body.
-    fn root_of(&self, link: &Link) -> Option<usize> {
+    fn group_of(&self, link: &Link) -> Option<usize> {
         match (link.a, link.b) {
-            (End::Audited(i, _), _) | (_, End::Audited(i, _)) => Some(self.bodies[i].root),
+            (End::Audited(i, _), _) | (_, End::Audited(i, _)) => {
+                Some(self.bodies[i as usize].group)
+            }
             _ => None,
         }
     }
@@ -380,7 +413,7 @@ impl EnergyLedger {
     /// World anchor of an end, from the pose `pose` gives an audited body.
     fn anchor(&self, end: End, pose: impl Fn(&Audited) -> Pose) -> Option<Vec3> {
         match end {
-            End::Audited(i, local) => Some(pose(&self.bodies[i]).transform_point(local)),
+            End::Audited(i, local) => Some(pose(&self.bodies[i as usize]).transform_point(local)),
             End::Fixed(p) => Some(p),
             End::Kinematic | End::Inactive => None,
         }
@@ -390,19 +423,15 @@ impl EnergyLedger {
     fn elastic(&self, link: &Link, pose: impl Fn(&Audited) -> Pose + Copy) -> Option<f64> {
         let pa = self.anchor(link.a, pose)?;
         let pb = self.anchor(link.b, pose)?;
-        Some(link.spring.elastic_energy(pa, pb))
+        Some(link.elastic_energy(pa, pb))
     }
 
     /// Link `k`'s elastic energy at the start of the step: the one the last step ended with
     /// when its inputs are the same bit for bit, else measured afresh.
-    fn start_elastic(&self, k: usize, link: &Link) -> Option<f64> {
-        if let Some(Some(memo)) = self.measured_springs.get(k)
-            && memo.pass == self.end_passes
-        {
-            // Its bodies are still, so their memos are from the same pass as the spring's.
-            if memo.same_inputs(link) && link.audited_bodies().all(|i| self.bodies[i].still) {
-                return memo.elastic;
-            }
+    fn start_elastic(&self, link: &Link) -> Option<f64> {
+        // Its bodies are still, so their memos are from the same pass as the spring's.
+        if link.measured == self.end_passes && link.audited_bodies().all(|i| self.bodies[i].still) {
+            return Some(link.elastic);
         }
         self.elastic(link, |b| b.start.0)
     }
@@ -446,21 +475,10 @@ impl EnergyLedger {
             let Some(link) = self.links.get(k) else {
                 return false;
             };
-            if !same_spring(&link.spring, spring) {
-                return false;
-            }
-            // An end that is not an audited body may have moved (a static body) or changed
-            // kind since: resolve it again.
-            let a = match link.a {
-                End::Audited(..) => link.a,
-                _ => end_of(self, ends, spring.a, spring.anchor_a),
-            };
-            let b = match (link.b, spring.b) {
-                (End::Audited(..), _) => link.b,
-                (_, SpringEnd::World(p)) => End::Fixed(p),
-                (_, SpringEnd::Body { body, anchor }) => end_of(self, ends, body, anchor),
-            };
-            if !(same_end(a, link.a) && same_end(b, link.b)) {
+            // Resolved again: an end that is not an audited body may have moved (a static
+            // body) or changed kind since.
+            let (a, b) = resolve_ends(self, ends, spring);
+            if !link.same_inputs(&Link::new(spring, a, b)) {
                 return false;
             }
             k += 1;
@@ -513,19 +531,21 @@ impl EnergyLedger {
         }
         for i in 0..self.bodies.len() {
             let Audited {
-                root, start_energy, ..
+                group,
+                start_energy,
+                ..
             } = self.bodies[i];
-            let g = &mut self.groups[root];
+            let g = &mut self.groups[group];
             g.start += start_energy;
             g.magnitude += start_energy;
         }
         for k in 0..self.links.len() {
             let link = self.links[k];
-            let Some(root) = self.root_of(&link) else {
+            let Some(group) = self.group_of(&link) else {
                 continue;
             };
-            if let Some(v) = self.start_elastic(k, &link) {
-                let g = &mut self.groups[root];
+            if let Some(v) = self.start_elastic(&link) {
+                let g = &mut self.groups[group];
                 g.start += v;
                 g.magnitude += v;
             }
@@ -537,7 +557,9 @@ impl EnergyLedger {
     #[cfg(test)]
     pub(crate) fn forget_measurements(&mut self) {
         self.measured_bodies.clear();
-        self.measured_springs.clear();
+        for link in &mut self.links {
+            link.measured = 0;
+        }
         self.closed = false;
     }
 }
@@ -551,32 +573,25 @@ type Ends<'w, 's> = Query<
     (With<RigidBody>, Without<Rejected>),
 >;
 
+/// Both ends of `spring`, resolved.
+fn resolve_ends(ledger: &EnergyLedger, ends: &Ends, spring: &Spring) -> (End, End) {
+    let a = end_of(ledger, ends, spring.a, spring.anchor_a);
+    let b = match spring.b {
+        SpringEnd::World(p) => End::Fixed(p),
+        SpringEnd::Body { body, anchor } => end_of(ledger, ends, body, anchor),
+    };
+    (a, b)
+}
+
 fn end_of(ledger: &EnergyLedger, ends: &Ends, body: Entity, anchor: Vec3) -> End {
     if let Some(i) = ledger.slot(body) {
-        return End::Audited(i, anchor);
+        return End::Audited(i as u32, anchor);
     }
     match ends.get(body) {
         Ok((_, _, true)) => End::Kinematic,
         Ok((t, true, _)) => End::Fixed(t.transform_point(anchor)),
         _ => End::Inactive,
     }
-}
-
-/// The same spring, bit for bit.
-fn same_spring(a: &Spring, b: &Spring) -> bool {
-    let bits = |s: &Spring| {
-        let (end, anchor_b) = match s.b {
-            SpringEnd::World(p) => (None, p),
-            SpringEnd::Body { body, anchor } => (Some(body), anchor),
-        };
-        let [x, y, z] = s.anchor_a.to_array();
-        let [bx, by, bz] = anchor_b.to_array();
-        (
-            (s.a, end),
-            [x, y, z, bx, by, bz, s.stiffness, s.damping, s.rest_length].map(Real::to_bits),
-        )
-    };
-    bits(a) == bits(b)
 }
 
 /// The same end, bit for bit.
@@ -618,6 +633,12 @@ pub fn audit_energy_start(
     }
     ledger.bodies.clear();
     ledger.groups.clear();
+    // Exact sizes: grown by doubling, a vector of a million entries would briefly be held
+    // twice, and this pass is the audit's peak.
+    ledger.bodies.reserve_exact(bodies.iter().len());
+    ledger
+        .links
+        .reserve_exact(springs.iter().len().saturating_sub(ledger.links.len()));
     for (entity, t, v, m) in &bodies {
         let i = ledger.bodies.len();
         let (energy, still) = ledger.start_kinetic(i, (entity, t, v, m));
@@ -629,45 +650,58 @@ pub fn audit_energy_start(
             load: (Vec3::ZERO, Vec3::ZERO),
             mass: m.mass().widen(),
             parent: i,
-            root: i,
+            group: 0,
             still,
             start_energy: energy,
         });
-        ledger.groups.push(GroupStep::default());
     }
-    ledger.links.clear();
+    // Each link is written over the last step's link at its index, keeping that one's
+    // measurement when the inputs are the same ([`memo`]).
+    let old = ledger.links.len();
+    let mut k = 0;
     for spring in &springs {
-        let a = end_of(ledger, &ends, spring.a, spring.anchor_a);
-        let b = match spring.b {
-            SpringEnd::World(p) => End::Fixed(p),
-            SpringEnd::Body { body, anchor } => end_of(ledger, &ends, body, anchor),
-        };
+        let (a, b) = resolve_ends(ledger, &ends, spring);
         if let (End::Audited(i, _), End::Audited(j, _)) = (a, b) {
-            ledger.union(i, j);
+            ledger.union(i as usize, j as usize);
         }
-        ledger.links.push(Link {
-            spring: *spring,
-            a,
-            b,
-        });
+        let mut link = Link::new(spring, a, b);
+        if k < old {
+            let last = ledger.links[k];
+            if last.same_inputs(&link) {
+                (link.measured, link.elastic) = (last.measured, last.elastic);
+            }
+            ledger.links[k] = link;
+        } else {
+            ledger.links.push(link);
+        }
+        k += 1;
     }
-    // Each body's group (roots are final now).
+    ledger.links.truncate(k);
+    // Each body's group (roots are final now), numbered in the order of their roots. A root
+    // is its group's smallest index (`union` attaches to the smaller), so it is met first and
+    // its group numbered before any other member asks for it.
     for i in 0..ledger.bodies.len() {
         let root = ledger.find(i);
-        ledger.bodies[i].root = root;
+        let group = if root == i {
+            ledger.groups.push(GroupStep::default());
+            ledger.groups.len() - 1
+        } else {
+            ledger.bodies[root].group
+        };
+        ledger.bodies[i].group = group;
         let entity = ledger.bodies[i].entity;
-        let g = &mut ledger.groups[root];
+        let g = &mut ledger.groups[group];
         g.members += 1;
         g.key = Some(g.key.map_or(entity, |k| k.min(entity)));
     }
     for k in 0..ledger.links.len() {
         let link = ledger.links[k];
-        let Some(root) = ledger.root_of(&link) else {
+        let Some(group) = ledger.group_of(&link) else {
             continue;
         };
         let kinematic = matches!(link.a, End::Kinematic) || matches!(link.b, End::Kinematic);
         let mass = |end: End| match end {
-            End::Audited(i, _) => ledger.bodies[i].mass,
+            End::Audited(i, _) => ledger.bodies[i as usize].mass,
             _ => f64::INFINITY,
         };
         let (ma, mb) = (mass(link.a), mass(link.b));
@@ -678,8 +712,8 @@ pub fn audit_energy_start(
         } else {
             ma * mb / (ma + mb)
         };
-        let omega_dt = (link.spring.stiffness.widen() / reduced).sqrt() * ledger.stability_span;
-        let g = &mut ledger.groups[root];
+        let omega_dt = (link.stiffness.widen() / reduced).sqrt() * ledger.stability_span;
+        let g = &mut ledger.groups[group];
         g.springs += 1;
         g.kinematic |= kinematic;
         g.omega_dt = g.omega_dt.max(omega_dt);
@@ -770,13 +804,12 @@ pub fn audit_energy(
     ledger.end_passes += 1;
     let pass = ledger.end_passes;
     ledger.measured_bodies.resize(ledger.bodies.len(), None);
-    ledger.measured_springs.resize(ledger.links.len(), None);
     for (entity, t, v, m, scale, has_accumulator) in &bodies {
         let Some(i) = ledger.slot(entity) else {
             continue;
         };
         let body = &mut ledger.bodies[i];
-        let root = body.root;
+        let group = body.group;
         body.end = *t;
         let (force, torque) = match gravity {
             // Bodies without an accumulator take gravity inside the integration.
@@ -790,32 +823,32 @@ pub fn audit_energy(
         let measured = BodyMemo::measure(pass, entity, t, v, m);
         let energy = measured.kinetic();
         ledger.measured_bodies[i] = Some(measured);
-        let g = &mut ledger.groups[root];
+        let g = &mut ledger.groups[group];
         g.end += energy;
         g.work += work;
         g.magnitude += energy + work.abs();
     }
     for k in 0..ledger.links.len() {
         let link = ledger.links[k];
-        let Some(root) = ledger.root_of(&link) else {
+        let Some(group) = ledger.group_of(&link) else {
             continue;
         };
         let elastic = ledger.elastic(&link, |b| b.end);
-        ledger.measured_springs[k] = Some(SpringMemo {
-            pass,
-            link,
-            elastic,
-        });
+        let memo = &mut ledger.links[k];
+        (memo.measured, memo.elastic) = match elastic {
+            Some(v) => (pass, v),
+            None => (0, 0.0),
+        };
         if let Some(v) = elastic {
-            ledger.groups[root].end += v;
-            ledger.groups[root].magnitude += v;
+            ledger.groups[group].end += v;
+            ledger.groups[group].magnitude += v;
         }
     }
     if std::mem::take(&mut ledger.restored) {
         // Move each restored account to its group's key (the smallest entity of the group).
         for i in 0..ledger.bodies.len() {
-            let Audited { entity, root, .. } = ledger.bodies[i];
-            if let Some(key) = ledger.groups[root].key
+            let Audited { entity, group, .. } = ledger.bodies[i];
+            if let Some(key) = ledger.groups[group].key
                 && key != entity
                 && let Some(account) = ledger.accounts.remove(&entity)
             {
@@ -827,12 +860,12 @@ pub fn audit_energy(
         account.seen = false;
     }
     let eps = ROUND_OFF_ULPS * Real::EPSILON.widen();
-    for root in 0..ledger.groups.len() {
-        // Only roots have a key: look before copying the group.
-        let Some(key) = ledger.groups[root].key else {
+    for group in 0..ledger.groups.len() {
+        // Every group has a member, so a key; a group without one would have nothing to audit.
+        let Some(key) = ledger.groups[group].key else {
             continue;
         };
-        let g = ledger.groups[root];
+        let g = ledger.groups[group];
         if g.kinematic {
             continue;
         }
@@ -872,7 +905,7 @@ pub fn audit_energy(
         }
         account.created = before;
         for i in 0..ledger.bodies.len() {
-            if ledger.bodies[i].root != root {
+            if ledger.bodies[i].group != group {
                 continue;
             }
             let body = ledger.bodies[i];

@@ -37,8 +37,10 @@ use thiserror::Error;
 use crate::text::path_for_terminal;
 
 mod live;
+mod sections;
 mod set;
 pub use live::remove_live_temporary_files;
+pub use sections::with_sections;
 pub use set::OutputSet;
 
 /// Most symbolic links followed when resolving an output path (Linux's `MAXSYMLINKS`).
@@ -111,6 +113,17 @@ pub enum OutputError {
     /// The output path is empty.
     #[error("the output path is empty")]
     EmptyPath,
+    /// A Markdown file to update lacks a section's markers (see [`with_sections`]).
+    #[error(
+        "{}: no <!-- {name}:begin --> … <!-- {name}:end --> markers",
+        path_for_terminal(.path)
+    )]
+    MissingMarkers {
+        /// The file.
+        path: std::path::PathBuf,
+        /// The section's name.
+        name: String,
+    },
     /// An I/O error while checking, writing or renaming.
     #[error("{}: {source}", path_for_terminal(.path))]
     Io {
@@ -140,6 +153,7 @@ impl OutputError {
             | Self::IsInput { path, .. }
             | Self::SymlinkLoop { path }
             | Self::UntrustedLink { path, .. }
+            | Self::MissingMarkers { path, .. }
             | Self::Io { path, .. } => path,
             Self::EmptyPath => Path::new(""),
         }

@@ -1,0 +1,306 @@
+//! Which free rotation a split method gives a body: its own split flow, or the exact flow where
+//! the split errs.
+//!
+//! `splitting` (and `splitting-xyz`, and `yoshida4`, a composition of it) integrate the
+//! torque-free body as an exact symmetric top `S` plus a residual rotation `R` about axis `c`
+//! (`b, c` the principal axes with the closest reciprocal moments `r = 1/I`, `a` the odd one).
+//! The Strang composition errs where `S` and `R` do not commute: per step the odd axis's rate
+//! is off by a relative
+//!
+//! ```text
+//! e = h² |ω_b ω_c| |I_b − I_c| / I_a
+//! ```
+//!
+//! and the orientation error over `T` seconds measures ≈ `0.4–0.7 e T/s` rad on plates and
+//! needles (f32, `I = (0.01, 1, 1.01)`, `(1e-4, 1, 1.0001)`, `(0.1, 1, 1.1)`, `(0.3, 1, 1.3)` at
+//! 1–10 rad/s, 60 and 240 Hz). The `exact` flow has no such error at any spin.
+//!
+//! That per-step error is a poor guide to what a run loses: on compact bodies it mostly
+//! averages out, on elongated ones it accumulates. Measured in `f64` against `exact` over 10 s
+//! (13 inertias from rods `(1e-4, 1, 1.0001)` and plates `(0.01, 1, 1.01)` to boxes and
+//! near-spheres, `|ω|Δt` from 0.003 to 3, random axes, 30, 60 and 240 Hz), the orientation
+//! error of `splitting` stays below
+//!
+//! ```text
+//! D = 2 (1 − ρ)² e_orbit ω_E T,     ρ = I_min / I_mid,     ω_E = √(2E / I_mid),
+//! e_orbit = h² |I_b − I_c| / I_a · min(E / √(I_b I_c), |L|² / (2 I_b I_c))
+//! ```
+//!
+//! in 1817 of 1820 cases of five sweeps (the other three, all far above any tolerance, within
+//! a factor of 2.4). `e_orbit` bounds `e` over the whole torque-free orbit (`|ω_b ω_c|` by the
+//! kinetic energy `E` and by `|L|²`), and `ω_E` is the rate scale of the energy: both are kept
+//! by the free flow, so the choice does not flicker as the body tumbles, and the two halves of
+//! a drift–kick–drift stage choose alike. `(1 − ρ)²` is the elongation: a rod or a narrow plate
+//! loses 20–40 times what a box does at the same `e`.
+//!
+//! Under [`FreeFlow::Auto`] (the default of a world) `splitting` and `splitting-xyz` check `D`
+//! for every body at every stage, from the state they are about to step, and give a body whose
+//! `D` over [`ACCURACY_HORIZON`] exceeds [`SPLIT_DRIFT_TOLERANCE`] — about what storing the
+//! state costs `exact` itself in the build's precision — the exact free flow instead
+//! ([`Integrator::exact_counterpart`]: `exact`): the same drift–kick–drift step, forces sampled
+//! at the same points, only the free rotation exact. `yoshida4` cancels the split's error to
+//! fourth order while `e` is small, so it switches to `exact4` where `e_orbit` of its largest
+//! stage (`|c₀| h ≈ 1.70 h`) exceeds [`COMPOSED_SPLIT_ERROR_LIMIT`]. A body that spins slowly never
+//! pays for the check beyond `|ω|²` (`e_orbit ≤ 0.75 h² |ω|²` and `ω_E ≤ √2 |ω|`, so
+//! `D ≤ 2.2 h² |ω|³ T`: `|I_b − I_c| ≤ I_a`, `I_max ≤ √2 √(I_b I_c)` and `I_max ≤ 2 I_mid`
+//! follow from the triangle inequality every [`MassProperties`] satisfies). The choice
+//! is a pure function of the state in `f64`, so it is the same on every kernel path, thread
+//! count and replay. [`FreeFlow::Method`] keeps every body on the method's own flow (to
+//! measure the method itself).
+
+use glam::DVec3;
+
+use super::Integrator;
+use super::frame::{principal_orientation, rotate64};
+use crate::mass::MassProperties;
+use crate::math::{Real, Widen};
+use crate::state::BodyState;
+
+/// The span over which a method's accuracy is judged (s): the drift `D` of the module docs, and
+/// the planner's accuracy warnings.
+pub const ACCURACY_HORIZON: Real = 10.0;
+
+/// Orientation drift over [`ACCURACY_HORIZON`] (rad) the split free rotation may cost a body
+/// before [`FreeFlow::Auto`] gives it the exact flow: about what rounding the stored state
+/// costs `exact` itself (`f32`: 1e-4 on boxes, 4e-4 on plates, 1e-2 on rods over 10 s; `f64`:
+/// 1e-8). In `f32` a box (I = (1, 2, 3)) switches above ≈ 1.2 rad/s at 60 Hz, a narrow plate
+/// (0.01, 1, 1.01) above ≈ 0.8 rad/s; in `f64` above ≈ 0.26 and 0.17 rad/s.
+pub const SPLIT_DRIFT_TOLERANCE: Real = if crate::math::DOUBLE_PRECISION {
+    1e-5
+} else {
+    1e-3
+};
+
+/// Relative error per step of the odd axis's rate under the split free rotation, `e` (module
+/// docs), above which the planner warns under [`FreeFlow::Method`]: 1 % a step, an orientation
+/// drift of about 5e-3 rad/s on a thin body. An ordinary box (I = (1, 2, 3)) reaches it at
+/// ≈ 6 rad/s about two axes at 60 Hz.
+pub const SPLIT_ERROR_LIMIT: Real = 1e-2;
+
+/// `e` on `yoshida4`'s largest stage (`|c₀| h ≈ 1.70 h` of the triple jump) above which a body
+/// takes the exact free flow (`exact4`) under [`FreeFlow::Auto`], and the planner warns under
+/// [`FreeFlow::Method`]. The composition cancels the
+/// split's error to fourth order only while it is small: measured over 10 s (f32, I at the
+/// triangle limit), 7.7 % per stage gives 1e-3–5e-3 rad, 31 % gives 0.04–0.2 rad.
+pub const COMPOSED_SPLIT_ERROR_LIMIT: Real = 0.15;
+
+/// Which free rotation a split method (`splitting`, `splitting-xyz`, `yoshida4`) gives each body
+/// (module docs). Methods that are not split (`exact`, `rk4`, the first-order ones) ignore it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(rename_all = "lowercase")
+)]
+pub enum FreeFlow {
+    /// The exact free flow for a body while the split's error per step exceeds its limit, the
+    /// method's own split flow otherwise.
+    #[default]
+    Auto,
+    /// The method's own free flow for every body, however fast it spins (the planner warns of
+    /// bodies above the limit).
+    Method,
+}
+
+impl FreeFlow {
+    /// Every setting, in declaration order.
+    pub const ALL: [FreeFlow; 2] = [FreeFlow::Auto, FreeFlow::Method];
+
+    /// The name used in scene files and on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            FreeFlow::Auto => "auto",
+            FreeFlow::Method => "method",
+        }
+    }
+}
+
+impl std::fmt::Display for FreeFlow {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for FreeFlow {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        FreeFlow::ALL
+            .into_iter()
+            .find(|m| m.name() == s)
+            .ok_or_else(|| "expected one of `auto`, `method`".to_owned())
+    }
+}
+
+/// The principal axes of the split: `a` the odd one, `(b, c)` the pair with the closest
+/// reciprocal moments; `None` for a locked axis (its rates are held: no split error).
+fn split_axes(i: [f64; 3]) -> Option<(usize, usize, usize)> {
+    if i.iter().any(|&x| x.is_nan() || x <= 0.0) {
+        return None;
+    }
+    let r = i.map(|x| 1.0 / x);
+    let a = (0..3)
+        .min_by(|&x, &y| {
+            let gap = |k: usize| (r[(k + 1) % 3] - r[(k + 2) % 3]).abs();
+            gap(x).total_cmp(&gap(y))
+        })
+        .unwrap_or(0);
+    Some((a, (a + 1) % 3, (a + 2) % 3))
+}
+
+/// `h² |ω_b ω_c| |I_b − I_c| / I_a` of the split free rotation (module docs) for principal
+/// moments `inertia` and principal rates `omega`. Zero for a body with a locked axis.
+pub fn split_rotation_error(inertia: DVec3, omega: DVec3, h: f64) -> f64 {
+    let (i, w) = (inertia.to_array(), omega.to_array());
+    let Some((a, b, c)) = split_axes(i) else {
+        return 0.0;
+    };
+    h * h * (w[b] * w[c]).abs() * (i[b] - i[c]).abs() / i[a]
+}
+
+/// `D`, the orientation drift (rad) the split free rotation predicts over `horizon` seconds
+/// for a body with principal moments `inertia` turning at principal rates `omega`, steps of
+/// `h` (module docs). Zero for a body with a locked axis.
+pub fn split_rotation_drift(inertia: DVec3, omega: DVec3, h: f64, horizon: f64) -> f64 {
+    let mut sorted = inertia.to_array();
+    if split_axes(sorted).is_none() {
+        return 0.0;
+    }
+    sorted.sort_by(f64::total_cmp);
+    let elongation = 1.0 - sorted[0] / sorted[1];
+    let energy = 0.5 * (inertia * omega * omega).element_sum();
+    let rate = (2.0 * energy / sorted[1]).sqrt();
+    let e_orbit = split_orbit_error(inertia, omega, h);
+    DRIFT_FACTOR * elongation * elongation * e_orbit * rate * horizon
+}
+
+/// `e_orbit`, the bound of [`split_rotation_error`] over the body's whole torque-free orbit:
+/// `|ω_b ω_c|` bounded by `E/√(I_b I_c)` and by `|L|²/(2 I_b I_c)` (module docs). Zero for a
+/// body with a locked axis.
+pub fn split_orbit_error(inertia: DVec3, omega: DVec3, h: f64) -> f64 {
+    let i = inertia.to_array();
+    let Some((a, b, c)) = split_axes(i) else {
+        return 0.0;
+    };
+    let energy = 0.5 * (inertia * omega * omega).element_sum();
+    let momentum2 = (inertia * omega).length_squared();
+    let bc = i[b] * i[c];
+    let orbit = (energy / bc.sqrt()).min(momentum2 / (2.0 * bc));
+    h * h * (i[b] - i[c]).abs() / i[a] * orbit
+}
+
+/// The constant of `D` (module docs).
+const DRIFT_FACTOR: f64 = 2.0;
+
+/// How a split method is judged for the switch.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Rule {
+    /// `D` over [`ACCURACY_HORIZON`] against [`SPLIT_DRIFT_TOLERANCE`] (`splitting`,
+    /// `splitting-xyz`).
+    Drift,
+    /// `e_orbit` of the largest stage against [`COMPOSED_SPLIT_ERROR_LIMIT`] (`yoshida4`).
+    StageError,
+}
+
+/// A split method's switch to its exact counterpart for the bodies it would integrate badly
+/// ([`FreeFlow::Auto`], module docs).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ExactSwitch {
+    exact: Integrator,
+    rule: Rule,
+    /// The span the split is judged on (s): the (largest) stage of a substep.
+    span: f64,
+    limit: f64,
+    /// `|ω|²` at or below which the body is inside the limit whatever its inertia (module
+    /// docs), less a margin for the triangle inequality's slack and the rounding of `|ω|²`.
+    quick: Real,
+}
+
+impl ExactSwitch {
+    /// The switch of `integrator` with substeps of `substep` (s) under `free_flow`; `None` when
+    /// every body keeps the method's flow (a method that is not split, or
+    /// [`FreeFlow::Method`]).
+    pub fn new(integrator: Integrator, free_flow: FreeFlow, substep: Real) -> Option<Self> {
+        if free_flow == FreeFlow::Method {
+            return None;
+        }
+        let exact = integrator.exact_counterpart()?;
+        let largest = integrator
+            .composition()
+            .iter()
+            .fold(0.0, |m: Real, c| m.max(c.abs()));
+        let span = (largest * substep).widen();
+        // Far above the rounding of `|ω|²` in either precision.
+        let margin = 1.0 + 1e-3;
+        let (rule, limit, quick) = if integrator.composition().len() == 1 {
+            // D ≤ 2.2 h² |ω|³ T (module docs).
+            let limit = SPLIT_DRIFT_TOLERANCE.widen();
+            let cube = limit / (2.2 * span * span * ACCURACY_HORIZON.widen());
+            (Rule::Drift, limit, cube.powf(2.0 / 3.0) / margin)
+        } else {
+            // e_orbit ≤ 0.75 h² |ω|² (module docs).
+            let limit = COMPOSED_SPLIT_ERROR_LIMIT.widen();
+            (
+                Rule::StageError,
+                limit,
+                2.0 * limit / (span * span) / margin,
+            )
+        };
+        Some(Self {
+            exact,
+            rule,
+            span,
+            limit,
+            quick: quick as Real,
+        })
+    }
+
+    /// The method a body takes when the switch applies to it.
+    pub fn exact(&self) -> Integrator {
+        self.exact
+    }
+
+    /// The limit the switch judges by: [`SPLIT_DRIFT_TOLERANCE`] (rad over
+    /// [`ACCURACY_HORIZON`]) for a method of one stage, [`COMPOSED_SPLIT_ERROR_LIMIT`] (per
+    /// stage) for a composition.
+    pub fn limit(&self) -> f64 {
+        self.limit
+    }
+
+    /// True when the split would cost this body more than the limit (module docs), from its
+    /// state and mass. Cheap unless it spins fast: one `|ω|²`.
+    #[inline(always)]
+    pub fn applies(&self, state: &BodyState, mass: &MassProperties) -> bool {
+        let w = state.angular_velocity;
+        // A fixed order of operations: the same bits on every path.
+        let w2 = w.x * w.x + w.y * w.y + w.z * w.z;
+        if w2 <= self.quick {
+            return false;
+        }
+        // A copy: a reference would escape into the cold call and keep the caller's state out
+        // of registers on the hot path. A NaN rate compares false here too: the method's own
+        // step takes it and reports it.
+        self.exceeds(*state, mass)
+    }
+
+    /// `measure > limit`, out of line.
+    #[cold]
+    #[inline(never)]
+    fn exceeds(&self, state: BodyState, mass: &MassProperties) -> bool {
+        self.measure(&state, mass) > self.limit
+    }
+
+    /// What the switch compares with [`limit`](Self::limit): the predicted drift `D` (rad over
+    /// [`ACCURACY_HORIZON`]) or the largest stage's `e_orbit` (module docs).
+    #[cold]
+    pub fn measure(&self, state: &BodyState, mass: &MassProperties) -> f64 {
+        let principal = principal_orientation(state, mass).widen();
+        let omega = rotate64(principal.conjugate(), state.angular_velocity.widen());
+        let inertia = mass.principal_inertia().widen();
+        match self.rule {
+            Rule::Drift => {
+                split_rotation_drift(inertia, omega, self.span, ACCURACY_HORIZON.widen())
+            }
+            Rule::StageError => split_orbit_error(inertia, omega, self.span),
+        }
+    }
+}
