@@ -10,7 +10,7 @@ use bevy_app::{App, FixedUpdate, Update};
 use bevy_ecs::prelude::*;
 use bevy_time::{Fixed, Time, TimePlugin, TimeUpdateStrategy};
 use bevy_transform::components::Transform;
-use tumble::ecs::plugin::{TumblePlugin, TumbleStep};
+use tumble::ecs::schedule::{TumblePlugin, TumbleStep};
 use tumble::math::{Quat, Real, Vec3, to_f64};
 use tumble::prelude::*;
 

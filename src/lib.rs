@@ -52,8 +52,8 @@
 //! | `parry` | yes | mass properties from parry3d shapes |
 //! | `parallel` | yes | big tables split over bevy's compute pool (bit-identical results) |
 //! | `scene` | no | `tumble::scene`: TOML scene files, CSV trajectories |
-//! | `serde` | no | serde for every component and resource; `ecs::snapshot` save / resume |
-//! | `bevy_app` | no | `ecs::plugin::TumblePlugin`: the step in a Bevy app's `FixedUpdate` |
+//! | `serde` | no | serde for every component and resource; `ecs::state::Snapshot` save / resume |
+//! | `bevy_app` | no | `ecs::schedule::TumblePlugin`: the step in a Bevy app's `FixedUpdate` |
 //! | `f64` | no | double precision throughout: [`math::Real`] = `f64`, `Vec3` = `DVec3`, … |
 //! | `parry-f64` | no | shapes from parry3d-f64 (implies `f64`) |
 //! | `enhanced-determinism` | no | glam's `scalar-math`: no SIMD lane order anywhere (the default build already gives the same bits; pinned checksums hold in both) |

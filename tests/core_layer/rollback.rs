@@ -4,7 +4,7 @@
 //! `SyncTestSession` finds every resimulated frame equal to the first simulation of it.
 
 use tumble::bevy_ecs::prelude::*;
-use tumble::ecs::rollback::{Parts, RollbackError};
+use tumble::ecs::state::{Parts, RollbackError};
 use tumble::math::{Real, Vec3};
 use tumble::prelude::*;
 
@@ -216,7 +216,7 @@ fn a_restore_into_other_entities_fails_and_changes_nothing() {
 fn a_body_costs_a_few_hundred_bytes() {
     let mut w = world(Integrator::Splitting, 1);
     let saved = RollbackSnapshot::capture(&mut w);
-    let per_body = std::mem::size_of::<tumble::ecs::rollback::BodyRecord>();
+    let per_body = std::mem::size_of::<tumble::ecs::state::BodyRecord>();
     // Pose, velocity, mass properties, two loads, gravity scale, damping, an entity and flags:
     // 43 reals and 9 bytes, padded.
     let reals = 43 * std::mem::size_of::<Real>();
@@ -250,7 +250,7 @@ fn ggrs_sync_test_resimulates_every_frame_to_the_same_checksum() {
         let implicit = synced
             .world
             .iter_entities()
-            .filter(|e| e.contains::<tumble::ecs::stiff::ImplicitSpring>())
+            .filter(|e| e.contains::<tumble::ecs::components::ImplicitSpring>())
             .count();
         assert!(implicit > 0);
     }

@@ -124,7 +124,7 @@ impl Engine for Ecs {
 }
 
 /// The world of an [`Ecs`] whose "step" is only the runner's check of the world before a step
-/// ([`PhysicsRunner::prepare`](tumble_ecs::runner::PhysicsRunner::prepare)): what the check
+/// ([`PhysicsRunner::prepare`](tumble_ecs::schedule::PhysicsRunner::prepare)): what the check
 /// costs on its own.
 pub struct RunnerCheck(Ecs);
 

@@ -7,7 +7,7 @@ use std::time::Instant;
 
 use serde::Serialize;
 use tumble_ecs::prelude::SpringSolver;
-use tumble_ecs::rollback::RollbackSnapshot;
+use tumble_ecs::state::RollbackSnapshot;
 use tumble_rapier::presets::ChainStart;
 
 use crate::engines::Engine;

@@ -29,7 +29,7 @@ pub(crate) fn init(verbose: u8, quiet: bool) {
         // quarantines (target `tumble`); the engine's own events say the same with entity ids,
         // so by default they are kept to errors. `RUST_LOG` shows them.
         _ => EnvFilter::builder().parse_lossy(format!(
-            "{level},tumble_ecs::schedule=error,tumble_ecs::validate=error"
+            "{level},tumble_ecs::schedule=error,tumble_ecs::components=error"
         )),
     };
     // `try_init`: a second subscriber (none today) must not make the CLI panic.

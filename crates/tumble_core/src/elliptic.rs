@@ -45,7 +45,7 @@ pub use carlson::{carlson_rc1, carlson_rf, carlson_rj, integral_sn2_over};
 use std::f64::consts::{FRAC_PI_2, PI};
 
 // tumble's own sine and cosine (IEEE arithmetic only): the same bits on every platform.
-use crate::integrate::sin_cos;
+use crate::simd::sin_cos;
 
 /// Most AGM/Landen levels ever needed: with `m₁` as small as the least positive f64 the scale
 /// converges in about 16 levels; 40 leaves a wide margin.

@@ -27,10 +27,9 @@ pub mod mass;
 pub mod math;
 pub mod prefetch;
 pub mod rotation;
-#[cfg(feature = "serde")]
-mod serde_impls;
 #[cfg(any(feature = "parry", feature = "parry-f64"))]
 pub mod shapes;
+mod simd;
 pub mod springs;
 pub mod state;
 

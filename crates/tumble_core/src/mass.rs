@@ -105,8 +105,8 @@ impl Density {
     feature = "serde",
     derive(serde::Serialize, serde::Deserialize),
     serde(
-        try_from = "crate::serde_impls::MassPropertiesData",
-        into = "crate::serde_impls::MassPropertiesData"
+        try_from = "crate::mass::MassPropertiesData",
+        into = "crate::mass::MassPropertiesData"
     )
 )]
 pub struct MassProperties {
@@ -379,6 +379,64 @@ impl MassProperties {
     fn world_diagonal_mul(&self, body_rotation: Quat, diagonal: Vec3, world: Vec3) -> Vec3 {
         let frame = quat_mul(body_rotation, self.principal_frame);
         quat_rotate(frame, diagonal * quat_rotate(frame.inverse(), world))
+    }
+}
+
+/// The stored fields of a [`MassProperties`], as saved (feature `serde`): a checked mirror, so a
+/// loaded value is exactly the saved one (bit for bit) and never an invalid one.
+#[cfg(feature = "serde")]
+#[derive(serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct MassPropertiesData {
+    pub inv_mass: Real,
+    pub principal_inertia: Vec3,
+    pub inv_principal_inertia: Vec3,
+    pub principal_frame: Quat,
+    pub local_center_of_mass: Vec3,
+}
+
+#[cfg(feature = "serde")]
+impl TryFrom<MassPropertiesData> for MassProperties {
+    type Error = crate::error::InvalidInput;
+
+    /// Accepts the saved fields only if they are what the constructors would have produced:
+    /// positive finite inverse mass, valid moments with their exact reciprocals, a unit frame,
+    /// a finite centre of mass. Nothing is recomputed, so the value is restored bit for bit.
+    fn try_from(d: MassPropertiesData) -> Result<Self, crate::error::InvalidInput> {
+        if !(d.inv_mass.is_finite() && d.inv_mass > 0.0) {
+            return Err(crate::error::InvalidInput::NonPositiveMass(
+                1.0 / d.inv_mass,
+            ));
+        }
+        crate::error::check_unit_quat("principal frame", d.principal_frame)?;
+        crate::error::check_finite_vec3("centre of mass", d.local_center_of_mass)?;
+        let rebuilt =
+            MassProperties::new(crate::Mass::new(1.0 / d.inv_mass)?, d.principal_inertia)?;
+        if rebuilt.inv_principal_inertia() != d.inv_principal_inertia {
+            return Err(crate::error::InvalidInput::Inconsistent(
+                "reciprocal principal moments",
+            ));
+        }
+        Ok(MassProperties::from_parts(
+            d.inv_mass,
+            d.principal_inertia,
+            d.inv_principal_inertia,
+            d.principal_frame,
+            d.local_center_of_mass,
+        ))
+    }
+}
+
+#[cfg(feature = "serde")]
+impl From<MassProperties> for MassPropertiesData {
+    fn from(m: MassProperties) -> Self {
+        Self {
+            inv_mass: m.inv_mass(),
+            principal_inertia: m.principal_inertia(),
+            inv_principal_inertia: m.inv_principal_inertia(),
+            principal_frame: m.principal_frame(),
+            local_center_of_mass: m.local_center_of_mass(),
+        }
     }
 }
 

@@ -17,7 +17,7 @@ pub(crate) fn exp_rotation(theta: Vec3) -> Quat {
         let angle = angle2.sqrt();
         // tumble's own sine and cosine (IEEE arithmetic only, in f64, rounded once): the same
         // bits on every platform, where `f32::sin_cos` follows the platform's libm.
-        let (s, c) = crate::integrate::sin_cos((0.5 * angle).widen());
+        let (s, c) = crate::simd::sin_cos((0.5 * angle).widen());
         let (s, c) = (s.narrow(), c.narrow());
         let xyz = theta * (s / angle);
         Quat::from_xyzw(xyz.x, xyz.y, xyz.z, c)

@@ -3,9 +3,9 @@
 //! The `bevy_ecs` layer of tumble: components ([`Pose`](components::Pose),
 //! [`Velocity`](components::Velocity), [`MassProps`](components::MassProps),
 //! [`ForceAccumulator`](components::ForceAccumulator), …), force generators, the integrate
-//! systems, a [`PhysicsRunner`](runner::PhysicsRunner) that steps a world by a
+//! systems, a [`PhysicsRunner`](schedule::PhysicsRunner) that steps a world by a
 //! [`PhysicsPlan`](schedule::PhysicsPlan) holding only what the world needs and plans again
-//! whenever the world changes, a fixed-step [`FixedStepper`](stepper::FixedStepper) and
+//! whenever the world changes, a fixed-step [`FixedStepper`](schedule::FixedStepper) and
 //! validation that keeps bad data out.
 
 // docs.rs builds with `--cfg docsrs` on nightly: feature-gated items are marked with the
@@ -16,29 +16,17 @@
 // ECS queries name their filters inline, as bevy itself does.
 #![allow(clippy::type_complexity)]
 
+// Folders read bottom-up: `components` and `parallel` are leaves; `forces`, `integrate`,
+// `springs`, `audit`, `stability` and `state` build on them; `schedule` ties them together.
 pub mod audit;
-pub mod body_forces;
-pub mod checksum;
 pub mod components;
-pub mod damping;
 pub mod forces;
-pub mod generator_check;
+pub mod integrate;
 pub mod parallel;
-#[cfg(feature = "bevy_app")]
-pub mod plugin;
-pub mod rollback;
-pub mod runner;
 pub mod schedule;
-#[cfg(feature = "serde")]
-pub mod snapshot;
+pub mod springs;
 pub mod stability;
-pub mod stages;
-pub mod stepper;
-pub mod stiff;
-pub mod systems;
-mod table;
-mod targets;
-pub mod validate;
+pub mod state;
 
 /// Everything a game loop needs, in one import. It holds no name of the preludes of the Bevy
 /// crates a game uses beside tumble (`bevy_ecs`, `bevy_app`, `bevy_math`, `bevy_time`,
@@ -47,22 +35,20 @@ pub mod validate;
 /// `f32`).
 pub mod prelude {
     pub use crate::audit::EnergyAudit;
-    pub use crate::body_forces::{ApplyForces, BodyForces};
-    pub use crate::checksum::{WorldChecksum, world_checksum};
     pub use crate::components::{
-        AssumedMass, Damping, ForceAccumulator, Gravity, GravityScale, Kinematic, MassProps,
-        PhysicsSettings, Pose, RigidBody, Static, Velocity,
+        AssumedMass, BodyError, BodyErrorKind, ConstantForce, ConstantLocalForce, ConstantTorque,
+        Damping, ForceAccumulator, GeneratorError, GeneratorErrorKind, Gravity, GravityScale,
+        Kinematic, MassProps, PhysicsErrors, PhysicsSettings, Pose, Rejected, RejectedGenerator,
+        RigidBody, Spring, SpringEnd, SpringSolver, Static, Velocity,
     };
-    pub use crate::forces::{ConstantForce, ConstantLocalForce, ConstantTorque, Spring, SpringEnd};
-    pub use crate::generator_check::{GeneratorError, GeneratorErrorKind, RejectedGenerator};
+    pub use crate::forces::{ApplyForces, BodyForces};
     pub use crate::parallel::Parallelism;
-    pub use crate::rollback::{RollbackError, RollbackSnapshot};
-    pub use crate::runner::{ForceSystems, PhysicsRunner};
-    pub use crate::schedule::{PhysicsPlan, PhysicsSet, Stage};
+    pub use crate::schedule::{
+        FixedStepper, ForceSystems, FrameSteps, PhysicsPlan, PhysicsRunner, PhysicsSet, Stage,
+        interpolate,
+    };
     pub use crate::stability::{StabilityWarning, check_stability};
-    pub use crate::stepper::{FixedStepper, FrameSteps, interpolate};
-    pub use crate::stiff::SpringSolver;
-    pub use crate::validate::{BodyError, BodyErrorKind, PhysicsErrors, Rejected};
+    pub use crate::state::{RollbackError, RollbackSnapshot, WorldChecksum, world_checksum};
     pub use tumble_core::integrate::FreeFlow;
     pub use tumble_core::{Density, Integrator, Mass, MassProperties};
 }

@@ -8,9 +8,9 @@ use bevy_ecs::prelude::*;
 use bevy_ecs::schedule::ScheduleLabel;
 use bevy_time::{Fixed, Time, TimePlugin, TimeUpdateStrategy, Virtual};
 use tumble_core::math::{Real, Vec3, to_f64};
-use tumble_ecs::checksum::world_checksum;
-use tumble_ecs::plugin::{TumblePlugin, TumbleStep};
 use tumble_ecs::prelude::*;
+use tumble_ecs::schedule::{TumblePlugin, TumbleStep};
+use tumble_ecs::state::world_checksum;
 
 /// A schedule of the game's own.
 #[derive(ScheduleLabel, Debug, Clone, PartialEq, Eq, Hash)]

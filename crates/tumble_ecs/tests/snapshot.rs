@@ -5,7 +5,7 @@ use tumble_core::math::{Quat, Real, Vec3, Widen};
 
 use tumble_core::{Integrator, Mass, MassProperties};
 use tumble_ecs::prelude::*;
-use tumble_ecs::snapshot::{Snapshot, SnapshotError};
+use tumble_ecs::state::{Snapshot, SnapshotError};
 
 /// A world with every kind of thing a snapshot must carry.
 fn scene(integrator: Integrator) -> World {

@@ -6,8 +6,8 @@ use bevy_app::App;
 use bevy_ecs::prelude::*;
 use bevy_ecs::schedule::ScheduleLabel;
 use tumble_core::math::{Real, Vec3, to_f64};
-use tumble_ecs::plugin::TumblePlugin;
 use tumble_ecs::prelude::*;
+use tumble_ecs::schedule::TumblePlugin;
 
 /// A schedule of the game's own, run once per step by hand.
 #[derive(ScheduleLabel, Debug, Clone, PartialEq, Eq, Hash)]

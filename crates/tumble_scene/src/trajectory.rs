@@ -106,7 +106,7 @@ impl TrajectoryStats {
 ///
 /// `on_step(step, world)` is called after each step (1 ..= `steps`) has been run and its rows
 /// written: report progress or read the world there (e.g. new
-/// [`PhysicsErrors`](tumble_ecs::validate::PhysicsErrors)), and return [`ControlFlow::Break`] to stop (the result is then
+/// [`PhysicsErrors`](tumble_ecs::components::PhysicsErrors)), and return [`ControlFlow::Break`] to stop (the result is then
 /// [`TrajectoryError::Stopped`]). `out` is buffered here; pass it unbuffered. Rows already
 /// written stay in `out` on error: write to a temporary file and rename it only on success
 /// (see [`crate::output::OutputFile`]).
@@ -273,7 +273,7 @@ fn write_rows(
 mod tests {
     use super::*;
     use crate::Scene;
-    use tumble_ecs::validate::{BodyError, BodyErrorKind};
+    use tumble_ecs::components::{BodyError, BodyErrorKind};
 
     fn chain() -> BuiltScene {
         let text = include_str!("../../../scenes/spring_chain.toml");

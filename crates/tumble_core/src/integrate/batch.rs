@@ -16,7 +16,6 @@ use crate::math::{Quat, Real, Vec3};
 use std::borrow::Borrow;
 
 use super::exact_flow::{rotate_exactly, rotate_exactly_pair};
-use super::simd::{Kernel, LANES};
 use super::splitting::{
     drift_kick_drift_linear, drift_kick_drift_translation, free_rotation_span, kick_angular,
 };
@@ -25,6 +24,7 @@ use super::{ExactSwitch, Integrator};
 use crate::mass::MassProperties;
 use crate::prefetch::prefetch;
 use crate::rotation::rotate_exact;
+use crate::simd::{Kernel, LANES};
 use crate::state::{BodyState, Wrench};
 
 /// Which part of a stage a batch performs (see [`Integrator::begin_stage`] and

@@ -67,7 +67,6 @@ use std::f64::consts::FRAC_PI_2;
 
 use glam::{DQuat, DVec3};
 
-use super::sin_cos;
 use super::splitting::{FreeBody, FreeState, rotate_freely};
 use crate::elliptic::{
     complete_k_complement, incomplete_f_sin_cos, integral_sn2_over, jacobi_sn_cn_dn_complement,
@@ -75,6 +74,7 @@ use crate::elliptic::{
 };
 use crate::mass::MassProperties;
 use crate::math::{Real, Widen};
+use crate::simd::sin_cos;
 use crate::state::BodyState;
 
 /// `atan x`: the series `x − x³/3 + x⁵/5 − x⁷/7` below `|x| = 10⁻³` (the first term left out,

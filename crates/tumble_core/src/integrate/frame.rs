@@ -6,8 +6,8 @@
 use crate::math::{Narrow, Quat, Vec3, Widen};
 use glam::{DQuat, DVec3};
 
-use super::simd::Lane;
 use crate::mass::MassProperties;
+use crate::simd::Lane;
 use crate::state::BodyState;
 
 /// Reciprocal of a principal moment, `0` for a locked axis, in lanes (`f64` for one body).

@@ -41,9 +41,6 @@ pub use free_flow::{
 mod implicit_gyroscopic;
 mod lclamp;
 mod rk4;
-mod simd;
-/// `(sin x, cos x)` in IEEE arithmetic only, the same bits on every CPU path (see `simd`).
-pub(crate) use simd::sin_cos;
 mod splitting;
 mod stages;
 pub use stages::{StageSpan, Stages, TRIPLE_JUMP_LIMIT, TRIPLE_JUMP_SWING_MATCH};
@@ -64,12 +61,12 @@ use crate::state::{BodyState, Wrench};
 // The public surface is the `Integrator` enum, the batch interface, the kernel path (and its
 // operation count) and the two frame rotations the tests and reports measure with; each
 // method's functions are internal.
+pub use crate::simd::{KERNEL_ENV, KernelError, KernelPath, OpCounts, kernel_path};
 use exact_flow::rotate_exactly;
 pub use frame::{rotate, rotate_inv};
 use implicit_gyroscopic::implicit_gyroscopic;
 use lclamp::lclamp;
 use rk4::rk4_free_flow;
-pub use simd::{KERNEL_ENV, KernelError, KernelPath, OpCounts, kernel_path};
 use splitting::{
     Rotation, drift_kick_drift, drift_kick_drift_translation, kick_angular, rotate_freely,
     rotate_symmetric_kicked, strang_free_flow,
@@ -460,4 +457,20 @@ pub enum StepError {
         /// The method that diverged.
         integrator: Integrator,
     },
+}
+
+/// Saved by name, as scene files and the command line name it (feature `serde`).
+#[cfg(feature = "serde")]
+impl serde::Serialize for Integrator {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(self.name())
+    }
+}
+
+#[cfg(feature = "serde")]
+impl<'de> serde::Deserialize<'de> for Integrator {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let name = <String as serde::Deserialize>::deserialize(d)?;
+        name.parse().map_err(serde::de::Error::custom)
+    }
 }

@@ -76,7 +76,7 @@ impl FreeBody {
     #[inline]
     pub(super) fn rotate_about_axis(&mut self, axis: usize, angle: f64) {
         // tumble's own sine and cosine: the same bits on every platform.
-        let (s, c) = super::sin_cos(0.5 * angle);
+        let (s, c) = crate::simd::sin_cos(0.5 * angle);
         // cos θ and sin θ from the half angle: one sin_cos per rotation.
         let (cos, sin) = (c * c - s * s, 2.0 * s * c);
         let m = self.m;

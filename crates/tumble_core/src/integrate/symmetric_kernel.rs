@@ -22,13 +22,13 @@
 //! (`r = 0`) and symmetric bodies need no branches.
 
 use super::frame::reciprocal;
-#[cfg(target_arch = "x86_64")]
-use super::simd::{Avx2, Avx4, Avx8, Avx512};
-use super::simd::{
-    Counted, F64x4, Kernel, LANES, Lane, OpCounts, Pair, Portable, counted, sin_cos,
-};
 use crate::mass::MassProperties;
 use crate::math::{Narrow, Quat, Real, Vec3, Widen};
+#[cfg(target_arch = "x86_64")]
+use crate::simd::{Avx2, Avx4, Avx8, Avx512};
+use crate::simd::{
+    Counted, F64x4, Kernel, LANES, Lane, OpCounts, Pair, Portable, counted, sin_cos,
+};
 
 /// A quaternion `(x, y, z, w)` in lanes.
 pub(super) type Quat4<T> = [T; 4];

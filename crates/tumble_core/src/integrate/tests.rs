@@ -191,7 +191,7 @@ fn bits(states: &[BodyState]) -> Vec<u64> {
         .collect()
 }
 
-use simd::Kernel;
+use crate::simd::Kernel;
 
 /// The population after `rounds` rounds of a whole step and a stage in two phases, one body at
 /// a time on the scalar path: the reference the batches must match bit for bit.

@@ -1,0 +1,504 @@
+//! The energy ledger: what the audit remembers of each spring group between its passes.
+
+use bevy_ecs::entity::EntityHashMap;
+use bevy_ecs::prelude::*;
+use tumble_core::math::{Real, Vec3, Widen};
+
+use super::memo::BodyMemo;
+use crate::components::{
+    Dynamic, Kinematic, MassProps, Pose, Rejected, RigidBody, Spring, SpringEnd, Static, Velocity,
+    kinetic_energy_f64,
+};
+
+/// beyond it the spring is unstable and grows geometrically past any finite bound anyway.
+pub(super) const OMEGA_DT_CAP: f64 = 1.99;
+
+/// Round-off allowance, in units of the precision's epsilon, on the step's energy magnitudes.
+pub(super) const ROUND_OFF_ULPS: f64 = 64.0;
+
+/// What the audit remembers of one body during a step.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Audited {
+    pub(super) entity: Entity,
+    pub(super) start: (Pose, Velocity),
+    /// Pose at the end of the step (for the springs' energy).
+    pub(super) end: Pose,
+    /// Every load except the springs: force and torque (world frame).
+    pub(super) load: (Vec3, Vec3),
+    /// Mass (kg), for the springs' reduced mass.
+    pub(super) mass: f64,
+    /// Union–find parent.
+    pub(super) parent: usize,
+    /// Its group's index in [`EnergyLedger::groups`], once the start pass has joined every
+    /// spring's ends.
+    pub(super) group: usize,
+    /// Unchanged since the end of the last step (bit for bit, [`memo`]).
+    pub(super) still: bool,
+    /// Kinetic energy at the start of the step.
+    pub(super) start_energy: f64,
+}
+
+/// One end of a spring as the audit sees it.
+#[derive(Debug, Clone, Copy)]
+pub(super) enum End {
+    /// An audited body: its index and the body-local anchor.
+    Audited(u32, Vec3),
+    /// A fixed point (world anchor or static body), in world coordinates.
+    Fixed(Vec3),
+    /// A kinematic body: game code moves it and does work the audit cannot see.
+    Kinematic,
+    /// Missing or rejected: the spring exerts nothing this step.
+    Inactive,
+}
+
+/// A spring with its ends resolved once per step: the inputs of its elastic energy besides its
+/// audited bodies' poses, and that energy as the last end pass measured it ([`memo`]). Only
+/// these: a million springs are a million links.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Link {
+    pub(super) stiffness: Real,
+    pub(super) rest_length: Real,
+    pub(super) a: End,
+    pub(super) b: End,
+    /// The end pass that measured `elastic` with these inputs (0: none did).
+    pub(super) measured: u64,
+    /// The elastic energy that pass measured.
+    pub(super) elastic: f64,
+}
+
+impl Link {
+    /// The spring `spring` with its ends resolved to `a` and `b`, not measured yet.
+    pub(super) fn new(spring: &Spring, a: End, b: End) -> Self {
+        Self {
+            stiffness: spring.stiffness,
+            rest_length: spring.rest_length,
+            a,
+            b,
+            measured: 0,
+            elastic: 0.0,
+        }
+    }
+
+    /// The audited bodies at its ends.
+    pub(super) fn audited_bodies(&self) -> impl Iterator<Item = usize> {
+        [self.a, self.b].into_iter().filter_map(|end| match end {
+            End::Audited(i, _) => Some(i as usize),
+            _ => None,
+        })
+    }
+
+    /// True when `other` has the same inputs, bit for bit, apart from its audited bodies'
+    /// poses (see [`BodyMemo::still`] for those).
+    pub(super) fn same_inputs(&self, other: &Link) -> bool {
+        let bits = |l: &Link| [l.stiffness, l.rest_length].map(Real::to_bits);
+        bits(self) == bits(other) && same_end(self.a, other.a) && same_end(self.b, other.b)
+    }
+
+    /// `½ k (|d| − L₀)²` with the anchors at the world points `pa` and `pb` (J, `f64`).
+    pub(super) fn elastic_energy(&self, pa: Vec3, pb: Vec3) -> f64 {
+        let stretch = (pa - pb).widen().length() - self.rest_length.widen();
+        0.5 * self.stiffness.widen() * stretch * stretch
+    }
+}
+
+/// One group's running account, keyed by its smallest entity.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct Account {
+    /// Members and springs when the account was opened: a group that changes starts afresh.
+    pub(super) signature: (usize, usize),
+    /// `D`: energy the integrator created so far (J).
+    pub(super) created: f64,
+    /// Seen in the current step (stale accounts are dropped).
+    pub(super) seen: bool,
+}
+
+/// Per-group sums of one step.
+#[derive(Debug, Clone, Copy, Default)]
+pub(super) struct GroupStep {
+    pub(super) members: usize,
+    pub(super) springs: usize,
+    pub(super) key: Option<Entity>,
+    pub(super) kinematic: bool,
+    /// `(T + V)` at the start.
+    pub(super) start: f64,
+    /// `(T + V)` at the end.
+    pub(super) end: f64,
+    /// `W_ext`.
+    pub(super) work: f64,
+    /// Magnitudes for the round-off allowance.
+    pub(super) magnitude: f64,
+    /// Stiffest spring's `ωΔt`.
+    pub(super) omega_dt: f64,
+}
+
+/// The audit's bookkeeping (reused every step so that steps do not allocate).
+#[derive(Resource, Debug, Default)]
+pub struct EnergyLedger {
+    pub(super) bodies: Vec<Audited>,
+    /// The index in `bodies` of an entity, at its `index_u32`: a dense table, not a hash map
+    /// (four lookups per body and step). Entries of entities no longer audited are left in
+    /// place: a lookup checks the entity it finds.
+    pub(super) slots: Vec<u32>,
+    pub(super) links: Vec<Link>,
+    pub(super) groups: Vec<GroupStep>,
+    pub(super) accounts: EntityHashMap<Account>,
+    pub(super) dt: f64,
+    /// The plain step with the stability of one substep (`Δt` unless there are substeps or a
+    /// composition, see `Stages::stability_span`): the span a spring's `ωh` is measured on.
+    pub(super) stability_span: f64,
+    /// Whether the integrator drifts–kicks–drifts (else it kicks, then drifts).
+    pub(super) midpoint: bool,
+    /// Accounts were restored under some member of their group, not necessarily its smallest
+    /// entity (entity ids change when a world is restored): re-key them at the next audit.
+    pub(super) restored: bool,
+    /// End passes so far: what the last one measured carries its number.
+    pub(super) end_passes: u64,
+    /// The last end pass's kinetic energies, by body index, with their inputs ([`memo`]).
+    pub(super) measured_bodies: Vec<Option<BodyMemo>>,
+    /// The groups were closed by an end pass since the last start: their end sums are the
+    /// energies the bodies stand at now, if nothing changed ([`EnergyLedger::restart`]).
+    pub(super) closed: bool,
+    /// Starts that took the unchanged world's shortcut (for tests).
+    #[cfg(test)]
+    pub(super) restarts: usize,
+    /// Starts that kept the last step's groups and measured what changed (for tests).
+    #[cfg(test)]
+    pub(super) partial_restarts: usize,
+}
+
+/// One group's running account as a snapshot saves it: a member of the group (any), the group's
+/// size and springs when the account was opened, and the energy the integrator made up so far.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct SavedAccount {
+    /// A body of the group.
+    pub member: Entity,
+    /// Bodies in the group.
+    pub members: usize,
+    /// Springs of the group.
+    pub springs: usize,
+    /// `D` (J).
+    pub created: f64,
+}
+
+/// The audit's running accounts as a [`RollbackSnapshot`](crate::state::RollbackSnapshot)
+/// keeps them: the energy each spring group's integration has made up so far, which decides
+/// whether a later step quarantines the group. Opaque; in entity order.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct LedgerState {
+    pub(super) accounts: Vec<(Entity, Account)>,
+    pub(super) restored: bool,
+}
+
+impl LedgerState {
+    /// Bytes on the heap.
+    pub fn heap_bytes(&self) -> usize {
+        self.accounts.capacity() * std::mem::size_of::<(Entity, Account)>()
+    }
+}
+
+impl EnergyLedger {
+    /// The index in `bodies` of an audited entity.
+    #[inline]
+    pub(super) fn slot(&self, entity: Entity) -> Option<usize> {
+        let i = *self.slots.get(entity.index_u32() as usize)? as usize;
+        (self.bodies.get(i)?.entity == entity).then_some(i)
+    }
+
+    /// Records that `entity` is audited at index `i`.
+    pub(super) fn set_slot(&mut self, entity: Entity, i: usize) {
+        let at = entity.index_u32() as usize;
+        if at >= self.slots.len() {
+            self.slots.resize(at + 1, u32::MAX);
+        }
+        self.slots[at] = i as u32;
+    }
+
+    pub(super) fn find(&mut self, mut i: usize) -> usize {
+        while self.bodies[i].parent != i {
+            let grand = self.bodies[self.bodies[i].parent].parent;
+            self.bodies[i].parent = grand;
+            i = grand;
+        }
+        i
+    }
+
+    pub(super) fn union(&mut self, a: usize, b: usize) {
+        let (ra, rb) = (self.find(a), self.find(b));
+        if ra != rb {
+            // Attach to the smaller index so that the root does not depend on spring order.
+            let (lo, hi) = if ra < rb { (ra, rb) } else { (rb, ra) };
+            self.bodies[hi].parent = lo;
+        }
+    }
+
+    /// The energy the integrator created so far in the group whose smallest entity is `key`.
+    pub fn created_energy(&self, key: Entity) -> Option<f64> {
+        self.accounts.get(&key).map(|a| a.created)
+    }
+
+    /// The running accounts, for a snapshot (in a stable order: by entity).
+    pub fn saved_accounts(&self) -> Vec<SavedAccount> {
+        let mut saved: Vec<SavedAccount> = self
+            .accounts
+            .iter()
+            .map(|(&member, a)| SavedAccount {
+                member,
+                members: a.signature.0,
+                springs: a.signature.1,
+                created: a.created,
+            })
+            .collect();
+        saved.sort_by_key(|a| a.member);
+        saved
+    }
+
+    /// Restores saved accounts, their members already mapped to the restored entities.
+    pub fn restore_accounts(&mut self, saved: impl IntoIterator<Item = SavedAccount>) {
+        self.accounts.clear();
+        for a in saved {
+            self.accounts.insert(
+                a.member,
+                Account {
+                    signature: (a.members, a.springs),
+                    created: a.created,
+                    seen: true,
+                },
+            );
+        }
+        self.restored = true;
+    }
+
+    /// Copies the running accounts (by entity) into `into`, for a rollback snapshot.
+    pub(crate) fn save_state(&self, into: &mut LedgerState) {
+        into.accounts.clear();
+        into.accounts
+            .extend(self.accounts.iter().map(|(&k, &a)| (k, a)));
+        into.accounts.sort_unstable_by_key(|(k, _)| *k);
+        into.restored = self.restored;
+    }
+
+    /// Puts back the running accounts of `from` exactly (same keys: a rollback keeps entities).
+    pub(crate) fn load_state(&mut self, from: &LedgerState) {
+        self.accounts.clear();
+        self.accounts.extend(from.accounts.iter().copied());
+        self.restored = from.restored;
+    }
+
+    /// The group (root index) a link belongs to, if it touches an audited body.
+    pub(super) fn group_of(&self, link: &Link) -> Option<usize> {
+        match (link.a, link.b) {
+            (End::Audited(i, _), _) | (_, End::Audited(i, _)) => {
+                Some(self.bodies[i as usize].group)
+            }
+            _ => None,
+        }
+    }
+
+    /// World anchor of an end, from the pose `pose` gives an audited body.
+    pub(super) fn anchor(&self, end: End, pose: impl Fn(&Audited) -> Pose) -> Option<Vec3> {
+        match end {
+            End::Audited(i, local) => Some(pose(&self.bodies[i as usize]).transform_point(local)),
+            End::Fixed(p) => Some(p),
+            End::Kinematic | End::Inactive => None,
+        }
+    }
+
+    /// Elastic energy of a link with the bodies at the poses `pose` gives.
+    pub(super) fn elastic(
+        &self,
+        link: &Link,
+        pose: impl Fn(&Audited) -> Pose + Copy,
+    ) -> Option<f64> {
+        let pa = self.anchor(link.a, pose)?;
+        let pb = self.anchor(link.b, pose)?;
+        Some(link.elastic_energy(pa, pb))
+    }
+
+    /// Link `k`'s elastic energy at the start of the step: the one the last step ended with
+    /// when its inputs are the same bit for bit, else measured afresh.
+    pub(super) fn start_elastic(&self, link: &Link) -> Option<f64> {
+        // Its bodies are still, so their memos are from the same pass as the spring's.
+        if link.measured == self.end_passes && link.audited_bodies().all(|i| self.bodies[i].still) {
+            return Some(link.elastic);
+        }
+        self.elastic(link, |b| b.start.0)
+    }
+
+    /// The start of a step when the world's spring graph is as the last step left it: the
+    /// same audited bodies in the same order with the same masses, the same springs (bit for
+    /// bit) with the same ends. Then the groups, links and union–find of the last step hold,
+    /// and only the energies need measuring, each reused from its [`memo`] where its inputs
+    /// are unchanged; when nothing changed at all, each group's `T + V` is the sum its end pass
+    /// closed with (the start pass would add the same energies in the same order). Either way
+    /// the sums are the full start pass's, bit for bit. Returns false as soon as the graph
+    /// differs, having changed only what the full start pass rebuilds.
+    pub(super) fn restart(
+        &mut self,
+        bodies: &AuditedBodies,
+        ends: &Ends,
+        springs: &Query<&Spring>,
+    ) -> bool {
+        let mut n = 0;
+        let mut all_still = true;
+        for (entity, t, v, m) in bodies {
+            let Some(body) = self.bodies.get(n) else {
+                return false;
+            };
+            if body.entity != entity {
+                return false;
+            }
+            let (energy, still) = self.start_kinetic(n, (entity, t, v, m));
+            // A new mass changes the springs' reduced masses, so their stiffness bound: regroup.
+            if !still && m.mass().widen().to_bits() != body.mass.to_bits() {
+                return false;
+            }
+            let body = &mut self.bodies[n];
+            body.start = (*t, *v);
+            body.end = *t;
+            body.load = (Vec3::ZERO, Vec3::ZERO);
+            (body.start_energy, body.still) = (energy, still);
+            all_still &= still;
+            n += 1;
+        }
+        if n != self.bodies.len() {
+            return false;
+        }
+        let mut k = 0;
+        for spring in springs {
+            let Some(link) = self.links.get(k) else {
+                return false;
+            };
+            // Resolved again: an end that is not an audited body may have moved (a static
+            // body) or changed kind since.
+            let (a, b) = resolve_ends(self, ends, spring);
+            if !link.same_inputs(&Link::new(spring, a, b)) {
+                return false;
+            }
+            k += 1;
+        }
+        if k != self.links.len() {
+            return false;
+        }
+        if all_still {
+            for g in &mut self.groups {
+                (g.start, g.magnitude) = (g.end, g.end);
+                (g.end, g.work) = (0.0, 0.0);
+            }
+            #[cfg(test)]
+            {
+                self.restarts += 1;
+            }
+            return true;
+        }
+        self.sum_start_energies();
+        #[cfg(test)]
+        {
+            self.partial_restarts += 1;
+        }
+        true
+    }
+
+    /// The kinetic energy at the start of the step of the body read at index `i`, and whether
+    /// it is still as the last end pass measured it there (bit for bit, [`memo`]): then the
+    /// energy is that measurement, else it is measured now.
+    pub(super) fn start_kinetic(
+        &self,
+        i: usize,
+        (entity, t, v, m): (Entity, &Pose, &Velocity, &MassProps),
+    ) -> (f64, bool) {
+        match self.measured_bodies.get(i) {
+            Some(Some(memo)) if memo.pass == self.end_passes && memo.still(entity, t, v, m) => {
+                (memo.kinetic(), true)
+            }
+            _ => (kinetic_energy_f64(t, v, m), false),
+        }
+    }
+
+    /// Each group's `T + V` at the start of the step (and its magnitude for the round-off
+    /// allowance), from the bodies' `start_energy` and the springs' elastic energy
+    /// ([`start_elastic`](Self::start_elastic)): the bodies by index into their roots, then the
+    /// springs in order, so the sums do not depend on which start pass formed the groups.
+    pub(super) fn sum_start_energies(&mut self) {
+        for g in &mut self.groups {
+            (g.start, g.magnitude, g.end, g.work) = (0.0, 0.0, 0.0, 0.0);
+        }
+        for i in 0..self.bodies.len() {
+            let Audited {
+                group,
+                start_energy,
+                ..
+            } = self.bodies[i];
+            let g = &mut self.groups[group];
+            g.start += start_energy;
+            g.magnitude += start_energy;
+        }
+        for k in 0..self.links.len() {
+            let link = self.links[k];
+            let Some(group) = self.group_of(&link) else {
+                continue;
+            };
+            if let Some(v) = self.start_elastic(&link) {
+                let g = &mut self.groups[group];
+                g.start += v;
+                g.magnitude += v;
+            }
+        }
+    }
+
+    /// Forgets what the last step measured: the next start measures every energy afresh.
+    /// (For tests that compare the reuse with fresh measurements.)
+    #[cfg(test)]
+    pub(crate) fn forget_measurements(&mut self) {
+        self.measured_bodies.clear();
+        for link in &mut self.links {
+            link.measured = 0;
+        }
+        self.closed = false;
+    }
+}
+
+/// Rigid bodies that are not quarantined, whatever their kind (spring ends may be static or
+/// kinematic).
+pub(super) type Ends<'w, 's> = Query<
+    'w,
+    's,
+    (&'static Pose, Has<Static>, Has<Kinematic>),
+    (With<RigidBody>, Without<Rejected>),
+>;
+
+/// Both ends of `spring`, resolved.
+pub(super) fn resolve_ends(ledger: &EnergyLedger, ends: &Ends, spring: &Spring) -> (End, End) {
+    let a = end_of(ledger, ends, spring.a, spring.anchor_a);
+    let b = match spring.b {
+        SpringEnd::World(p) => End::Fixed(p),
+        SpringEnd::Body { body, anchor } => end_of(ledger, ends, body, anchor),
+    };
+    (a, b)
+}
+
+pub(super) fn end_of(ledger: &EnergyLedger, ends: &Ends, body: Entity, anchor: Vec3) -> End {
+    if let Some(i) = ledger.slot(body) {
+        return End::Audited(i as u32, anchor);
+    }
+    match ends.get(body) {
+        Ok((_, _, true)) => End::Kinematic,
+        Ok((t, true, _)) => End::Fixed(t.transform_point(anchor)),
+        _ => End::Inactive,
+    }
+}
+
+/// The same end, bit for bit.
+pub(super) fn same_end(a: End, b: End) -> bool {
+    let bits = |p: Vec3| p.to_array().map(Real::to_bits);
+    match (a, b) {
+        (End::Audited(i, p), End::Audited(j, q)) => i == j && bits(p) == bits(q),
+        (End::Fixed(p), End::Fixed(q)) => bits(p) == bits(q),
+        (End::Kinematic, End::Kinematic) | (End::Inactive, End::Inactive) => true,
+        _ => false,
+    }
+}
+
+/// The bodies the audit watches, as its start pass reads them.
+pub(super) type AuditedBodies<'w, 's> =
+    Query<'w, 's, (Entity, &'static Pose, &'static Velocity, &'static MassProps), Dynamic>;

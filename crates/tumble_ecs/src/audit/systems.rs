@@ -1,0 +1,364 @@
+//! The audit's systems: open the balance, credit the external loads, close it and quarantine.
+
+use bevy_ecs::prelude::*;
+use tumble_core::math::{Real, Vec3, Widen};
+
+use super::ledger::{
+    Account, Audited, AuditedBodies, End, Ends, EnergyLedger, GroupStep, Link, OMEGA_DT_CAP,
+    ROUND_OFF_ULPS, resolve_ends,
+};
+use super::memo::BodyMemo;
+use crate::components::{
+    BodyError, BodyErrorKind, Dynamic, ForceAccumulator, Gravity, GravityScale, MassProps,
+    PhysicsSettings, Pose, Spring, Velocity, reject,
+};
+use crate::integrate::StageCursor;
+
+/// Start of an audited step (first in the plan): remembers each dynamic body's state, resolves
+/// the springs' ends, forms the spring groups and measures each group's `T + V`.
+pub fn audit_energy_start(
+    settings: Res<PhysicsSettings>,
+    cursor: Res<StageCursor>,
+    mut ledger: ResMut<EnergyLedger>,
+    bodies: AuditedBodies,
+    ends: Ends,
+    springs: Query<&Spring>,
+) {
+    let ledger = &mut *ledger;
+    if !cursor.span(&settings).opens_step {
+        return;
+    }
+    ledger.dt = settings.dt().widen();
+    let stability_span = settings.stages().stability_span(settings.dt()).widen();
+    let same_span = stability_span.to_bits() == ledger.stability_span.to_bits();
+    ledger.stability_span = stability_span;
+    ledger.midpoint = settings.integrator.samples_forces_at_midpoint();
+    if std::mem::take(&mut ledger.closed) && same_span && ledger.restart(&bodies, &ends, &springs) {
+        return;
+    }
+    ledger.bodies.clear();
+    ledger.groups.clear();
+    // Exact sizes: grown by doubling, a vector of a million entries would briefly be held
+    // twice, and this pass is the audit's peak.
+    ledger.bodies.reserve_exact(bodies.iter().len());
+    ledger
+        .links
+        .reserve_exact(springs.iter().len().saturating_sub(ledger.links.len()));
+    for (entity, t, v, m) in &bodies {
+        let i = ledger.bodies.len();
+        let (energy, still) = ledger.start_kinetic(i, (entity, t, v, m));
+        ledger.set_slot(entity, i);
+        ledger.bodies.push(Audited {
+            entity,
+            start: (*t, *v),
+            end: *t,
+            load: (Vec3::ZERO, Vec3::ZERO),
+            mass: m.mass().widen(),
+            parent: i,
+            group: 0,
+            still,
+            start_energy: energy,
+        });
+    }
+    // Each link is written over the last step's link at its index, keeping that one's
+    // measurement when the inputs are the same ([`memo`]).
+    let old = ledger.links.len();
+    let mut k = 0;
+    for spring in &springs {
+        let (a, b) = resolve_ends(ledger, &ends, spring);
+        if let (End::Audited(i, _), End::Audited(j, _)) = (a, b) {
+            ledger.union(i as usize, j as usize);
+        }
+        let mut link = Link::new(spring, a, b);
+        if k < old {
+            let last = ledger.links[k];
+            if last.same_inputs(&link) {
+                (link.measured, link.elastic) = (last.measured, last.elastic);
+            }
+            ledger.links[k] = link;
+        } else {
+            ledger.links.push(link);
+        }
+        k += 1;
+    }
+    ledger.links.truncate(k);
+    ledger.number_groups();
+    ledger.count_group_springs();
+    ledger.sum_start_energies();
+}
+
+/// Before the integration, after every force system but the springs (the plan runs
+/// [`apply_springs`](crate::forces::apply_springs) right after this system in audited worlds):
+/// records each audited body's load without the springs, `F`, `τ`, as the accumulators hold it
+/// now. (Spring dampers are not forces in the accumulators: they are the velocity flow of
+/// [`crate::springs`], an energy loss the balance sees and never flags. Implicit springs never
+/// write to the accumulators.)
+pub fn audit_external_loads(
+    settings: Res<PhysicsSettings>,
+    cursor: Res<StageCursor>,
+    mut ledger: ResMut<EnergyLedger>,
+    bodies: Query<
+        (
+            Entity,
+            &Pose,
+            &ForceAccumulator,
+            Option<&crate::components::ImplicitBody>,
+        ),
+        Dynamic,
+    >,
+) {
+    let ledger = &mut *ledger;
+    let span = cursor.span(&settings);
+    // Each stage's load counts with the stage's share `h/Δt` of the step (1 for a step of one
+    // stage, so its load is used as it is).
+    let share = if span.opens_step && span.closes_step {
+        None
+    } else {
+        Some(span.h / settings.dt())
+    };
+    for (entity, t, acc, implicit) in &bodies {
+        let Some(i) = ledger.slot(entity) else {
+            continue;
+        };
+        // The torque of the forces at points an implicit body's solve takes at mid-step,
+        // credited here at the pose the forces were sampled at.
+        let torque = acc.torque + implicit.map_or(Vec3::ZERO, |b| b.point_torque(t.rotation));
+        let load = &mut ledger.bodies[i].load;
+        match share {
+            None => *load = (acc.force, torque),
+            Some(w) => {
+                if span.opens_step {
+                    *load = (Vec3::ZERO, Vec3::ZERO);
+                }
+                load.0 += w * acc.force;
+                load.1 += w * torque;
+            }
+        }
+    }
+}
+
+/// End of an audited step (last in the plan): closes each group's balance and quarantines the
+/// groups whose integrator created more energy than the bound allows, putting them back to
+/// their state at the start of the step.
+pub fn audit_energy(
+    settings: Res<PhysicsSettings>,
+    cursor: Res<StageCursor>,
+    mut ledger: ResMut<EnergyLedger>,
+    gravity: Option<Res<Gravity>>,
+    bodies: Query<
+        (
+            Entity,
+            &Pose,
+            &Velocity,
+            &MassProps,
+            Option<&GravityScale>,
+            Has<ForceAccumulator>,
+        ),
+        Dynamic,
+    >,
+    mut commands: Commands,
+) {
+    let ledger = &mut *ledger;
+    if !cursor.span(&settings).closes_step {
+        return;
+    }
+    let dt = ledger.dt;
+    let gravity = gravity.map(|g| g.0);
+    // Only what this pass measures may be reused (a body it does not see keeps an older memo,
+    // which its number rules out): a spring's memo is reused only with its bodies' poses
+    // measured in the same pass.
+    ledger.end_passes += 1;
+    let pass = ledger.end_passes;
+    ledger.measured_bodies.resize(ledger.bodies.len(), None);
+    for (entity, t, v, m, scale, has_accumulator) in &bodies {
+        let Some(i) = ledger.slot(entity) else {
+            continue;
+        };
+        let body = &mut ledger.bodies[i];
+        let group = body.group;
+        body.end = *t;
+        let (force, torque) = match gravity {
+            // Bodies without an accumulator take gravity inside the integration.
+            Some(g) if !has_accumulator => (m.mass() * scale.map_or(1.0, |s| s.0) * g, Vec3::ZERO),
+            _ => body.load,
+        };
+        let v0 = body.start.1;
+        let v_mean = 0.5 * (v0.linear.widen() + v.linear.widen());
+        let w_mean = 0.5 * (v0.angular.widen() + v.angular.widen());
+        let work = dt * (force.widen().dot(v_mean) + torque.widen().dot(w_mean));
+        let measured = BodyMemo::measure(pass, entity, t, v, m);
+        let energy = measured.kinetic();
+        ledger.measured_bodies[i] = Some(measured);
+        let g = &mut ledger.groups[group];
+        g.end += energy;
+        g.work += work;
+        g.magnitude += energy + work.abs();
+    }
+    ledger.measure_springs_at_end(pass);
+    ledger.rekey_restored_accounts();
+    ledger.close_balances(&mut commands);
+    ledger.accounts.retain(|_, a| a.seen);
+    ledger.closed = true;
+}
+
+impl EnergyLedger {
+    /// Gives each body its group (the union–find roots are final now), numbered in the order
+    /// of their roots. A root is its group's smallest index (`union` attaches to the smaller),
+    /// so it is met first and its group numbered before any other member asks for it.
+    fn number_groups(&mut self) {
+        for i in 0..self.bodies.len() {
+            let root = self.find(i);
+            let group = if root == i {
+                self.groups.push(GroupStep::default());
+                self.groups.len() - 1
+            } else {
+                self.bodies[root].group
+            };
+            self.bodies[i].group = group;
+            let entity = self.bodies[i].entity;
+            let g = &mut self.groups[group];
+            g.members += 1;
+            g.key = Some(g.key.map_or(entity, |k| k.min(entity)));
+        }
+    }
+
+    /// Counts each group's springs, whether a kinematic body holds one, and its stiffest
+    /// spring's `ω Δt` on the stability span.
+    fn count_group_springs(&mut self) {
+        for k in 0..self.links.len() {
+            let link = self.links[k];
+            let Some(group) = self.group_of(&link) else {
+                continue;
+            };
+            let kinematic = matches!(link.a, End::Kinematic) || matches!(link.b, End::Kinematic);
+            let mass = |end: End| match end {
+                End::Audited(i, _) => self.bodies[i as usize].mass,
+                _ => f64::INFINITY,
+            };
+            let (ma, mb) = (mass(link.a), mass(link.b));
+            let reduced = if mb.is_infinite() {
+                ma
+            } else if ma.is_infinite() {
+                mb
+            } else {
+                ma * mb / (ma + mb)
+            };
+            let omega_dt = (link.stiffness.widen() / reduced).sqrt() * self.stability_span;
+            let g = &mut self.groups[group];
+            g.springs += 1;
+            g.kinematic |= kinematic;
+            g.omega_dt = g.omega_dt.max(omega_dt);
+        }
+    }
+
+    /// Adds each spring's elastic energy at the end of the step to its group, remembering it
+    /// for the next step's start (measured in pass `pass`).
+    fn measure_springs_at_end(&mut self, pass: u64) {
+        for k in 0..self.links.len() {
+            let link = self.links[k];
+            let Some(group) = self.group_of(&link) else {
+                continue;
+            };
+            let elastic = self.elastic(&link, |b| b.end);
+            let memo = &mut self.links[k];
+            (memo.measured, memo.elastic) = match elastic {
+                Some(v) => (pass, v),
+                None => (0, 0.0),
+            };
+            if let Some(v) = elastic {
+                self.groups[group].end += v;
+                self.groups[group].magnitude += v;
+            }
+        }
+    }
+
+    /// After a rollback restore, moves each account to its group's key (the smallest entity of
+    /// the group).
+    fn rekey_restored_accounts(&mut self) {
+        if std::mem::take(&mut self.restored) {
+            for i in 0..self.bodies.len() {
+                let Audited { entity, group, .. } = self.bodies[i];
+                if let Some(key) = self.groups[group].key
+                    && key != entity
+                    && let Some(account) = self.accounts.remove(&entity)
+                {
+                    self.accounts.insert(key, account);
+                }
+            }
+        }
+    }
+
+    /// Closes every group's balance: adds the energy the step created to its account and, where
+    /// the account exceeds what a stable step allows, puts the group back to its start and
+    /// quarantines its bodies.
+    fn close_balances(&mut self, commands: &mut Commands) {
+        for account in self.accounts.values_mut() {
+            account.seen = false;
+        }
+        let eps = ROUND_OFF_ULPS * Real::EPSILON.widen();
+        for group in 0..self.groups.len() {
+            // Every group has a member, so a key; a group without one would have nothing to audit.
+            let Some(key) = self.groups[group].key else {
+                continue;
+            };
+            let g = self.groups[group];
+            if g.kinematic {
+                continue;
+            }
+            let signature = (g.members, g.springs);
+            let account = self.accounts.entry(key).or_insert(Account {
+                signature,
+                created: 0.0,
+                seen: true,
+            });
+            if account.signature != signature {
+                *account = Account {
+                    signature,
+                    created: 0.0,
+                    seen: true,
+                };
+            }
+            account.seen = true;
+            let before = account.created;
+            let should = (g.start - before).max(0.0);
+            account.created += g.end - g.start - g.work;
+            let x = OMEGA_DT_CAP.min(g.omega_dt) / 2.0;
+            let factor = if self.midpoint {
+                2.0 / (1.0 - x * x)
+            } else {
+                2.0 * (1.0 + x) / (1.0 - x)
+            };
+            let bound = (factor - 1.0) * should + eps * g.magnitude + f64::MIN_POSITIVE;
+            let created = account.created;
+            if !(g.end.is_finite() && g.work.is_finite() && created.is_finite()) {
+                // A member with non-finite data was rejected by the integrate systems' own checks
+                // this step; the group's balance is meaningless until then, so start it afresh.
+                account.created = 0.0;
+                continue;
+            }
+            if created <= bound {
+                continue;
+            }
+            account.created = before;
+            for i in 0..self.bodies.len() {
+                if self.bodies[i].group != group {
+                    continue;
+                }
+                let body = self.bodies[i];
+                commands.entity(body.entity).insert(body.start);
+                reject(
+                    commands,
+                    BodyError {
+                        entity: body.entity,
+                        kind: BodyErrorKind::EnergyGrew {
+                            should,
+                            created,
+                            bound,
+                            group: g.members,
+                        },
+                    },
+                );
+            }
+        }
+    }
+}

@@ -1,0 +1,270 @@
+//! The systems of the force stage: gravity, constant forces and torques, explicit springs.
+
+use bevy_ecs::prelude::*;
+use tumble_core::math::{Vec3, quat_rotate};
+
+use super::targets::{ForceTargets, TargetRows, Targets};
+use crate::components::{
+    ConstantForce, ConstantLocalForce, ConstantTorque, ForceAccumulator, Gravity, GravityScale,
+    ImplicitBody, MassProps, Pose, Spring, SpringEnd, Velocity, dense,
+};
+use crate::parallel::{Parallelism, scope};
+
+/// Kinetic energy of every body with a velocity plus the elastic energy of every spring (J), in
+/// `f64`. Panics if a spring names a body without a [`Pose`].
+pub fn kinetic_and_elastic_energy(world: &mut World) -> f64 {
+    crate::components::assume_missing_masses(world);
+    let kinetic: f64 = world
+        .query::<(&Pose, &Velocity, &MassProps)>()
+        .iter(world)
+        .map(|(t, v, m)| crate::components::kinetic_energy_f64(t, v, m))
+        .sum();
+    let springs: Vec<Spring> = world.query::<&Spring>().iter(world).copied().collect();
+    let mut poses = world.query::<&Pose>();
+    let elastic: f64 = springs
+        .iter()
+        .map(|s| {
+            let pa = poses.get(world, s.a).unwrap().transform_point(s.anchor_a);
+            let pb = match s.b {
+                SpringEnd::World(p) => p,
+                SpringEnd::Body { body, anchor } => {
+                    poses.get(world, body).unwrap().transform_point(anchor)
+                }
+            };
+            s.elastic_energy(pa, pb)
+        })
+        .sum();
+    kinetic + elastic
+}
+
+/// Adds `m g s` to every dynamic body with an accumulator (`s` = [`GravityScale`], default 1).
+/// Only in the schedule when a [`Gravity`] resource exists.
+pub fn apply_gravity(
+    gravity: Res<Gravity>,
+    mut bodies: Query<
+        (&MassProps, Option<&GravityScale>, &mut ForceAccumulator),
+        crate::components::Dynamic,
+    >,
+) {
+    let g = gravity.0;
+    for (mass, scale, mut acc) in &mut bodies {
+        let s = scale.map_or(1.0, |s| s.0);
+        acc.force += (mass.mass() * s) * g;
+    }
+}
+
+/// Applies every [`ConstantForce`]: its force, and the torque of a force at a body point about
+/// the centre of mass (for a body of an implicit spring group, the point goes to the implicit
+/// solve instead, which takes that torque at mid-step: see [`ImplicitBody`]).
+pub fn apply_constant_forces(
+    generators: Query<&ConstantForce>,
+    local_generators: Query<&ConstantLocalForce>,
+    mut bodies: ForceTargets,
+    mut rows: Local<TargetRows>,
+    mut implicit: Query<&mut ImplicitBody>,
+) {
+    let mut targets = Targets::of(&mut bodies, &mut rows);
+    // Looked up only where some body is in an implicit group: a lookup per force otherwise.
+    let any_implicit = !implicit.is_empty();
+    // World-frame forces first, then body-frame ones (`None`: already in the world frame).
+    let world_frame = generators
+        .iter()
+        .map(|g| (g.body, g.force, false, g.local_point));
+    let body_frame = (local_generators.iter()).map(|g| (g.body, g.force, true, g.local_point));
+    for (body, force, in_body_frame, local_point) in world_frame.chain(body_frame) {
+        let Some((transform, mass)) = targets.body(body) else {
+            continue;
+        };
+        let force = if in_body_frame {
+            quat_rotate(transform.rotation, force)
+        } else {
+            force
+        };
+        let Some(local) = local_point else {
+            targets.push(body, |acc| acc.add_force(force));
+            continue;
+        };
+        if any_implicit && let Ok(mut implicit) = implicit.get_mut(body) {
+            // The implicit step takes the torque of a force at a point at mid-step (it turns
+            // with the body): the force goes to the accumulator, its point to the solve.
+            implicit.add_point_force(local - mass.local_center_of_mass(), force);
+            targets.push(body, |acc| acc.add_force(force));
+            continue;
+        }
+        let (point, center) = (
+            transform.transform_point(local),
+            transform.center_of_mass(mass),
+        );
+        targets.push(body, |acc| acc.add_force_at_point(force, point, center));
+    }
+}
+
+/// Applies every [`ConstantTorque`].
+pub fn apply_constant_torques(
+    generators: Query<&ConstantTorque>,
+    mut bodies: ForceTargets,
+    mut rows: Local<TargetRows>,
+) {
+    let mut targets = Targets::of(&mut bodies, &mut rows);
+    for gen_torque in &generators {
+        targets.push(gen_torque.body, |acc| acc.add_torque(gen_torque.torque));
+    }
+}
+
+/// World anchor point and the centre of mass, for a body-local anchor.
+#[inline]
+fn anchor_point(transform: &Pose, mass: &MassProps, local: Vec3) -> (Vec3, Vec3) {
+    (
+        transform.transform_point(local),
+        transform.center_of_mass(mass),
+    )
+}
+
+/// Elastic spring force on end `a`, `−k (|d| − L₀) n` with `d = p_a − p_b`, `n = d/|d|`; zero
+/// when `|d| = 0`. The damper is not a force here: it is the velocity flow of
+/// [`crate::springs`].
+#[inline]
+pub fn spring_force(spring: &Spring, d: Vec3) -> Vec3 {
+    let length = d.length();
+    if length <= 0.0 {
+        return Vec3::ZERO;
+    }
+    let n = d / length;
+    -(spring.stiffness * (length - spring.rest_length)) * n
+}
+
+/// What one spring pushes: its force and the anchor points it acts at, with each end's centre
+/// of mass (the torque's pivot). Computed from the bodies' poses alone, so many springs can be
+/// computed at once; applied in spring order, so the sums are the same whatever computed them.
+#[derive(Debug, Clone, Copy, Default)]
+enum SpringPush {
+    /// An end is missing (or both are one body): nothing.
+    #[default]
+    Nothing,
+    /// `f` on `a` at `pa`; the other end is a world point.
+    OnA { f: Vec3, pa: Vec3, com_a: Vec3 },
+    /// `f` on `a` at `pa`, `−f` on body `b` at `pb`.
+    OnBoth {
+        b: Entity,
+        f: Vec3,
+        pa: Vec3,
+        com_a: Vec3,
+        pb: Vec3,
+        com_b: Vec3,
+    },
+}
+
+impl SpringPush {
+    /// The push of `spring` on the bodies as `targets` holds them.
+    #[inline]
+    fn of(spring: &Spring, targets: &Targets) -> Self {
+        let Some((ta, ma)) = targets.body(spring.a) else {
+            return Self::Nothing;
+        };
+        let (pa, com_a) = anchor_point(ta, ma, spring.anchor_a);
+        match spring.b {
+            SpringEnd::World(anchor_b) => Self::OnA {
+                f: spring_force(spring, pa - anchor_b),
+                pa,
+                com_a,
+            },
+            // A spring from a body to its own points exerts nothing: its two forces cancel, and
+            // so do their torques (the force is along `pa − pb`).
+            SpringEnd::Body { body, .. } if body == spring.a => Self::Nothing,
+            SpringEnd::Body { body, anchor } => {
+                let Some((tb, mb)) = targets.body(body) else {
+                    return Self::Nothing;
+                };
+                let (pb, com_b) = anchor_point(tb, mb, anchor);
+                Self::OnBoth {
+                    b: body,
+                    f: spring_force(spring, pa - pb),
+                    pa,
+                    com_a,
+                    pb,
+                    com_b,
+                }
+            }
+        }
+    }
+
+    /// Adds the push to the accumulators of `spring`'s bodies.
+    #[inline]
+    fn apply(self, spring: &Spring, targets: &mut Targets) {
+        match self {
+            Self::Nothing => {}
+            Self::OnA { f, pa, com_a } => {
+                targets.push(spring.a, |acc| acc.add_force_at_point(f, pa, com_a));
+            }
+            Self::OnBoth {
+                b,
+                f,
+                pa,
+                com_a,
+                pb,
+                com_b,
+            } => {
+                targets.push(spring.a, |acc| acc.add_force_at_point(f, pa, com_a));
+                targets.push(b, |acc| acc.add_force_at_point(-f, pb, com_b));
+            }
+        }
+    }
+}
+
+/// The springs' pushes of one run of [`apply_springs`] on the compute pool, kept between steps
+/// so that a step does not allocate.
+#[derive(Debug, Default)]
+pub struct SpringPushes(Vec<SpringPush>);
+
+/// Applies every [`Spring`]'s elastic force, for the springs stepped explicitly (the implicit
+/// step of [`crate::springs`] handles the others; every damper is [`crate::springs`]'s).
+///
+/// With [`Parallelism`] and enough springs, the pushes are computed on the compute pool's
+/// threads (each spring reads only its two bodies) into a buffer kept between steps, then added
+/// to the accumulators on this thread in spring order: a spring system writes to bodies in any
+/// order, and this keeps the threads busy without letting two of them add to one accumulator.
+/// The sums are the same bits for any thread count.
+pub fn apply_springs(
+    springs: Query<&Spring, Without<crate::components::ImplicitSpring>>,
+    mut bodies: ForceTargets,
+    mut rows: Local<TargetRows>,
+    mut pushes: Local<SpringPushes>,
+    parallelism: Option<Res<Parallelism>>,
+) {
+    let mut targets = Targets::of(&mut bodies, &mut rows);
+    let parallelism = parallelism.map_or_else(Parallelism::default, |p| *p);
+    let count = springs.iter().len();
+    let threads = match targets {
+        Targets::Tables { .. } => parallelism.threads_for(count),
+        // The query's own lookups are not shared between threads.
+        Targets::Query(_) => 1,
+    };
+    if threads <= 1 {
+        for spring in &springs {
+            SpringPush::of(spring, &targets).apply(spring, &mut targets);
+        }
+        return;
+    }
+    let pushes = &mut pushes.0;
+    pushes.clear();
+    pushes.resize(count, SpringPush::Nothing);
+    let mut rest = pushes.as_mut_slice();
+    let shared = &targets;
+    for table in dense(springs.contiguous_iter()) {
+        let (out, tail) = rest.split_at_mut(table.len());
+        rest = tail;
+        let per = table.len().div_ceil(threads).max(1);
+        scope(|spawn| {
+            for (springs, out) in table.chunks(per).zip(out.chunks_mut(per)) {
+                spawn(Box::new(move || {
+                    for (spring, push) in springs.iter().zip(out) {
+                        *push = SpringPush::of(spring, shared);
+                    }
+                }));
+            }
+        });
+    }
+    for (spring, push) in springs.iter().zip(pushes.iter()) {
+        push.apply(spring, &mut targets);
+    }
+}

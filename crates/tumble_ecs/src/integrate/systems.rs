@@ -1,0 +1,153 @@
+//! The integrate systems: thin loops over the query's tables that hand each table to the core's
+//! batched step (the `table` module: a table run of bodies as a `BodyBatch`).
+//!
+//! A body whose data is bad or whose step diverges is quarantined with [`Rejected`] and keeps its
+//! last valid state, and the others step on unharmed.
+
+use bevy_ecs::prelude::*;
+use tumble_core::StepPhase;
+
+use super::table::{Bodies, Loads, StageTiming, step_table};
+use crate::components::{
+    BodyError, Dynamic, ForceAccumulator, Gravity, GravityScale, ImplicitBody, Kinematic,
+    PhysicsSettings, RigidBody, Static, Stepped, dense, reject,
+};
+use crate::parallel::Parallelism;
+
+/// Steps every table of the query `$bodies` ([`Stepped`] items) through [`step_table`], each
+/// table's loads made from its load column by the closure-like last argument, then quarantines
+/// the bodies that failed. A macro rather than a function: bevy hands out each load
+/// component's contiguous column as a type of its own that borrows the query table by table,
+/// which a closure parameter of a function cannot name.
+macro_rules! step_each_table {
+    ($bodies:ident, $stage:ident, $parallelism:ident, $commands:ident, |$load:pat_param| $loads:expr) => {{
+        let parallelism = $parallelism.map_or_else(Parallelism::default, |p| *p);
+        let mut errors = Vec::new();
+        for (entities, mut t, mut v, masses, $load, dampings) in
+            dense($bodies.contiguous_iter_mut())
+        {
+            let bodies = Bodies {
+                entities,
+                transforms: &mut t,
+                velocities: &mut v,
+                masses,
+                dampings,
+                loads: $loads,
+            };
+            step_table(&$stage, &parallelism, bodies, &mut errors);
+        }
+        reject_all(&mut $commands, errors);
+    }};
+}
+
+/// Quarantines the bodies in `errors` (in the order found: table by table, entity order
+/// within a table).
+fn reject_all(commands: &mut Commands, errors: Vec<BodyError>) {
+    for error in errors {
+        reject(commands, error);
+    }
+}
+
+/// Zeroes the accumulators of [`Static`] and [`Kinematic`] bodies (springs may push on them;
+/// they are never integrated, so the forces are discarded rather than left to pile up). In the
+/// schedule only when such a body has an accumulator.
+pub fn discard_fixed_body_forces(
+    mut bodies: Query<
+        &mut ForceAccumulator,
+        (With<RigidBody>, Or<(With<Static>, With<Kinematic>)>),
+    >,
+) {
+    for mut acc in &mut bodies {
+        if *acc != ForceAccumulator::default() {
+            *acc = ForceAccumulator::default();
+        }
+    }
+}
+
+/// Set by [`begin_stage`] when it has drifted the bodies with accumulators half a stage, so
+/// that [`integrate_with_forces`] finishes the stage instead of taking a whole one. Reset every
+/// stage.
+#[derive(Resource, Debug, Default, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct HalfDrifted(pub bool);
+
+/// First phase of a drift–kick–drift stage for bodies with a [`ForceAccumulator`]: the first
+/// half of the [`Damping`](crate::components::Damping) flow (when the stage opens a substep), then half a drift before the
+/// force systems run, so forces are sampled at the midpoint of the stage. Does nothing for
+/// methods that sample forces at the start. Bodies without an accumulator feel no
+/// state-dependent force and take their whole stage in [`integrate_without_forces`].
+pub fn begin_stage(
+    settings: Res<PhysicsSettings>,
+    cursor: Res<crate::integrate::StageCursor>,
+    parallelism: Option<Res<Parallelism>>,
+    mut drifted: ResMut<HalfDrifted>,
+    mut commands: Commands,
+    mut bodies: Query<Stepped<&ForceAccumulator>, (Dynamic, Without<ImplicitBody>)>,
+) {
+    if !settings.integrator.samples_forces_at_midpoint() {
+        return;
+    }
+    drifted.0 = true;
+    let stage = StageTiming::new(&settings, *cursor, StepPhase::Begin);
+    step_each_table!(bodies, stage, parallelism, commands, |accs| Loads::Checked(
+        accs
+    ));
+}
+
+/// Integrates bodies that have a [`ForceAccumulator`], consuming (reading and zeroing) it.
+///
+/// For a drift–kick–drift method this finishes the stage that [`begin_stage`] began; if the
+/// schedule was planned without `begin_stage` (the integrator was changed afterwards) it takes
+/// the whole stage with the forces sampled at its start, and warns once. The [`Damping`](crate::components::Damping) flow
+/// runs for half a substep before a whole stage that opens a substep and after any stage that
+/// closes one.
+pub fn integrate_with_forces(
+    settings: Res<PhysicsSettings>,
+    cursor: Res<crate::integrate::StageCursor>,
+    parallelism: Option<Res<Parallelism>>,
+    mut drifted: ResMut<HalfDrifted>,
+    mut warned: Local<bool>,
+    mut commands: Commands,
+    mut bodies: Query<Stepped<&mut ForceAccumulator>, (Dynamic, Without<ImplicitBody>)>,
+) {
+    let phase = if drifted.0 {
+        StepPhase::Finish
+    } else {
+        StepPhase::Whole
+    };
+    if settings.integrator.samples_forces_at_midpoint() && phase == StepPhase::Whole && !*warned {
+        *warned = true;
+        tracing::warn!(
+            integrator = %settings.integrator,
+            "schedule planned without begin_stage: forces are sampled at the start of the stage; \
+             plan again after changing the integrator"
+        );
+    }
+    drifted.0 = false;
+    let stage = StageTiming::new(&settings, *cursor, phase);
+    step_each_table!(bodies, stage, parallelism, commands, |mut accs| {
+        Loads::Consumed(&mut accs)
+    });
+}
+
+/// Integrates bodies without a [`ForceAccumulator`]: free motion, plus gravity when a
+/// [`Gravity`] resource exists (a uniform field needs no accumulator), one whole stage, with the
+/// [`Damping`](crate::components::Damping) flow for half a substep before a stage that opens a substep and after one that
+/// closes it. With a composed integrator (`yoshida4`) such a body takes its whole substep in the
+/// stage that opens it (nothing samples its state in between), its free rotation rounded once.
+pub fn integrate_without_forces(
+    settings: Res<PhysicsSettings>,
+    cursor: Res<crate::integrate::StageCursor>,
+    parallelism: Option<Res<Parallelism>>,
+    gravity: Option<Res<Gravity>>,
+    mut commands: Commands,
+    mut bodies: Query<Stepped<Option<&GravityScale>>, (Dynamic, Without<ForceAccumulator>)>,
+) {
+    let gravity = gravity.map(|g| g.0);
+    let Some(stage) = StageTiming::free_motion(&settings, *cursor) else {
+        return;
+    };
+    step_each_table!(bodies, stage, parallelism, commands, |scales| {
+        Loads::Field { gravity, scales }
+    });
+}

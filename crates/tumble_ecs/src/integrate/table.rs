@@ -1,0 +1,355 @@
+//! One table's run of bodies, stepped through the core's batched step: the [`BodyBatch`] the
+//! integrate systems hand to [`Integrator::stage_batch`], reading and writing the components in
+//! place, split over the compute pool's threads for big tables.
+//!
+//! Each body is checked before it is stepped (game code may have written bad data through a
+//! `&mut` borrow) and after (the method may have left its stable region); a failing body keeps
+//! its last valid state and is reported, and the others step on unharmed.
+
+use std::sync::Mutex;
+
+use bevy_ecs::prelude::*;
+use tumble_core::damping::decrement;
+use tumble_core::integrate::ExactSwitch;
+use tumble_core::math::{Real, Vec3};
+use tumble_core::prefetch::prefetch;
+use tumble_core::{BodyBatch, BodyState, Integrator, MassProperties, StepPhase, Wrench};
+
+use crate::components::{BodyError, BodyErrorKind, check_accumulator, check_body};
+use crate::components::{
+    Damping, ForceAccumulator, GravityScale, MassProps, PhysicsSettings, Pose, Velocity,
+    body_state, write_body_state,
+};
+use crate::integrate::StageCursor;
+use crate::parallel::Parallelism;
+
+/// Where each body's load comes from.
+pub(crate) enum Loads<'a> {
+    /// A uniform field (or nothing): `F = m s g`, no torque.
+    Field {
+        gravity: Option<Vec3>,
+        scales: Option<&'a [GravityScale]>,
+    },
+    /// Accumulators that are only checked (the first half-drift samples no load).
+    Checked(&'a [ForceAccumulator]),
+    /// Accumulators that are checked and consumed.
+    Consumed(&'a mut [ForceAccumulator]),
+}
+
+impl Loads<'_> {
+    /// Splits at `mid` like `split_at_mut`.
+    fn split_at(self, mid: usize) -> (Self, Self) {
+        match self {
+            Loads::Field { gravity, scales } => {
+                let (a, b) = scales.map_or((None, None), |s| {
+                    let (a, b) = s.split_at(mid);
+                    (Some(a), Some(b))
+                });
+                (
+                    Loads::Field { gravity, scales: a },
+                    Loads::Field { gravity, scales: b },
+                )
+            }
+            Loads::Checked(accs) => {
+                let (a, b) = accs.split_at(mid);
+                (Loads::Checked(a), Loads::Checked(b))
+            }
+            Loads::Consumed(accs) => {
+                let (a, b) = accs.split_at_mut(mid);
+                (Loads::Consumed(a), Loads::Consumed(b))
+            }
+        }
+    }
+
+    /// Checks body `i`'s load and returns it (consuming an accumulator).
+    #[inline(always)]
+    fn take(&mut self, i: usize, mass: &MassProps) -> Result<Wrench, BodyErrorKind> {
+        match self {
+            Loads::Field { gravity, scales } => Ok(match gravity {
+                Some(g) => Wrench {
+                    force: (mass.mass() * scales.map_or(1.0, |s| s[i].0)) * *g,
+                    torque: Vec3::ZERO,
+                },
+                None => Wrench::ZERO,
+            }),
+            Loads::Checked(accs) => check_accumulator(&accs[i]).map(|()| Wrench::ZERO),
+            Loads::Consumed(accs) => check_accumulator(&accs[i]).map(|()| accs[i].take()),
+        }
+    }
+}
+
+/// A run of bodies from one table, as plain slices.
+pub(crate) struct Bodies<'a> {
+    pub(crate) entities: &'a [Entity],
+    pub(crate) transforms: &'a mut [Pose],
+    pub(crate) velocities: &'a mut [Velocity],
+    pub(crate) masses: &'a [MassProps],
+    pub(crate) dampings: Option<&'a [Damping]>,
+    pub(crate) loads: Loads<'a>,
+}
+
+impl<'a> Bodies<'a> {
+    fn len(&self) -> usize {
+        self.entities.len()
+    }
+
+    /// Splits into bodies `[0, mid)` and `[mid, len)`.
+    fn split_at(self, mid: usize) -> (Self, Self) {
+        let (e0, e1) = self.entities.split_at(mid);
+        let (t0, t1) = self.transforms.split_at_mut(mid);
+        let (v0, v1) = self.velocities.split_at_mut(mid);
+        let (m0, m1) = self.masses.split_at(mid);
+        let (d0, d1) = self.dampings.map_or((None, None), |d| {
+            let (a, b) = d.split_at(mid);
+            (Some(a), Some(b))
+        });
+        let (l0, l1) = self.loads.split_at(mid);
+        (
+            Bodies {
+                entities: e0,
+                transforms: t0,
+                velocities: v0,
+                masses: m0,
+                dampings: d0,
+                loads: l0,
+            },
+            Bodies {
+                entities: e1,
+                transforms: t1,
+                velocities: v1,
+                masses: m1,
+                dampings: d1,
+                loads: l1,
+            },
+        )
+    }
+}
+
+/// One table run of bodies as a [`BodyBatch`] for the core's batched step: bodies are read
+/// from and written to their components directly. A body whose data is bad is skipped and one
+/// whose step diverges keeps its state; both are reported in `errors`.
+struct TableBatch<'a, 'e> {
+    bodies: Bodies<'a>,
+    /// [`Damping`]'s first half-substep flow applies to the velocity read by a phase that
+    /// begins a substep, its second to the velocity written by a phase that ends one.
+    damp_read: bool,
+    damp_write: bool,
+    /// Half the substep, `Δt/(2N)`: the span of each damping flow.
+    half_dt: Real,
+    integrator: Integrator,
+    errors: &'e mut Vec<BodyError>,
+}
+
+/// What one integrate system does to its bodies: which phase of which stage, and where the
+/// [`Damping`] flow runs.
+pub(crate) struct StageTiming {
+    integrator: Integrator,
+    phase: StepPhase,
+    /// The stage's span `h`.
+    h: Real,
+    /// Half the substep: the span of each half of the damping flow.
+    half_substep: Real,
+    damp_read: bool,
+    damp_write: bool,
+    /// The whole substep at once (`h` is the substep): [`Integrator::step_batch`].
+    whole_substep: bool,
+    /// The switch of a split method to the exact free flow for fast spins
+    /// ([`PhysicsSettings::free_flow`]).
+    switch: Option<ExactSwitch>,
+}
+
+impl StageTiming {
+    /// A whole substep, for bodies whose only load is constant (no accumulator): in a plan whose
+    /// integrator is a composition, the substep's stages run at once in the stage that opens
+    /// it (`None` in its other stages), so that a torque-free composed step rounds its rotation
+    /// once (see [`Integrator::step`]); otherwise the stage's [`Whole`](StepPhase::Whole) phase.
+    pub(crate) fn free_motion(settings: &PhysicsSettings, cursor: StageCursor) -> Option<Self> {
+        if settings.integrator.composition().len() == 1 {
+            return Some(Self::new(settings, cursor, StepPhase::Whole));
+        }
+        let span = cursor.span(settings);
+        span.opens_substep.then_some(Self {
+            integrator: settings.integrator,
+            phase: StepPhase::Whole,
+            h: span.substep,
+            half_substep: 0.5 * span.substep,
+            damp_read: true,
+            damp_write: true,
+            whole_substep: true,
+            switch: ExactSwitch::new(settings.integrator, settings.free_flow, span.substep),
+        })
+    }
+
+    /// `phase` of the stage `cursor` points at, under `settings`: the damping flow's first half
+    /// before a phase that begins the stage (`Begin`, `Whole`) when the stage opens its
+    /// substep, its second half after a phase that ends the stage (`Finish`, `Whole`) when the
+    /// stage closes it.
+    pub(crate) fn new(settings: &PhysicsSettings, cursor: StageCursor, phase: StepPhase) -> Self {
+        let span = cursor.span(settings);
+        Self {
+            integrator: settings.integrator,
+            phase,
+            h: span.h,
+            half_substep: 0.5 * span.substep,
+            damp_read: phase != StepPhase::Finish && span.opens_substep,
+            damp_write: phase != StepPhase::Begin && span.closes_substep,
+            whole_substep: false,
+            switch: ExactSwitch::new(settings.integrator, settings.free_flow, span.substep),
+        }
+    }
+}
+
+impl BodyBatch for TableBatch<'_, '_> {
+    fn len(&self) -> usize {
+        self.bodies.len()
+    }
+
+    #[inline(always)]
+    fn read(&mut self, i: usize, state: &mut BodyState) -> Option<Wrench> {
+        let bodies = &mut self.bodies;
+        let (transform, velocity) = (&bodies.transforms[i], &bodies.velocities[i]);
+        let mass = &bodies.masses[i];
+        match check_body(transform, velocity, None).and_then(|()| bodies.loads.take(i, mass)) {
+            Ok(wrench) => {
+                state.copy_fields_from(&body_state(transform, velocity, mass));
+                if self.damp_read
+                    && let Some(d) = bodies.dampings.map(|d| &d[i])
+                {
+                    damp(
+                        d,
+                        self.half_dt,
+                        &mut state.linear_velocity,
+                        &mut state.angular_velocity,
+                    );
+                }
+                Some(wrench)
+            }
+            Err(kind) => {
+                self.errors.push(BodyError {
+                    entity: bodies.entities[i],
+                    kind,
+                });
+                None
+            }
+        }
+    }
+
+    #[inline(always)]
+    fn mass(&self, i: usize) -> &MassProperties {
+        &self.bodies.masses[i].0
+    }
+
+    #[inline(always)]
+    fn prefetch(&self, i: usize) {
+        let bodies = &self.bodies;
+        if i < bodies.len() {
+            prefetch(&bodies.transforms[i]);
+            prefetch(&bodies.velocities[i]);
+            prefetch(&bodies.masses[i]);
+        }
+    }
+
+    #[inline(always)]
+    fn write(&mut self, i: usize, state: &BodyState) {
+        let bodies = &mut self.bodies;
+        let (transform, velocity) = (&mut bodies.transforms[i], &mut bodies.velocities[i]);
+        write_body_state(state, &bodies.masses[i], transform, velocity);
+        if self.damp_write
+            && let Some(d) = bodies.dampings.map(|d| &d[i])
+        {
+            damp(d, self.half_dt, &mut velocity.linear, &mut velocity.angular);
+        }
+    }
+
+    fn diverged(&mut self, i: usize) {
+        let integrator = self.integrator;
+        self.errors.push(BodyError {
+            entity: self.bodies.entities[i],
+            kind: BodyErrorKind::Diverged(tumble_core::StepError::Diverged { integrator }),
+        });
+    }
+}
+
+/// [`Damping`]'s flow over `τ`: `v ← decay(c_lin τ) v`, `ω ← decay(c_ang τ) ω`, written as
+/// `v − decrement(c τ) v` (see [`tumble_core::damping`]). Outside the core's step, in the
+/// adapter's `read` and `write`, so every kernel path of the batch sees the same bits.
+#[inline(always)]
+pub(crate) fn damp(damping: &Damping, tau: Real, linear: &mut Vec3, angular: &mut Vec3) {
+    *linear -= decrement(damping.linear * tau) * *linear;
+    *angular -= decrement(damping.angular * tau) * *angular;
+}
+
+/// Steps every body of `bodies` through the stage's phase with the core's batched step
+/// (bit-identical to stepping each body alone). Errors are appended sorted by entity.
+fn step_bodies(stage: &StageTiming, bodies: Bodies<'_>, errors: &mut Vec<BodyError>) {
+    let found = errors.len();
+    let mut batch = TableBatch {
+        bodies,
+        damp_read: stage.damp_read,
+        damp_write: stage.damp_write,
+        half_dt: stage.half_substep,
+        integrator: stage.integrator,
+        errors,
+    };
+    if stage.whole_substep {
+        stage
+            .integrator
+            .step_batch_switched(&mut batch, stage.h, stage.switch);
+    } else {
+        stage
+            .integrator
+            .stage_batch_switched(stage.phase, &mut batch, stage.h, stage.switch);
+    }
+    errors[found..].sort_by_key(|e| e.entity);
+}
+
+/// Steps one table's bodies, split over the compute pool's threads when [`Parallelism`] says
+/// the table is big enough. Each body is stepped by the same code in any split, so the result
+/// does not depend on the number of threads. Errors are returned sorted by entity.
+pub(crate) fn step_table(
+    stage: &StageTiming,
+    parallelism: &Parallelism,
+    bodies: Bodies<'_>,
+    errors: &mut Vec<BodyError>,
+) {
+    let threads = parallelism.threads_for(bodies.len());
+    if threads <= 1 {
+        step_bodies(stage, bodies, errors);
+        return;
+    }
+    let parts = split_evenly(bodies, threads);
+    let found = Mutex::new(Vec::new());
+    crate::parallel::scope(|spawn| {
+        for part in parts {
+            let found = &found;
+            spawn(Box::new(move || {
+                let mut local = Vec::new();
+                step_bodies(stage, part, &mut local);
+                if !local.is_empty() {
+                    found
+                        .lock()
+                        .unwrap_or_else(|poisoned| poisoned.into_inner())
+                        .extend(local);
+                }
+            }));
+        }
+    });
+    let mut found = found
+        .into_inner()
+        .unwrap_or_else(|poisoned| poisoned.into_inner());
+    found.sort_by_key(|e| e.entity);
+    errors.extend(found);
+}
+
+/// Splits `bodies` into `parts` runs of nearly equal length.
+fn split_evenly(bodies: Bodies<'_>, parts: usize) -> Vec<Bodies<'_>> {
+    let mut out = Vec::with_capacity(parts);
+    let mut rest = bodies;
+    for k in (1..=parts).rev() {
+        let take = rest.len() / k;
+        let (head, tail) = rest.split_at(take);
+        out.push(head);
+        rest = tail;
+    }
+    out
+}

@@ -1,0 +1,77 @@
+//! Springs stepped by the world itself: the implicit step of stiff spring groups and the
+//! spring dampers' flow.
+//!
+//! ## Stiff springs
+//!
+//! Stiff springs: which spring groups the implicit step takes, and the system that steps them.
+//!
+//! The explicit (drift–kick–drift) spring step is cheap but keeps a spring's energy only to about
+//! `(ωΔt)²/4` of it and diverges at `ωΔt ≥ 2`. A group of bodies joined by springs (a connected
+//! component of the spring graph over dynamic bodies) that can vibrate at
+//! `ωΔt ≥` [`IMPLICIT_OMEGA_DT`](tumble_core::springs::IMPLICIT_OMEGA_DT) is stepped instead by the energy-conserving implicit step of
+//! [`tumble_core::springs::implicit`], as a whole: stable at any stiffness, with kinetic plus
+//! elastic energy conserved exactly and no numerical damping. `ω` is bounded above per body, over
+//! all of its springs and with the anchors' lever arms:
+//! `ω² ≤ max_bodies Σ_(its springs) k (ι_a + ι_b)`, `ι = 1/m + |r|² max I⁻¹` per end (a
+//! Gershgorin-style bound on the group's stiffness matrix, exact for the top mode of a uniform
+//! chain; one spring's own `k (ι_a + ι_b)` misses that a body pulled by several springs vibrates
+//! faster, by up to √degree). So a group is never stiffer than the classification assumed. Soft
+//! groups pay nothing: their bodies stay on the explicit path. `Δt` here is the span of the plain
+//! step whose explicit spring step is as accurate as one substep (`Stages::accuracy_span`:
+//! `Δt/N` with `N` substeps; `0.44 Δt/N` with `yoshida4`'s composition, whose explicit step
+//! swings a spring's energy by 2.3 % only at `ωh = 0.68`, and is stable up to 1.57); in a step
+//! of several stages the implicit step runs once per stage, over the
+//! stage's span (the backward stage of the composition included: implicit midpoint is
+//! symmetric, so the composition keeps its order).
+//!
+//! [`PhysicsSettings::springs`](crate::components::PhysicsSettings::springs) overrides the choice
+//! for a world ([`SpringSolver`](crate::components::SpringSolver)). The classification is made when the schedule is planned and
+//! redone when the time step, the setting or the number of springs changes (a
+//! [`PhysicsRunner`](crate::schedule::PhysicsRunner) notices); after changing a spring's stiffness
+//! or a body's mass in place, re-insert the spring (or plan again) to re-classify.
+//!
+//! Bodies of an implicit group are marked [`ImplicitBody`](crate::components::ImplicitBody) and their springs [`ImplicitSpring`](crate::components::ImplicitSpring):
+//! the half drift and the explicit integrate systems skip them, `apply_springs` skips their
+//! springs, and [`solve_implicit_springs`] steps them, reading every other load (gravity,
+//! constant forces, game forces) from their accumulators, held constant over the stage.
+//!
+//! ## Spring dampers
+//!
+//! Spring dampers as a velocity flow of their own, half a step before the step and half a step
+//! after it (see [`tumble_core::damping`] for why that keeps the step second order).
+//!
+//! The damper of one [`Spring`](crate::components::Spring) (coefficient `c`, axis `n` from the second end to the first)
+//! acts on the relative anchor velocity along the axis, `u = J v = (ṗ_a − ṗ_b)·n` with
+//! `ṗ = v + ω × r` (`r` the anchor's lever arm from the centre of mass). Alone, at fixed
+//! positions, it obeys `m_eff u̇ = −c u` with the effective mass
+//!
+//! ```text
+//! 1/m_eff = J M⁻¹ Jᵀ = 1/m_a + (r_a × n)·I_a⁻¹ (r_a × n) + 1/m_b + (r_b × n)·I_b⁻¹ (r_b × n)
+//! ```
+//!
+//! (world inverse inertia; a world anchor, a [`Static`](crate::components::Static) or a [`Kinematic`](crate::components::Kinematic) end is infinitely
+//! massive and contributes 0), whose flow over `τ` is `u(τ) = e^{−cτ/m_eff} u`. It is applied as
+//! the impulse `P = m_eff (e^{−cτ/m_eff} − 1) u` along `n` at anchor `a` and `−P n` at anchor `b`
+//! (with the torques `r × (±P n)`), the exponential replaced by [`decrement`](tumble_core::damping::decrement) (`1 − e^{−x}` to
+//! `O(x⁴)`, never above 1, no platform `exp`). The kinetic energy changes by `½ m_eff u² (f² − 1) ≤ 0`, `f ∈ [0, 1]` the
+//! decay factor: a damper never adds energy, however large `cΔt`.
+//!
+//! Springs that share a body are swept one after another: at the start of the step in query
+//! order ([`damp_springs_start`]), at the end in the reverse order ([`damp_springs_end`]), so the
+//! end sweep is the adjoint of the start sweep and the whole step stays symmetric. Query order is
+//! the order of the springs' tables, the same on every run of the same world (as for the forces
+//! of [`apply_springs`](crate::forces::apply_springs)).
+
+mod damping;
+mod stiff;
+
+pub use damping::{damp_springs_end, damp_springs_start};
+pub use stiff::{
+    SpringClassification, classification_is_stale, classify_springs, solve_implicit_springs,
+};
+
+pub(crate) use damping::is_damped;
+
+// Scratch memory of `solve_implicit_springs`, in its signature; not for game code.
+#[doc(hidden)]
+pub use stiff::ImplicitScratch;

@@ -1,0 +1,481 @@
+//! Classification of spring groups into implicit and explicit, and the implicit solve system.
+
+use bevy_ecs::entity::EntityHashMap;
+use bevy_ecs::prelude::*;
+
+use tumble_core::math::{Real, Vec3};
+use tumble_core::springs::{
+    GroupBody, GroupSpring, IMPLICIT_OMEGA_DT, ImplicitSpringSolver, LinkEnd,
+    inverse_effective_mass_bound, omega_dt_bound,
+};
+
+use crate::components::{
+    BodyError, BodyErrorKind, Dynamic, ForceAccumulator, ImplicitBody, ImplicitSpring, MassProps,
+    PhysicsSettings, Pose, RigidBody, Spring, SpringEnd, SpringSolver, Stepped, body_state, reject,
+    write_body_state,
+};
+use crate::integrate::damp;
+
+/// What the classification was made for; a change re-classifies.
+#[derive(Resource, Debug, Clone, Copy, PartialEq)]
+pub struct SpringClassification {
+    dt: Real,
+    solver: SpringSolver,
+    springs: usize,
+}
+
+/// The span the explicit spring step's accuracy is judged on, as if it were one plain step
+/// (`Δt` without substeps, `Δt/N` with `N`, `0.44 Δt/N` for `yoshida4`'s composition: see
+/// [`Stages::accuracy_span`](tumble_core::integrate::Stages::accuracy_span)).
+fn classification_span(settings: &PhysicsSettings) -> Real {
+    settings.stages().accuracy_span(settings.dt())
+}
+
+/// Number of spring entities, from the archetypes (no query state needed).
+fn spring_count(world: &World) -> usize {
+    let Some(id) = world.component_id::<Spring>() else {
+        return 0;
+    };
+    world
+        .archetypes()
+        .iter()
+        .filter(|a| a.contains(id))
+        .map(|a| a.len() as usize)
+        .sum()
+}
+
+/// True when [`classify_springs`] must run again: the time step, the setting or the number of
+/// springs changed since it last ran.
+pub fn classification_is_stale(world: &World) -> bool {
+    let settings = world
+        .get_resource::<PhysicsSettings>()
+        .copied()
+        .unwrap_or_default();
+    let springs = spring_count(world);
+    match world.get_resource::<SpringClassification>() {
+        None => springs > 0,
+        Some(c) => {
+            c.dt != classification_span(&settings)
+                || c.solver != settings.springs
+                || c.springs != springs
+        }
+    }
+}
+
+/// The indices (in `index`) of a spring's two ends, `None` for an end outside it (a world anchor
+/// or a body that is not indexed).
+fn ends_in(index: &EntityHashMap<usize>, spring: &Spring) -> (Option<usize>, Option<usize>) {
+    let a = index.get(&spring.a).copied();
+    let b = match spring.b {
+        SpringEnd::Body { body, .. } => index.get(&body).copied(),
+        SpringEnd::World(_) => None,
+    };
+    (a, b)
+}
+
+fn find(parent: &mut [usize], mut i: usize) -> usize {
+    while parent[i] != i {
+        parent[i] = parent[parent[i]];
+        i = parent[i];
+    }
+    i
+}
+
+/// Decides which spring groups are stepped implicitly and marks them (see the module docs).
+pub fn classify_springs(world: &mut World) {
+    let settings = world
+        .get_resource::<PhysicsSettings>()
+        .copied()
+        .unwrap_or_default();
+    let dt = classification_span(&settings);
+    let springs: Vec<(Entity, Spring)> = world
+        .query::<(Entity, &Spring)>()
+        .iter(world)
+        .map(|(e, s)| (e, *s))
+        .collect();
+    let mut dynamic = world.query_filtered::<(Entity, &MassProps), Dynamic>();
+    let mut index = EntityHashMap::default();
+    let mut masses = Vec::new();
+    for (entity, mass) in dynamic.iter(world) {
+        index.insert(entity, masses.len());
+        masses.push(*mass);
+    }
+    let mut parent: Vec<usize> = (0..masses.len()).collect();
+    let mut stiff_group = vec![false; masses.len()];
+    let mut spring_root = Vec::with_capacity(springs.len());
+    // Per spring, its ends (indices in `masses`) and their inverse effective mass bounds `ι`;
+    // per body, `Σ k (ι_a + ι_b)` over its springs (see the module docs).
+    let ends: Vec<(Option<usize>, Option<usize>, [Real; 2])> = springs
+        .iter()
+        .map(|(_, spring)| {
+            let (a, b) = ends_in(&index, spring);
+            let bound = |end: Option<usize>, anchor| {
+                end.map_or(0.0, |i| inverse_effective_mass_bound(&masses[i], anchor))
+            };
+            let anchor_b = match spring.b {
+                SpringEnd::Body { anchor, .. } => anchor,
+                SpringEnd::World(_) => tumble_core::math::Vec3::ZERO,
+            };
+            (a, b, [bound(a, spring.anchor_a), bound(b, anchor_b)])
+        })
+        .collect();
+    let mut pull: Vec<Real> = vec![0.0; masses.len()];
+    for ((_, spring), &(a, b, iota)) in springs.iter().zip(&ends) {
+        for i in [a, b].into_iter().flatten() {
+            pull[i] += spring.stiffness * (iota[0] + iota[1]);
+        }
+    }
+    for ((_, spring), &(a, b, iota)) in springs.iter().zip(&ends) {
+        // A body's pull includes this spring's own `k (ι_a + ι_b)`; a spring without a dynamic
+        // end joins no group, and its own bound is all there is.
+        let own = omega_dt_bound(spring.stiffness, iota, dt);
+        let omega_dt = [a, b]
+            .into_iter()
+            .flatten()
+            .map(|i| pull[i].sqrt() * dt)
+            .fold(own, Real::max);
+        let stiff = match settings.springs {
+            SpringSolver::Auto => omega_dt >= IMPLICIT_OMEGA_DT,
+            SpringSolver::Implicit => true,
+            SpringSolver::Explicit => false,
+        };
+        let root = match (a, b) {
+            (Some(i), Some(j)) => {
+                let (ri, rj) = (find(&mut parent, i), find(&mut parent, j));
+                let merged = stiff_group[ri] || stiff_group[rj];
+                parent[ri] = rj;
+                stiff_group[rj] = merged;
+                Some(rj)
+            }
+            (Some(i), None) | (None, Some(i)) => Some(find(&mut parent, i)),
+            (None, None) => None,
+        };
+        if let Some(r) = root {
+            stiff_group[r] |= stiff;
+        }
+        spring_root.push(root);
+    }
+    let mut implicit_spring = Vec::with_capacity(springs.len());
+    for root in spring_root {
+        let stiff = root.is_some_and(|r| {
+            let r = find(&mut parent, r);
+            stiff_group[r]
+        });
+        implicit_spring.push(stiff);
+    }
+    let mut implicit_body = vec![false; masses.len()];
+    for (i, flag) in implicit_body.iter_mut().enumerate() {
+        let r = find(&mut parent, i);
+        *flag = stiff_group[r];
+    }
+    mark_stiff(world, &springs, implicit_spring, &index, &implicit_body);
+    let springs = spring_count(world);
+    world.insert_resource(SpringClassification {
+        dt,
+        solver: settings.springs,
+        springs,
+    });
+}
+
+/// Puts [`ImplicitSpring`] on the springs and [`ImplicitBody`] on the bodies the classification
+/// found stiff (`implicit_spring` per spring, `implicit_body` per dynamic body of `index`), and
+/// takes them off the others.
+fn mark_stiff(
+    world: &mut World,
+    springs: &[(Entity, Spring)],
+    implicit_spring: Vec<bool>,
+    index: &EntityHashMap<usize>,
+    implicit_body: &[bool],
+) {
+    for ((entity, _), stiff) in springs.iter().zip(implicit_spring) {
+        let has = world.get::<ImplicitSpring>(*entity).is_some();
+        if stiff && !has {
+            world.entity_mut(*entity).insert(ImplicitSpring);
+        } else if !stiff && has {
+            world.entity_mut(*entity).remove::<ImplicitSpring>();
+        }
+    }
+    let bodies: Vec<Entity> = world
+        .query_filtered::<Entity, With<RigidBody>>()
+        .iter(world)
+        .collect();
+    for entity in bodies {
+        let stiff = index.get(&entity).is_some_and(|&i| implicit_body[i]);
+        let has = world.get::<ImplicitBody>(entity).is_some();
+        if stiff && !has {
+            world.entity_mut(entity).insert(ImplicitBody::default());
+        } else if !stiff && has {
+            world.entity_mut(entity).remove::<ImplicitBody>();
+        }
+    }
+}
+
+/// Scratch memory of [`solve_implicit_springs`], kept between steps.
+#[derive(Default)]
+pub struct ImplicitScratch {
+    solver: ImplicitSpringSolver,
+    index: EntityHashMap<usize>,
+    entities: Vec<Entity>,
+    parent: Vec<usize>,
+    group_of: Vec<usize>,
+    /// Per root body, its group's number (groups numbered in order of their roots).
+    rank: Vec<usize>,
+    /// Body indices grouped: group `g`'s are `members[member_start[g]..member_start[g + 1]]`,
+    /// in index order.
+    members: Vec<usize>,
+    member_start: Vec<usize>,
+    /// Springs grouped the same way, in query order within a group, their ends as indices
+    /// local to the group.
+    springs: Vec<GroupSpring>,
+    spring_start: Vec<usize>,
+    /// Each spring's group, in query order, before the springs are grouped.
+    pending: Vec<u32>,
+    cursor: Vec<usize>,
+    /// Per body, its index within its group.
+    local: Vec<usize>,
+    /// The current group's bodies, handed to the solver.
+    bodies: Vec<GroupBody>,
+    /// Every implicit body of the world, in query order.
+    all: Vec<GroupBody>,
+}
+
+/// Steps every implicit spring group with the energy-conserving implicit step (see
+/// [`tumble_core::springs::implicit`]), consuming the bodies' accumulators. A group whose solve
+/// fails keeps its state and is quarantined.
+pub fn solve_implicit_springs(
+    settings: Res<PhysicsSettings>,
+    cursor: Res<crate::integrate::StageCursor>,
+    mut scratch: Local<ImplicitScratch>,
+    mut commands: Commands,
+    springs: Query<&Spring, With<ImplicitSpring>>,
+    mut bodies: Query<
+        (Stepped<&mut ForceAccumulator>, &mut ImplicitBody),
+        (Dynamic, With<ImplicitBody>),
+    >,
+    others: Query<&Pose, (With<RigidBody>, Without<ImplicitBody>)>,
+) {
+    let s = &mut *scratch;
+    s.index.clear();
+    s.entities.clear();
+    s.parent.clear();
+    s.all.clear();
+    let span = cursor.span(&settings);
+    let dt = span.h;
+    let half_substep = 0.5 * span.substep;
+    for ((entity, t, mut v, m, mut acc, damping), mut implicit) in &mut bodies {
+        // `Damping` is a flow of its own, half a substep before the substep and half after (see
+        // `tumble_core::damping`), as on the explicit path.
+        if let Some(d) = damping
+            && span.opens_substep
+        {
+            let v = &mut *v;
+            damp(d, half_substep, &mut v.linear, &mut v.angular);
+        }
+        s.index.insert(entity, s.entities.len());
+        s.parent.push(s.entities.len());
+        s.entities.push(entity);
+        s.all.push(GroupBody {
+            state: body_state(&t, &v, m),
+            mass: m.0,
+            load: acc.take(),
+            load_moment: implicit.take_load_moment(),
+        });
+    }
+    let groups = s.group_bodies(&springs);
+    s.group_springs(&springs, &others, groups);
+    for g in 0..groups {
+        let members = s.member_start[g]..s.member_start[g + 1];
+        s.bodies.clear();
+        s.bodies
+            .extend(s.members[members.clone()].iter().map(|&i| s.all[i]));
+        let springs = &s.springs[s.spring_start[g]..s.spring_start[g + 1]];
+        match s.solver.step(&mut s.bodies, springs, dt) {
+            Ok(stats) => {
+                tracing::trace!(
+                    bodies = s.bodies.len(),
+                    springs = springs.len(),
+                    newton = stats.newton_iterations,
+                    linear = stats.linear_iterations,
+                    splits = stats.splits,
+                    "implicit spring group stepped"
+                );
+                for (k, &i) in s.members[members].iter().enumerate() {
+                    if let Ok(((_, mut t, mut v, m, _, damping), _)) = bodies.get_mut(s.entities[i])
+                    {
+                        write_body_state(&s.bodies[k].state, m, &mut t, &mut v);
+                        if let Some(d) = damping
+                            && span.closes_substep
+                        {
+                            let v = &mut *v;
+                            damp(d, half_substep, &mut v.linear, &mut v.angular);
+                        }
+                    }
+                }
+            }
+            Err(error) => {
+                for &i in &s.members[members] {
+                    reject(
+                        &mut commands,
+                        BodyError {
+                            entity: s.entities[i],
+                            kind: BodyErrorKind::ImplicitSprings(error),
+                        },
+                    );
+                }
+            }
+        }
+    }
+}
+
+impl ImplicitScratch {
+    /// Forms the spring groups of the bodies read into `all` (union–find over `springs`) and
+    /// lays them out group by group: `members` in order of their roots, members in index order
+    /// (query order: deterministic), by counting sort, one pass over the bodies and one over
+    /// the springs whatever the number of groups. Returns the number of groups.
+    fn group_bodies(&mut self, springs: &Query<&Spring, With<ImplicitSpring>>) -> usize {
+        for spring in springs {
+            if let (Some(i), Some(j)) = ends_in(&self.index, spring) {
+                let (ri, rj) = (find(&mut self.parent, i), find(&mut self.parent, j));
+                self.parent[ri] = rj;
+            }
+        }
+        let n = self.entities.len();
+        self.group_of.clear();
+        for i in 0..n {
+            let r = find(&mut self.parent, i);
+            self.group_of.push(r);
+        }
+        self.rank.clear();
+        self.rank.resize(n, usize::MAX);
+        let mut groups = 0;
+        for i in 0..n {
+            if self.group_of[i] == i {
+                self.rank[i] = groups;
+                groups += 1;
+            }
+        }
+        let (rank, group_of) = (&self.rank, &self.group_of);
+        counting_starts(
+            &mut self.member_start,
+            groups,
+            (0..n).map(|i| rank[group_of[i]]),
+        );
+        self.members.clear();
+        self.members.resize(n, 0);
+        self.local.clear();
+        self.local.resize(n, 0);
+        self.cursor.clear();
+        self.cursor.extend_from_slice(&self.member_start[..groups]);
+        for i in 0..n {
+            let g = self.rank[self.group_of[i]];
+            self.local[i] = self.cursor[g] - self.member_start[g];
+            self.members[self.cursor[g]] = i;
+            self.cursor[g] += 1;
+        }
+        groups
+    }
+
+    /// Lays the springs out group by group in `springs`, each resolved to its group's local
+    /// body indices.
+    fn group_springs(
+        &mut self,
+        springs: &Query<&Spring, With<ImplicitSpring>>,
+        others: &Query<&Pose, (With<RigidBody>, Without<ImplicitBody>)>,
+        groups: usize,
+    ) {
+        // Two passes over the springs: one counts each group's springs, the other writes each in
+        // its group's slot. Resolving a spring twice is cheaper than keeping every resolved spring
+        // twice (a group of a million springs).
+        self.pending.clear();
+        for spring in springs {
+            if let Some((first, _)) = group_spring(&self.index, &self.local, others, spring) {
+                self.pending.push(self.rank[self.group_of[first]] as u32);
+            }
+        }
+        counting_starts(
+            &mut self.spring_start,
+            groups,
+            self.pending.iter().map(|&g| g as usize),
+        );
+        self.springs.clear();
+        // Every slot is written below (the counts are the same pass's); the filler never reaches
+        // the solver.
+        let filler = GroupSpring {
+            a: 0,
+            anchor_a: Vec3::ZERO,
+            b: LinkEnd::Fixed(Vec3::ZERO),
+            stiffness: 0.0,
+            rest_length: 0.0,
+        };
+        self.springs.resize(self.pending.len(), filler);
+        self.cursor.clear();
+        self.cursor.extend_from_slice(&self.spring_start[..groups]);
+        let mut k = 0;
+        for spring in springs {
+            if let Some((_, link)) = group_spring(&self.index, &self.local, others, spring) {
+                let g = self.pending[k] as usize;
+                k += 1;
+                self.springs[self.cursor[g]] = link;
+                self.cursor[g] += 1;
+            }
+        }
+    }
+}
+
+/// A spring of an implicit group as the solver takes it, with the index of its first end (an
+/// implicit body), or `None` when the spring does not act this step (an end missing or
+/// rejected).
+fn group_spring(
+    index: &EntityHashMap<usize>,
+    local: &[usize],
+    others: &Query<&Pose, (With<RigidBody>, Without<ImplicitBody>)>,
+    spring: &Spring,
+) -> Option<(usize, GroupSpring)> {
+    // Orient each spring so that its first end is an implicit body.
+    let (first, anchor_first, second) = match (ends_in(index, spring), spring.b) {
+        ((Some(i), _), _) => (i, spring.anchor_a, spring.b),
+        ((None, Some(j)), SpringEnd::Body { anchor, .. }) => (
+            j,
+            anchor,
+            SpringEnd::Body {
+                body: spring.a,
+                anchor: spring.anchor_a,
+            },
+        ),
+        _ => return None,
+    };
+    let end = match second {
+        SpringEnd::World(p) => LinkEnd::Fixed(p),
+        SpringEnd::Body { body, anchor } => match index.get(&body) {
+            Some(&k) => LinkEnd::Body {
+                index: local[k],
+                anchor,
+            },
+            // A static, kinematic or quarantined body holds its anchor still.
+            None => LinkEnd::Fixed(others.get(body).ok()?.transform_point(anchor)),
+        },
+    };
+    Some((
+        first,
+        GroupSpring {
+            a: local[first],
+            anchor_a: anchor_first,
+            b: end,
+            stiffness: spring.stiffness,
+            rest_length: spring.rest_length,
+        },
+    ))
+}
+
+/// Fills `starts` (length `groups + 1`) with the prefix sums of how many of `keys` fall in each
+/// group: group `g`'s items go to `starts[g]..starts[g + 1]`.
+fn counting_starts(starts: &mut Vec<usize>, groups: usize, keys: impl Iterator<Item = usize>) {
+    starts.clear();
+    starts.resize(groups + 1, 0);
+    for g in keys {
+        starts[g + 1] += 1;
+    }
+    for g in 0..groups {
+        starts[g + 1] += starts[g];
+    }
+}

@@ -1,0 +1,285 @@
+//! What the stability prediction reports, and how it says it.
+
+use bevy_ecs::prelude::*;
+use tumble_core::Integrator;
+use tumble_core::math::{DOUBLE_PRECISION, REAL_NAME, Real};
+
+use super::{
+    ACCURACY_HORIZON, COMPOSED_SPLIT_ERROR_LIMIT, RK4_STIFFNESS_LIMIT, SPLIT_DRIFT_TOLERANCE,
+    SPRING_LIMIT,
+};
+
+/// A setting outside the selected integrator's stable region, or beyond what the precision can
+/// resolve.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum StabilityWarning {
+    /// A spring too stiff for the time step, stepped explicitly ([`SpringSolver::Explicit`](crate::components::SpringSolver::Explicit)).
+    StiffSpring {
+        /// The spring entity.
+        spring: Entity,
+        /// `√(k/μ) Δt` (stable below [`SPRING_LIMIT`]).
+        omega_dt: Real,
+    },
+    /// A spin the explicit gyroscopic step will blow up.
+    ExplicitGyroscopic {
+        /// The body.
+        body: Entity,
+        /// The integrator.
+        integrator: Integrator,
+        /// Predicted time for round-off to grow to order one (s).
+        seconds: Real,
+    },
+    /// A spin the split free rotation of `splitting` / `splitting-xyz` integrates with a large
+    /// error per step (not an instability: the motion stays bounded and `|L|` exact, but wrong);
+    /// `exact` integrates it exactly.
+    InexactFreeRotation {
+        /// The body.
+        body: Entity,
+        /// The integrator.
+        integrator: Integrator,
+        /// `Δt² |ω_b ω_c| |I_b − I_c| / I_a`, compared with [`SPLIT_ERROR_LIMIT`](super::SPLIT_ERROR_LIMIT).
+        error_per_step: Real,
+    },
+    /// A body whose `rk4` rotation is stiff, `|L| Δt / I_min` above [`RK4_STIFFNESS_LIMIT`]
+    /// (module docs): the state stays finite, the orientation goes wrong.
+    StiffRk4Rotation {
+        /// The body.
+        body: Entity,
+        /// `|L| Δt / I_min`.
+        stiffness: Real,
+    },
+    /// Bodies a split method gives the exact free flow under
+    /// [`FreeFlow::Auto`](tumble_core::integrate::FreeFlow::Auto): their split free rotation
+    /// would err by more than the limit in a stage (see [`tumble_core::integrate::FreeFlow`]).
+    /// Not a fault: what the planner chose, said so that the choice is never silent. One for
+    /// the world, naming the first such body; the choice is made again every stage, from each
+    /// body's state then.
+    ExactFreeFlow {
+        /// The first such body.
+        body: Entity,
+        /// How many bodies take the exact flow now.
+        bodies: usize,
+        /// The selected (split) integrator.
+        integrator: Integrator,
+        /// What the split would cost the first body, as [`ExactSwitch::measure`](tumble_core::integrate::ExactSwitch::measure) judges it: the
+        /// predicted drift over [`ACCURACY_HORIZON`] (rad), or for a composition (`yoshida4`)
+        /// the relative error `e` of its largest stage.
+        measure: Real,
+    },
+    /// Bodies in stiff spring groups (see [`crate::springs`]), which the implicit spring solve
+    /// steps — translation and rotation, by the implicit midpoint rule — instead of the selected
+    /// integrator (not an instability: stable at any stiffness, but not the method asked for).
+    /// One warning for the world, naming the first such body.
+    ImplicitGroups {
+        /// The first body of an implicit group.
+        body: Entity,
+        /// Bodies in implicit groups.
+        bodies: usize,
+        /// The integrator they do not run.
+        integrator: Integrator,
+    },
+    /// A spin whose gyroscopic term a first-order method (`lclamp`, `implicit-gyroscopic`)
+    /// integrates with an orientation drift over [`ACCURACY_HORIZON`] above
+    /// [`FIRST_ORDER_DRIFT_LIMIT`](super::FIRST_ORDER_DRIFT_LIMIT) (not an instability: the motion stays bounded, but wrong).
+    FirstOrderGyroscopic {
+        /// The body.
+        body: Entity,
+        /// The integrator.
+        integrator: Integrator,
+        /// The predicted orientation drift over [`ACCURACY_HORIZON`] (rad), see
+        /// [`first_order_drift`](super::first_order_drift).
+        drift: Real,
+    },
+    /// A body so far from the origin that rounding of its stored position eats a visible part
+    /// of each step's motion (not an instability: the motion stays bounded, but wrong).
+    CoarsePosition {
+        /// The body.
+        body: Entity,
+        /// Its distance from the origin (m).
+        distance: Real,
+        /// Its motion in one step, `s Δt` (m).
+        step_motion: Real,
+        /// `r ε / (2 s Δt)`, compared with [`POSITION_RESOLUTION_LIMIT`](super::POSITION_RESOLUTION_LIMIT).
+        relative_error: Real,
+    },
+    /// A body that turns about a locked principal axis (a zero moment of inertia): every
+    /// integrator holds that rate at 0, so the first step drops it (not an instability, but the
+    /// motion is not the one given).
+    LockedAxisRate {
+        /// The body.
+        body: Entity,
+        /// `|b|`, the rates about its locked axes (rad/s), see
+        /// [`MassProperties::locked_axis_rates`](tumble_core::MassProperties::locked_axis_rates).
+        rate: Real,
+    },
+}
+
+impl StabilityWarning {
+    /// The spring or body warned of.
+    pub fn subject(&self) -> Entity {
+        match *self {
+            StabilityWarning::StiffSpring { spring, .. } => spring,
+            StabilityWarning::ExplicitGyroscopic { body, .. }
+            | StabilityWarning::FirstOrderGyroscopic { body, .. }
+            | StabilityWarning::ImplicitGroups { body, .. }
+            | StabilityWarning::ExactFreeFlow { body, .. }
+            | StabilityWarning::InexactFreeRotation { body, .. }
+            | StabilityWarning::StiffRk4Rotation { body, .. }
+            | StabilityWarning::CoarsePosition { body, .. }
+            | StabilityWarning::LockedAxisRate { body, .. } => body,
+        }
+    }
+
+    /// True for settings that make the integration diverge (stiff springs, explicit gyroscopic
+    /// blow-ups); false for a limit of accuracy or precision.
+    pub fn is_instability(&self) -> bool {
+        !matches!(
+            self,
+            StabilityWarning::CoarsePosition { .. }
+                | StabilityWarning::LockedAxisRate { .. }
+                | StabilityWarning::FirstOrderGyroscopic { .. }
+                | StabilityWarning::ImplicitGroups { .. }
+                | StabilityWarning::ExactFreeFlow { .. }
+                | StabilityWarning::InexactFreeRotation { .. }
+                | StabilityWarning::StiffRk4Rotation { .. }
+        )
+    }
+}
+
+impl std::fmt::Display for StabilityWarning {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match *self {
+            StabilityWarning::StiffSpring { spring, omega_dt } => write!(
+                f,
+                "spring {spring}: √(k/μ)Δt = {omega_dt:.3} ≥ {SPRING_LIMIT}, outside the stable \
+                 region of the explicit spring step; use the implicit one (springs = `auto` or \
+                 `implicit`), or lower the stiffness or the time step"
+            ),
+            StabilityWarning::ExplicitGyroscopic {
+                body,
+                integrator,
+                seconds,
+            } => write!(
+                f,
+                "rigid body {body}: integrator `{integrator}` amplifies its spin's round-off to \
+                 order one in about {seconds:.1} s (explicit gyroscopic term); use `splitting`"
+            ),
+            StabilityWarning::InexactFreeRotation {
+                body,
+                integrator,
+                error_per_step,
+            } => write!(
+                f,
+                "rigid body {body}: integrator `{integrator}` splits its free rotation with a \
+                 relative error of {:.1} % per {} in its spin (Δt²|ω_b ω_c||I_b − I_c|/I_a); \
+                 use free_flow = `auto` (the exact flow where the split errs), `exact`, or a \
+                 smaller time step",
+                100.0 * error_per_step,
+                if integrator.composition().len() > 1 {
+                    "stage"
+                } else {
+                    "step"
+                }
+            ),
+            StabilityWarning::ExactFreeFlow {
+                body,
+                bodies,
+                integrator,
+                measure,
+            } => exact_free_flow(f, body, bodies, integrator, measure),
+            StabilityWarning::ImplicitGroups {
+                body,
+                bodies,
+                integrator,
+            } => write!(
+                f,
+                "rigid body {body}: {} in stiff spring groups, stepped by the implicit spring \
+                 solve (implicit midpoint, translation and rotation), not by `{integrator}`; \
+                 springs = `explicit` steps them with `{integrator}` at a time step small \
+                 enough for their stiffness",
+                if bodies == 1 {
+                    "alone".to_owned()
+                } else {
+                    format!("and {} more bodies", bodies - 1)
+                }
+            ),
+            StabilityWarning::FirstOrderGyroscopic {
+                body,
+                integrator,
+                drift,
+            } => write!(
+                f,
+                "rigid body {body}: integrator `{integrator}` integrates its gyroscopic term to \
+                 first order, and at this spin its orientation drifts by about {drift:.2} rad in \
+                 {ACCURACY_HORIZON} s; use `splitting`, or `exact` for a thin or fast body"
+            ),
+            StabilityWarning::StiffRk4Rotation { body, stiffness } => write!(
+                f,
+                "rigid body {body}: integrator `rk4` is stiff for this body, |L|Δt/I_min = \
+                 {stiffness:.2} > {RK4_STIFFNESS_LIMIT} (its rotation at constant L reads any \
+                 tilt as a spin about the thinnest axis), so its orientation goes wrong; use \
+                 `splitting` or `exact`"
+            ),
+            StabilityWarning::CoarsePosition {
+                body,
+                distance,
+                step_motion,
+                relative_error,
+            } => write!(
+                f,
+                "rigid body {body}: {distance:.3e} m from the origin, {REAL_NAME} positions are \
+                 spaced up to {:.1e} m there, and it moves {step_motion:.1e} m per step: up to \
+                 {:.2} % of every step is lost to rounding{}",
+                distance * Real::EPSILON,
+                100.0 * relative_error,
+                if DOUBLE_PRECISION {
+                    "; move the origin closer"
+                } else {
+                    "; build with the `f64` feature (or move the origin closer)"
+                }
+            ),
+            StabilityWarning::LockedAxisRate { body, rate } => write!(
+                f,
+                "rigid body {body}: turns at {rate:.3e} rad/s about a locked principal axis (a \
+                 zero moment of inertia), a rate every integrator holds at 0: the first step \
+                 drops it; give it no rate about that axis, or a nonzero moment"
+            ),
+        }
+    }
+}
+
+/// The notice of [`StabilityWarning::ExactFreeFlow`].
+fn exact_free_flow(
+    f: &mut std::fmt::Formatter<'_>,
+    body: Entity,
+    bodies: usize,
+    integrator: Integrator,
+    measure: Real,
+) -> std::fmt::Result {
+    write!(
+        f,
+        "rigid body {body}{}: `{integrator}`'s split free rotation would {}; stepped \
+                 with the exact free flow (as `{}`) while that holds; free_flow = `method` \
+                 keeps the split",
+        if bodies == 1 {
+            String::new()
+        } else {
+            format!(" and {} more bodies", bodies - 1)
+        },
+        if integrator.composition().len() > 1 {
+            format!(
+                "err by {:.1} % a stage (Δt²|ω_b ω_c||I_b − I_c|/I_a > {:.0} %)",
+                100.0 * measure,
+                100.0 * COMPOSED_SPLIT_ERROR_LIMIT
+            )
+        } else {
+            format!(
+                "drift by about {measure:.1e} rad in {ACCURACY_HORIZON} s (> \
+                         {SPLIT_DRIFT_TOLERANCE:.0e} rad, the {REAL_NAME} state's own rounding)"
+            )
+        },
+        integrator
+            .exact_counterpart()
+            .map_or("exact", |exact| exact.name()),
+    )
+}
