@@ -49,7 +49,7 @@ struct TumbleTypes(
         PhysicsRunner,
         PhysicsPlan,
         PhysicsSet,
-        Stage,
+        PhysicsSystem,
     ),
     (
         StabilityWarning,

@@ -127,7 +127,7 @@ fn constant_torque_generator_spins_up_linearly() {
         torque: Vec3::Z * 4.0,
     });
     let mut physics = PhysicsRunner::new(&mut world);
-    assert!(physics.plan().contains(Stage::ConstantTorques));
+    assert!(physics.plan().contains(PhysicsSystem::ConstantTorques));
     assert!(
         world.get::<ForceAccumulator>(body).is_some(),
         "generator inserts the accumulator"

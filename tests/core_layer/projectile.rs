@@ -96,7 +96,10 @@ fn drift_kick_drift_is_exact_for_constant_gravity() {
             .id();
         let mut physics = PhysicsRunner::new(&mut world);
         let plan = physics.plan();
-        assert!(plan.contains(Stage::BeginStage), "{integrator}: {plan}");
+        assert!(
+            plan.contains(PhysicsSystem::BeginStage),
+            "{integrator}: {plan}"
+        );
         let n = 600;
         for _ in 0..n {
             physics.step(&mut world);

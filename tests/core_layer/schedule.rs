@@ -12,9 +12,9 @@ fn gravity_free_world_has_no_gravity_system() {
     let mut world = world_with(0.01, Integrator::SymplecticEuler);
     let body = world.spawn((RigidBody, ForceAccumulator::default())).id();
     let plan = PhysicsPlan::for_world(&mut world);
-    assert!(!plan.contains(Stage::Gravity));
+    assert!(!plan.contains(PhysicsSystem::Gravity));
     // One body, with an accumulator: nothing but its integrate system.
-    assert_eq!(plan.stages(), &[Stage::IntegrateWithForces]);
+    assert_eq!(plan.systems(), &[PhysicsSystem::IntegrateWithForces]);
     let mut physics = PhysicsRunner::new(&mut world);
     for _ in 0..10 {
         physics.step(&mut world);
@@ -34,11 +34,11 @@ fn each_generator_kind_adds_exactly_its_system() {
     });
     let plan = PhysicsPlan::for_world(&mut world);
     assert_eq!(
-        plan.stages(),
+        plan.systems(),
         &[
-            Stage::Gravity,
-            Stage::ConstantForces,
-            Stage::IntegrateWithForces,
+            PhysicsSystem::Gravity,
+            PhysicsSystem::ConstantForces,
+            PhysicsSystem::IntegrateWithForces,
         ]
     );
     assert_eq!(
@@ -59,9 +59,9 @@ fn each_generator_kind_adds_exactly_its_system() {
     });
     let plan = PhysicsPlan::for_world(&mut world);
     // Springs bring the energy audit along: its start, its load reading and its balance.
-    assert_eq!(plan.stages().len(), 5 + 3);
-    assert!(plan.contains(Stage::Springs) && plan.contains(Stage::ConstantTorques));
-    assert!(plan.contains(Stage::AuditEnergy));
+    assert_eq!(plan.systems().len(), 5 + 3);
+    assert!(plan.contains(PhysicsSystem::Springs) && plan.contains(PhysicsSystem::ConstantTorques));
+    assert!(plan.contains(PhysicsSystem::AuditEnergy));
 }
 
 #[test]
@@ -75,7 +75,7 @@ fn static_and_kinematic_bodies_are_never_integrated() {
     let wall = world.spawn((RigidBody, Static, moving)).id();
     let platform = world.spawn((RigidBody, Kinematic, moving)).id();
     // Only fixed bodies: nothing to integrate, no system at all.
-    assert!(PhysicsPlan::for_world(&mut world).stages().is_empty());
+    assert!(PhysicsPlan::for_world(&mut world).systems().is_empty());
     // A dynamic body hanging from the static one by a spring: the spring pulls on both ends, the
     // static end's share is discarded every step.
     let ball = world
@@ -155,7 +155,7 @@ fn the_runner_replans_when_the_world_changes() {
     // Switching to a drift–kick–drift integrator adds the first half-drift.
     world.resource_mut::<PhysicsSettings>().integrator = Integrator::Splitting;
     physics.step(&mut world);
-    assert!(physics.plan().contains(Stage::BeginStage));
+    assert!(physics.plan().contains(PhysicsSystem::BeginStage));
     assert_eq!(physics.replans(), 3);
     assert_eq!(format!("{physics}"), physics.plan().to_string());
 }
@@ -198,8 +198,8 @@ fn user_force_system_in_forces_set_runs_before_integration() {
     );
 }
 
-/// A world that needs every stage gets all of them, once each, in `Stage::ALL` order (so the
-/// plan's inline capacity, `Stage::COUNT`, always suffices).
+/// A world that needs every stage gets all of them, once each, in `PhysicsSystem::ALL` order (so the
+/// plan's inline capacity, `PhysicsSystem::COUNT`, always suffices).
 #[test]
 fn a_world_needing_everything_plans_every_stage_in_order() {
     let mut world = world_with(0.01, Integrator::Splitting);
@@ -245,8 +245,8 @@ fn a_world_needing_everything_plans_every_stage_in_order() {
         rest_length: 1.0,
     });
     let plan = PhysicsPlan::for_world(&mut world);
-    assert_eq!(plan.stages(), &Stage::ALL[..]);
-    assert_eq!(Stage::ALL.len(), Stage::COUNT);
+    assert_eq!(plan.systems(), &PhysicsSystem::ALL[..]);
+    assert_eq!(PhysicsSystem::ALL.len(), PhysicsSystem::COUNT);
 }
 
 /// The spring dampers' two stages are planned only while some spring has `damping > 0`, and the
@@ -264,7 +264,10 @@ fn damper_stages_only_with_a_damped_spring() {
         rest_length: 0.5,
     };
     let undamped = world.spawn(spring(0.0)).id();
-    let damper = [Stage::DampSpringsStart, Stage::DampSpringsEnd];
+    let damper = [
+        PhysicsSystem::DampSpringsStart,
+        PhysicsSystem::DampSpringsEnd,
+    ];
     let mut physics = PhysicsRunner::new(&mut world);
     physics.step(&mut world);
     assert!(damper.iter().all(|&s| !physics.plan().contains(s)));

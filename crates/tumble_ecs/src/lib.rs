@@ -44,8 +44,8 @@ pub mod prelude {
     pub use crate::forces::{ApplyForces, BodyForces};
     pub use crate::parallel::Parallelism;
     pub use crate::schedule::{
-        FixedStepper, ForceSystems, FrameSteps, PhysicsPlan, PhysicsRunner, PhysicsSet, Stage,
-        interpolate,
+        FixedStepper, ForceSystems, FrameSteps, PhysicsPlan, PhysicsRunner, PhysicsSet,
+        PhysicsSystem, interpolate,
     };
     pub use crate::stability::{StabilityWarning, check_stability};
     pub use crate::state::{RollbackError, RollbackSnapshot, WorldChecksum, world_checksum};

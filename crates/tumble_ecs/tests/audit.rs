@@ -251,7 +251,7 @@ fn the_audit_is_planned_only_where_energy_can_blow_up() {
         } else {
             body(&mut w, 0.0, ASYMMETRIC, Vec3::Y);
         }
-        PhysicsPlan::for_world(&mut w).contains(Stage::AuditEnergy)
+        PhysicsPlan::for_world(&mut w).contains(PhysicsSystem::AuditEnergy)
     };
     assert!(
         !plan(Integrator::Splitting, false, None),

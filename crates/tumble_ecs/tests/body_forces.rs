@@ -210,7 +210,7 @@ fn a_constant_local_force_turns_with_the_body() {
         })
         .id();
     let mut physics = PhysicsRunner::new(&mut world);
-    assert!(physics.plan().contains(Stage::ConstantForces));
+    assert!(physics.plan().contains(PhysicsSystem::ConstantForces));
     for _ in 0..100 {
         physics.step(&mut world);
         world.clear_trackers();

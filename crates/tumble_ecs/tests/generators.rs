@@ -78,7 +78,7 @@ fn a_negative_stiffness_is_left_out_when_inserted() {
     let mut physics = PhysicsRunner::new(&mut world);
     step(&mut world, &mut physics, 50);
     assert_left_out(&world, spring, "stiffness");
-    assert!(!physics.plan().contains(Stage::Springs));
+    assert!(!physics.plan().contains(PhysicsSystem::Springs));
     assert_eq!(world.get::<Pose>(body).unwrap().translation, Vec3::X);
 }
 
@@ -154,11 +154,11 @@ fn a_generator_whose_body_is_despawned_is_reported_once() {
         .id();
     let mut physics = PhysicsRunner::new(&mut world);
     step(&mut world, &mut physics, 5);
-    assert!(physics.plan().contains(Stage::Springs));
+    assert!(physics.plan().contains(PhysicsSystem::Springs));
     world.despawn(gone);
     step(&mut world, &mut physics, 20);
     assert_left_out(&world, spring, "b");
-    assert!(!physics.plan().contains(Stage::Springs));
+    assert!(!physics.plan().contains(PhysicsSystem::Springs));
 }
 
 #[test]

@@ -159,8 +159,8 @@ fn the_planner_picks_the_spring_method_and_can_be_overridden() {
             .iter()
             .any(|w| matches!(w, StabilityWarning::StiffSpring { .. }));
         (
-            plan.contains(Stage::SolveImplicitSprings),
-            plan.contains(Stage::Springs),
+            plan.contains(PhysicsSystem::SolveImplicitSprings),
+            plan.contains(PhysicsSystem::Springs),
             warned,
         )
     };
@@ -195,7 +195,7 @@ fn the_planner_counts_every_spring_on_a_body() {
             let end = SpringEnd::World(Vec3::new(angle.cos(), angle.sin(), 0.0));
             world.spawn(Spring::new(hub, Vec3::ZERO, end, k, 0.5));
         }
-        PhysicsPlan::for_world(&mut world).contains(Stage::SolveImplicitSprings)
+        PhysicsPlan::for_world(&mut world).contains(PhysicsSystem::SolveImplicitSprings)
     };
     assert!(!implicit_with(1), "one soft spring stays explicit");
     assert!(
@@ -262,7 +262,7 @@ fn a_stiff_cloth_falls_without_making_energy() {
     };
     let e0 = total(&mut world);
     let mut physics = PhysicsRunner::new(&mut world);
-    assert!(physics.plan().contains(Stage::SolveImplicitSprings));
+    assert!(physics.plan().contains(PhysicsSystem::SolveImplicitSprings));
     let mut lowest: Real = 0.0;
     for _ in 0..60 {
         physics.step(&mut world);

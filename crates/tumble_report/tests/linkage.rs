@@ -210,7 +210,7 @@ fn substeps_are_steps_of_the_substep_bit_for_bit() {
             }
         }
         assert!(
-            a.plan().contains(Stage::SolveImplicitSprings),
+            a.plan().contains(PhysicsSystem::SolveImplicitSprings),
             "{}",
             a.plan()
         );
@@ -242,7 +242,7 @@ fn implicit_springs_keep_the_order_with_forces_at_points() {
                     physics.step(&mut w);
                     w.clear_trackers();
                 }
-                assert!(physics.plan().contains(Stage::SolveImplicitSprings));
+                assert!(physics.plan().contains(PhysicsSystem::SolveImplicitSprings));
                 let (position, orientation) = error(&w, &bodies, &exact);
                 position + orientation
             })

@@ -15,7 +15,7 @@ fn plan_of(name: &str) -> (String, usize) {
     let world: &mut World = &mut built.world;
     assert_eq!(&PhysicsPlan::for_world(world), built.physics.plan());
     let plan = built.physics.plan();
-    (plan.to_string(), plan.stages().len())
+    (plan.to_string(), plan.systems().len())
 }
 
 #[test]

@@ -474,7 +474,8 @@ pub(super) fn rotate_symmetric_lanes(
 ) -> RotatedLanes {
     match kernel {
         // Not paired: `wide`'s `f64x4` is already two SSE2 registers side by side, and a pair of
-        // them spills so much that the kernel runs 40 % slower.
+        // them spills so many values to the stack that it loses to one run of four (the
+        // kernel rows of `tumble bench`).
         Kernel::Portable => rotate_symmetric_lanes_in::<F64x4>(Portable, inputs, h, kicks),
         #[cfg(target_arch = "x86_64")]
         #[expect(
@@ -508,9 +509,9 @@ fn rotate_symmetric_lanes_avx512(
 }
 
 /// The kernel compiled with AVX2 enabled: eight bodies as two 256-bit registers side by side
-/// ([`Pair`] of [`Avx4`]). The pair spills some values to the stack, yet on an AVX2-only EPYC it is
-/// 11–15 % faster per body-step than the two runs of four one after the other: each run's
-/// chain of four dependent rotations leaves the core idle, and the other run fills it.
+/// ([`Pair`] of [`Avx4`]). The pair spills some values to the stack, yet it beats two runs of
+/// four one after the other per body-step (the kernel rows of `tumble bench`): each run's chain
+/// of four dependent rotations leaves the core idle, and the other run fills it.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 fn rotate_symmetric_lanes_avx2(

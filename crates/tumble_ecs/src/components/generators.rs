@@ -202,41 +202,31 @@ fn force_at_point(force: Vec3, local_point: Option<Vec3>) -> Result<(), Generato
     }
 }
 
-impl Generator for ConstantForce {
-    const NAME: &'static str = "ConstantForce";
+/// The [`Generator`] of a type that acts on one body, its field `body`, with the values
+/// checked by `$check` (`$g` the generator).
+macro_rules! one_body_generator {
+    ($name:ident, |$g:ident| $check:expr) => {
+        impl Generator for $name {
+            const NAME: &'static str = stringify!($name);
 
-    fn check_values(&self) -> Result<(), GeneratorErrorKind> {
-        force_at_point(self.force, self.local_point)
-    }
+            fn check_values(&self) -> Result<(), GeneratorErrorKind> {
+                let $g = self;
+                $check
+            }
 
-    fn bodies(&self) -> impl Iterator<Item = (&'static str, Entity)> {
-        std::iter::once(("body", self.body))
-    }
+            fn bodies(&self) -> impl Iterator<Item = (&'static str, Entity)> {
+                std::iter::once(("body", self.body))
+            }
+        }
+    };
 }
 
-impl Generator for ConstantLocalForce {
-    const NAME: &'static str = "ConstantLocalForce";
-
-    fn check_values(&self) -> Result<(), GeneratorErrorKind> {
-        force_at_point(self.force, self.local_point)
-    }
-
-    fn bodies(&self) -> impl Iterator<Item = (&'static str, Entity)> {
-        std::iter::once(("body", self.body))
-    }
-}
-
-impl Generator for ConstantTorque {
-    const NAME: &'static str = "ConstantTorque";
-
-    fn check_values(&self) -> Result<(), GeneratorErrorKind> {
-        finite_vec3("torque", self.torque)
-    }
-
-    fn bodies(&self) -> impl Iterator<Item = (&'static str, Entity)> {
-        std::iter::once(("body", self.body))
-    }
-}
+one_body_generator!(ConstantForce, |g| force_at_point(g.force, g.local_point));
+one_body_generator!(ConstantLocalForce, |g| force_at_point(
+    g.force,
+    g.local_point
+));
+one_body_generator!(ConstantTorque, |g| finite_vec3("torque", g.torque));
 
 impl Generator for Spring {
     const NAME: &'static str = "Spring";

@@ -65,7 +65,7 @@ mod plugin;
 mod runner;
 mod stepper;
 
-pub use plan::{PhysicsPlan, PhysicsSet, Stage};
+pub use plan::{PhysicsPlan, PhysicsSet, PhysicsSystem};
 #[cfg(feature = "bevy_app")]
 pub use plugin::{TumblePlugin, TumbleStep, physics_step};
 pub use runner::{ForceSystems, PhysicsRunner};

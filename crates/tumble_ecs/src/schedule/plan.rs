@@ -31,7 +31,7 @@ use crate::springs::{damp_springs_end, damp_springs_start, is_damped};
 #[derive(ScheduleLabel, Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub(crate) struct PlannedStage;
 
-/// The ordered stages of one physics step.
+/// The ordered phases of one run of the physics schedule (one stage of a step).
 #[derive(SystemSet, Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum PhysicsSet {
     /// Start of the step: the audit's start, the first half of the damping flows, the first
@@ -47,35 +47,35 @@ pub enum PhysicsSet {
     Integrate,
 }
 
-/// Declares [`Stage`] from one list, in the order a step runs the systems, each variant with its
-/// doc and its system's name: the order ([`Stage::ALL`]) and the names ([`Stage::name`]) are
+/// Declares [`PhysicsSystem`] from one list, in the order a step runs the systems, each variant with its
+/// doc and its system's name: the order ([`PhysicsSystem::ALL`]) and the names ([`PhysicsSystem::name`]) are
 /// made from the same list and cannot drift apart.
-macro_rules! stages {
+macro_rules! physics_systems {
     ($($(#[doc = $doc:expr])* $variant:ident => $name:literal,)*) => {
         /// One system of the physics step.
         #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-        pub enum Stage {
+        pub enum PhysicsSystem {
             $($(#[doc = $doc])* $variant,)*
         }
 
-        impl Stage {
-            /// Every stage, in the order a step runs them.
-            pub const ALL: [Stage; [$($name),*].len()] = [$(Stage::$variant),*];
+        impl PhysicsSystem {
+            /// Every system, in the order a step runs them.
+            pub const ALL: [PhysicsSystem; [$($name),*].len()] = [$(PhysicsSystem::$variant),*];
 
-            /// How many stages there are (a plan holds each at most once).
+            /// How many systems there are (a plan holds each at most once).
             pub const COUNT: usize = Self::ALL.len();
 
             /// The system's name.
             pub fn name(self) -> &'static str {
                 match self {
-                    $(Stage::$variant => $name,)*
+                    $(PhysicsSystem::$variant => $name,)*
                 }
             }
         }
     };
 }
 
-stages! {
+physics_systems! {
     /// [`hold_game_loads`].
     HoldGameLoads => "hold_game_loads",
     /// [`audit_energy_start`].
@@ -131,7 +131,7 @@ stages! {
 /// - `discard_fixed_body_forces` only if a static or kinematic body has an accumulator.
 ///
 /// [`PhysicsPlan::of`] is cheap (one pass over the archetypes, and over the springs when there
-/// are any; the stages live inline), so [`PhysicsRunner`](crate::schedule::PhysicsRunner)
+/// are any; the systems live inline), so [`PhysicsRunner`](crate::schedule::PhysicsRunner)
 /// re-plans every step and rebuilds the schedule only when the plan changes; the runner keeps
 /// its spring query between steps, so its re-planning does not allocate.
 ///
@@ -139,7 +139,7 @@ stages! {
 /// after checking it against the world, so no public path steps a world by a stale plan.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct PhysicsPlan {
-    stages: ArrayVec<Stage, { Stage::COUNT }>,
+    systems: ArrayVec<PhysicsSystem, { PhysicsSystem::COUNT }>,
     runs_per_step: usize,
 }
 
@@ -262,37 +262,49 @@ impl PhysicsPlan {
                 .copied()
                 .unwrap_or_default()
                 .applies(c.springs);
-        // Whether each stage is needed, in the order a step runs them (`Stage::ALL`'s). The
+        // Whether each system is needed, in the order a step runs them (`PhysicsSystem::ALL`'s). The
         // springs come last among the forces, after the audit has read the others' loads, so
         // that the audit needs no second evaluation of every spring to take theirs out again.
         let loaded = c.dynamic_with_accumulator || c.implicit_bodies;
         let needed = [
-            (Stage::HoldGameLoads, staged && loaded),
-            (Stage::AuditEnergyStart, audit),
-            (Stage::DampSpringsStart, c.damped_springs),
-            (Stage::BeginStage, midpoint && c.dynamic_with_accumulator),
+            (PhysicsSystem::HoldGameLoads, staged && loaded),
+            (PhysicsSystem::AuditEnergyStart, audit),
+            (PhysicsSystem::DampSpringsStart, c.damped_springs),
             (
-                Stage::Gravity,
+                PhysicsSystem::BeginStage,
+                midpoint && c.dynamic_with_accumulator,
+            ),
+            (
+                PhysicsSystem::Gravity,
                 world.contains_resource::<Gravity>() && loaded,
             ),
-            (Stage::ConstantForces, c.constant_forces),
-            (Stage::ConstantTorques, c.constant_torques),
-            (Stage::AuditExternalLoads, audit && loaded),
-            (Stage::Springs, c.explicit_springs),
-            (Stage::SolveImplicitSprings, c.implicit_bodies),
-            (Stage::IntegrateWithForces, c.dynamic_with_accumulator),
-            (Stage::IntegrateWithoutForces, c.dynamic_without_accumulator),
-            (Stage::DiscardFixedBodyForces, c.fixed_with_accumulator),
-            (Stage::DampSpringsEnd, c.damped_springs),
-            (Stage::AuditEnergy, audit),
-            (Stage::NextStage, staged),
+            (PhysicsSystem::ConstantForces, c.constant_forces),
+            (PhysicsSystem::ConstantTorques, c.constant_torques),
+            (PhysicsSystem::AuditExternalLoads, audit && loaded),
+            (PhysicsSystem::Springs, c.explicit_springs),
+            (PhysicsSystem::SolveImplicitSprings, c.implicit_bodies),
+            (
+                PhysicsSystem::IntegrateWithForces,
+                c.dynamic_with_accumulator,
+            ),
+            (
+                PhysicsSystem::IntegrateWithoutForces,
+                c.dynamic_without_accumulator,
+            ),
+            (
+                PhysicsSystem::DiscardFixedBodyForces,
+                c.fixed_with_accumulator,
+            ),
+            (PhysicsSystem::DampSpringsEnd, c.damped_springs),
+            (PhysicsSystem::AuditEnergy, audit),
+            (PhysicsSystem::NextStage, staged),
         ];
-        let stages = needed
+        let systems = needed
             .into_iter()
-            .filter_map(|(stage, needed)| needed.then_some(stage))
+            .filter_map(|(system, needed)| needed.then_some(system))
             .collect();
         Self {
-            stages,
+            systems,
             runs_per_step,
         }
     }
@@ -315,13 +327,13 @@ impl PhysicsPlan {
     }
 
     /// The planned systems, in run order.
-    pub fn stages(&self) -> &[Stage] {
-        &self.stages
+    pub fn systems(&self) -> &[PhysicsSystem] {
+        &self.systems
     }
 
-    /// True when `stage` is part of the plan.
-    pub fn contains(&self, stage: Stage) -> bool {
-        self.stages.contains(&stage)
+    /// True when `system` is part of the plan.
+    pub fn contains(&self, system: PhysicsSystem) -> bool {
+        self.systems.contains(&system)
     }
 
     /// Builds the schedule holding exactly the planned systems, strictly ordered (so forces are
@@ -329,12 +341,12 @@ impl PhysicsPlan {
     /// of a step: [`run_step`](Self::run_step) runs a whole step.
     pub(crate) fn build_schedule(&self) -> Schedule {
         let mut schedule = Schedule::new(PlannedStage);
-        // The stages run strictly one after another, so a multi-threaded executor (bevy's
-        // default with `multi_threaded`) could only add overhead: ~45 µs per step measured.
+        // The systems run strictly one after another, so a multi-threaded executor (bevy's
+        // default with `multi_threaded`) could only add its own overhead.
         // Parallelism lives inside the integrate systems instead (see `crate::parallel`).
         schedule.set_executor(bevy_ecs::schedule::SingleThreadedExecutor::new());
         // Commands (quarantine of a bad body) are rare: apply them once at the end of the step
-        // instead of paying for sync points between the stages.
+        // instead of paying for sync points between the systems.
         schedule.set_build_settings(ScheduleBuildSettings {
             auto_insert_apply_deferred: false,
             ..Default::default()
@@ -348,67 +360,74 @@ impl PhysicsPlan {
             )
                 .chain(),
         );
-        let mut previous: Option<Stage> = None;
-        for &stage in &self.stages {
-            let set = match stage {
-                Stage::HoldGameLoads
-                | Stage::AuditEnergyStart
-                | Stage::DampSpringsStart
-                | Stage::BeginStage => PhysicsSet::Prepare,
-                Stage::Gravity => PhysicsSet::Gravity,
-                Stage::AuditExternalLoads
-                | Stage::AuditEnergy
-                | Stage::SolveImplicitSprings
-                | Stage::IntegrateWithForces
-                | Stage::IntegrateWithoutForces
-                | Stage::DiscardFixedBodyForces
-                | Stage::DampSpringsEnd
-                | Stage::NextStage => PhysicsSet::Integrate,
+        let mut previous: Option<PhysicsSystem> = None;
+        for &system in &self.systems {
+            let set = match system {
+                PhysicsSystem::HoldGameLoads
+                | PhysicsSystem::AuditEnergyStart
+                | PhysicsSystem::DampSpringsStart
+                | PhysicsSystem::BeginStage => PhysicsSet::Prepare,
+                PhysicsSystem::Gravity => PhysicsSet::Gravity,
+                PhysicsSystem::AuditExternalLoads
+                | PhysicsSystem::AuditEnergy
+                | PhysicsSystem::SolveImplicitSprings
+                | PhysicsSystem::IntegrateWithForces
+                | PhysicsSystem::IntegrateWithoutForces
+                | PhysicsSystem::DiscardFixedBodyForces
+                | PhysicsSystem::DampSpringsEnd
+                | PhysicsSystem::NextStage => PhysicsSet::Integrate,
                 // After the audit's reading of the loads when there is one (see
                 // `from_contents`), so in its set.
-                Stage::Springs if self.contains(Stage::AuditExternalLoads) => PhysicsSet::Integrate,
+                PhysicsSystem::Springs if self.contains(PhysicsSystem::AuditExternalLoads) => {
+                    PhysicsSet::Integrate
+                }
                 _ => PhysicsSet::Forces,
             };
-            add_stage(&mut schedule, stage, set, previous);
-            previous = Some(stage);
+            add_system(&mut schedule, system, set, previous);
+            previous = Some(system);
         }
         schedule
     }
 }
 
-/// A marker set per stage, used to chain the stages in plan order.
+/// A marker set per system, used to chain the systems in plan order.
 #[derive(SystemSet, Debug, Clone, Copy, PartialEq, Eq, Hash)]
-struct StageSet(Stage);
+struct SystemOrder(PhysicsSystem);
 
-fn add_stage(schedule: &mut Schedule, stage: Stage, set: PhysicsSet, after: Option<Stage>) {
-    let config = match stage {
-        Stage::HoldGameLoads => hold_game_loads.into_configs(),
-        Stage::NextStage => next_stage.into_configs(),
-        Stage::AuditEnergyStart => audit_energy_start.into_configs(),
-        Stage::AuditExternalLoads => audit_external_loads.into_configs(),
-        Stage::AuditEnergy => audit_energy.into_configs(),
-        Stage::DampSpringsStart => damp_springs_start.into_configs(),
-        Stage::DampSpringsEnd => damp_springs_end.into_configs(),
-        Stage::BeginStage => begin_stage.into_configs(),
-        Stage::Gravity => apply_gravity.into_configs(),
-        Stage::ConstantForces => apply_constant_forces.into_configs(),
-        Stage::ConstantTorques => apply_constant_torques.into_configs(),
-        Stage::Springs => apply_springs.into_configs(),
-        Stage::SolveImplicitSprings => solve_implicit_springs.into_configs(),
-        Stage::IntegrateWithForces => integrate_with_forces.into_configs(),
-        Stage::IntegrateWithoutForces => integrate_without_forces.into_configs(),
-        Stage::DiscardFixedBodyForces => discard_fixed_body_forces.into_configs(),
+fn add_system(
+    schedule: &mut Schedule,
+    system: PhysicsSystem,
+    set: PhysicsSet,
+    after: Option<PhysicsSystem>,
+) {
+    let config = match system {
+        PhysicsSystem::HoldGameLoads => hold_game_loads.into_configs(),
+        PhysicsSystem::NextStage => next_stage.into_configs(),
+        PhysicsSystem::AuditEnergyStart => audit_energy_start.into_configs(),
+        PhysicsSystem::AuditExternalLoads => audit_external_loads.into_configs(),
+        PhysicsSystem::AuditEnergy => audit_energy.into_configs(),
+        PhysicsSystem::DampSpringsStart => damp_springs_start.into_configs(),
+        PhysicsSystem::DampSpringsEnd => damp_springs_end.into_configs(),
+        PhysicsSystem::BeginStage => begin_stage.into_configs(),
+        PhysicsSystem::Gravity => apply_gravity.into_configs(),
+        PhysicsSystem::ConstantForces => apply_constant_forces.into_configs(),
+        PhysicsSystem::ConstantTorques => apply_constant_torques.into_configs(),
+        PhysicsSystem::Springs => apply_springs.into_configs(),
+        PhysicsSystem::SolveImplicitSprings => solve_implicit_springs.into_configs(),
+        PhysicsSystem::IntegrateWithForces => integrate_with_forces.into_configs(),
+        PhysicsSystem::IntegrateWithoutForces => integrate_without_forces.into_configs(),
+        PhysicsSystem::DiscardFixedBodyForces => discard_fixed_body_forces.into_configs(),
     };
-    let config = config.in_set(set).in_set(StageSet(stage));
+    let config = config.in_set(set).in_set(SystemOrder(system));
     match after {
-        Some(prev) => schedule.add_systems(config.after(StageSet(prev))),
+        Some(prev) => schedule.add_systems(config.after(SystemOrder(prev))),
         None => schedule.add_systems(config),
     };
 }
 
 impl fmt::Display for PhysicsPlan {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let names: Vec<&str> = self.stages.iter().map(|s| s.name()).collect();
+        let names: Vec<&str> = self.systems.iter().map(|s| s.name()).collect();
         write!(f, "{}", names.join(" → "))?;
         if self.runs_per_step > 1 {
             write!(f, " (× {} stages per step)", self.runs_per_step)?;
@@ -444,9 +463,9 @@ mod tests {
             torque: Vec3::Y,
         });
         let plan = PhysicsPlan::for_world(&mut world);
-        assert!(plan.stages().len() >= 8, "{plan}");
+        assert!(plan.systems().len() >= 8, "{plan}");
         let mut schedule = plan.build_schedule();
         schedule.initialize(&mut world).unwrap();
-        assert_eq!(schedule.systems_len(), plan.stages().len(), "{plan}");
+        assert_eq!(schedule.systems_len(), plan.systems().len(), "{plan}");
     }
 }

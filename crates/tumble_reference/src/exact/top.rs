@@ -61,8 +61,9 @@
 //! `L`): rates and orientation agree to ≲ 1e-13 over 10 s away from the separatrix, ≲ 5e-12 next
 //! to it (`Ω₀ = (0.01, 10, 0.01)`, `I = (1, 2, 3)`, `1 − m ≈ 2e-6`), ≈ 1e-10 at 120 s there, and on the
 //! separatrix itself ≲ 1e-13 over 3 s. `E` and the world `L` evaluated from the returned `Ω(t)`,
-//! `q(t)` are constant to 1e-12 relative. Cost: `new` ≈ 0.1 ms (one period of quadrature), a
-//! rate ≈ 0.2 µs, an orientation at any horizon ≤ one period of quadrature (≈ 20–80 µs).
+//! `q(t)` are constant to 1e-12 relative. Cost: `new` integrates one period by quadrature; a
+//! rate is a few elliptic functions; an orientation at any horizon costs at most one period of
+//! quadrature.
 //! Horizons are limited only by `τ = λt + τ₀` and `φ` being f64: the orientation error grows
 //! like `ε·φ(t)` (≈ 1e-11 rad at `t = 1e4 s`, `|Ω| = 10 rad/s`).
 
