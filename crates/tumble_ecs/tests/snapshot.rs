@@ -4,8 +4,9 @@ use bevy_ecs::prelude::*;
 use tumble_core::math::{Quat, Real, Vec3, Widen};
 
 use tumble_core::{Integrator, Mass, MassProperties};
+use tumble_ecs::components::HeldLoad;
 use tumble_ecs::prelude::*;
-use tumble_ecs::state::{Snapshot, SnapshotError};
+use tumble_ecs::state::{BodyRecord, RollbackSnapshot, Snapshot, SnapshotError};
 
 /// A world with every kind of thing a snapshot must carry.
 fn scene(integrator: Integrator) -> World {
@@ -141,4 +142,135 @@ fn snapshots_round_trip_and_bad_ones_are_refused() {
     orphan.bodies.remove(1);
     let err = orphan.restore(&mut World::new()).unwrap_err();
     assert!(matches!(err, SnapshotError::UnknownBody(_)), "{err}");
+}
+
+/// A world of one body with every part a body record holds, none at its default.
+fn full_body() -> (World, Entity) {
+    let mut world = World::new();
+    world.insert_resource(PhysicsSettings::new(1.0 / 60.0, Integrator::Splitting).unwrap());
+    let mass = MassProperties::new(Mass::new(2.5).unwrap(), Vec3::new(0.2, 0.3, 0.4))
+        .unwrap()
+        .with_center_of_mass(Vec3::new(0.01, 0.0, -0.02))
+        .unwrap()
+        .with_principal_frame(Quat::from_rotation_x(0.3))
+        .unwrap();
+    let body = world
+        .spawn((
+            RigidBody,
+            MassProps(mass),
+            Pose::from_translation(Vec3::new(1.0, 2.0, 3.0)),
+            Velocity::new(Vec3::new(0.1, 0.2, 0.3), Vec3::new(-1.0, 0.5, 0.25)),
+            ForceAccumulator {
+                force: Vec3::new(1.0, 0.0, -1.0),
+                torque: Vec3::new(0.0, 0.5, 0.0),
+            },
+            GravityScale(0.5),
+            Damping {
+                linear: 0.1,
+                angular: 0.2,
+            },
+        ))
+        .id();
+    *world.get_mut::<HeldLoad>(body).unwrap() = HeldLoad {
+        force: Vec3::new(0.0, 3.0, 0.0),
+        torque: Vec3::new(0.0, 0.0, 0.7),
+    };
+    (world, body)
+}
+
+/// Rollback, the checksum and serde snapshots share one body record: a change to any part of
+/// a body changes the checksum, a rollback puts it back, and a snapshot carries it.
+#[test]
+fn every_part_of_a_body_is_checksummed_rolled_back_and_saved() {
+    type Change = fn(&mut World, Entity);
+    let changes: [(&str, Change); 16] = [
+        ("position", |w, b| {
+            w.get_mut::<Pose>(b).unwrap().translation.x += 1.0
+        }),
+        ("rotation", |w, b| {
+            w.get_mut::<Pose>(b).unwrap().rotation = Quat::from_rotation_y(0.5)
+        }),
+        ("linear velocity", |w, b| {
+            w.get_mut::<Velocity>(b).unwrap().linear.y += 1.0
+        }),
+        ("angular velocity", |w, b| {
+            w.get_mut::<Velocity>(b).unwrap().angular.z += 1.0
+        }),
+        ("mass", |w, b| {
+            let mass = MassProperties::new(Mass::new(3.0).unwrap(), Vec3::ONE).unwrap();
+            w.entity_mut(b).insert(MassProps(mass));
+        }),
+        ("force", |w, b| {
+            w.get_mut::<ForceAccumulator>(b).unwrap().force.x += 1.0
+        }),
+        ("torque", |w, b| {
+            w.get_mut::<ForceAccumulator>(b).unwrap().torque.x += 1.0
+        }),
+        ("held force", |w, b| {
+            w.get_mut::<HeldLoad>(b).unwrap().force.z += 1.0
+        }),
+        ("held torque", |w, b| {
+            w.get_mut::<HeldLoad>(b).unwrap().torque.y += 1.0
+        }),
+        ("gravity scale", |w, b| {
+            w.get_mut::<GravityScale>(b).unwrap().0 = 2.0
+        }),
+        ("no gravity scale", |w, b| {
+            w.entity_mut(b).remove::<GravityScale>();
+        }),
+        ("linear damping", |w, b| {
+            w.get_mut::<Damping>(b).unwrap().linear = 0.3
+        }),
+        ("angular damping", |w, b| {
+            w.get_mut::<Damping>(b).unwrap().angular = 0.3
+        }),
+        ("static", |w, b| {
+            w.entity_mut(b).insert(Static);
+        }),
+        ("kinematic", |w, b| {
+            w.entity_mut(b).insert(Kinematic);
+        }),
+        ("quarantined", |w, b| {
+            let error = BodyError {
+                entity: b,
+                kind: BodyErrorKind::Restored("test".to_owned()),
+            };
+            w.entity_mut(b).insert(Rejected(error));
+        }),
+    ];
+    for (part, change) in changes {
+        let (mut world, body) = full_body();
+        let before = world_checksum(&world);
+        let saved = RollbackSnapshot::capture(&mut world);
+        change(&mut world, body);
+        let changed = world_checksum(&world);
+        assert_ne!(changed, before, "{part}: the checksum must see it");
+        let record = RollbackSnapshot::capture(&mut world).bodies()[0];
+        assert_ne!(record, saved.bodies()[0], "{part}: the record must hold it");
+
+        // A serde snapshot carries the changed record whole (the entity is the new world's).
+        let text = serde_json::to_string(&Snapshot::capture(&mut world)).unwrap();
+        let mut elsewhere = World::new();
+        let map = serde_json::from_str::<Snapshot>(&text)
+            .unwrap()
+            .restore(&mut elsewhere)
+            .unwrap();
+        let loaded = RollbackSnapshot::capture(&mut elsewhere).bodies()[0];
+        assert_eq!(loaded.entity, map[&body]);
+        assert_eq!(
+            BodyRecord {
+                entity: body,
+                ..loaded
+            },
+            record,
+            "{part}: the snapshot must carry it"
+        );
+
+        saved.restore(&mut world).unwrap();
+        assert_eq!(
+            world_checksum(&world),
+            before,
+            "{part}: the rollback must undo it"
+        );
+    }
 }

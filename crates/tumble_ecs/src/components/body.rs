@@ -306,6 +306,7 @@ impl ForceAccumulator {
 /// only then; it comes with every accumulator (a required component), so holding the load never
 /// changes a body's archetype. A step of one stage never reads or writes it.
 #[derive(Component, Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct HeldLoad {
     /// Held force (N), world frame.
     pub force: Vec3,

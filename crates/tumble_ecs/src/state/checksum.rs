@@ -13,6 +13,8 @@ use crate::components::{
 };
 use crate::integrate::StageCursor;
 
+use super::record::{BodyRecord, Parts};
+
 /// The checksum of a world's step-affecting state (module docs): print it as 32 hex digits
 /// (`{}`), or take the number.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -127,59 +129,74 @@ fn bodies(world: &World, out: &mut Stream) {
         world,
         |(e, t, v, m)| {
             let entity = world.entity(e);
-            (
+            let record = BodyRecord::new(
                 e,
+                (t, v, m),
                 (
-                    *t,
-                    *v,
-                    *m,
-                    entity.get::<ForceAccumulator>().copied(),
-                    entity.get::<HeldLoad>().copied(),
-                    entity.get::<GravityScale>().copied(),
-                    entity.get::<Damping>().copied(),
-                    (
-                        entity.contains::<Static>(),
-                        entity.contains::<Kinematic>(),
-                        entity.contains::<Rejected>(),
-                    ),
+                    entity.get::<ForceAccumulator>(),
+                    entity.get::<HeldLoad>(),
+                    entity.get::<GravityScale>(),
+                    entity.get::<Damping>(),
                 ),
-            )
+                (
+                    entity.contains::<Static>(),
+                    entity.contains::<Kinematic>(),
+                    entity.contains::<Rejected>(),
+                ),
+            );
+            (e, record)
         },
     );
     out.bytes(&(rows.len() as u64).to_le_bytes());
-    for (e, (t, v, m, acc, held, scale, damping, (fixed, kinematic, rejected))) in rows {
-        out.entity(e);
-        out.vec3(t.translation);
-        out.quat(t.rotation);
-        out.vec3(v.linear);
-        out.vec3(v.angular);
-        out.real(m.mass());
-        out.vec3(m.principal_inertia());
-        out.quat(m.principal_frame());
-        out.vec3(m.local_center_of_mass());
-        out.flag(acc.is_some());
-        if let Some(a) = acc {
-            out.vec3(a.force);
-            out.vec3(a.torque);
-        }
-        out.flag(held.is_some());
-        if let Some(h) = held {
-            out.vec3(h.force);
-            out.vec3(h.torque);
-        }
-        out.flag(scale.is_some());
-        if let Some(s) = scale {
-            out.real(s.0);
-        }
-        out.flag(damping.is_some());
-        if let Some(d) = damping {
-            out.real(d.linear);
-            out.real(d.angular);
-        }
-        out.flag(fixed);
-        out.flag(kinematic);
-        out.flag(rejected);
+    for (_, record) in rows {
+        body(out, &record);
     }
+}
+
+/// One body's bytes: every field of its record, optional parts behind a presence flag.
+fn body(out: &mut Stream, record: &BodyRecord) {
+    let BodyRecord {
+        entity,
+        transform,
+        velocity,
+        mass,
+        accumulator,
+        held,
+        gravity_scale,
+        damping,
+        parts,
+    } = *record;
+    out.entity(entity);
+    out.vec3(transform.translation);
+    out.quat(transform.rotation);
+    out.vec3(velocity.linear);
+    out.vec3(velocity.angular);
+    out.real(mass.mass());
+    out.vec3(mass.principal_inertia());
+    out.quat(mass.principal_frame());
+    out.vec3(mass.local_center_of_mass());
+    out.flag(parts.contains(Parts::ACCUMULATOR));
+    if parts.contains(Parts::ACCUMULATOR) {
+        out.vec3(accumulator.force);
+        out.vec3(accumulator.torque);
+    }
+    out.flag(parts.contains(Parts::HELD_LOAD));
+    if parts.contains(Parts::HELD_LOAD) {
+        out.vec3(held.force);
+        out.vec3(held.torque);
+    }
+    out.flag(parts.contains(Parts::GRAVITY_SCALE));
+    if parts.contains(Parts::GRAVITY_SCALE) {
+        out.real(gravity_scale);
+    }
+    out.flag(parts.contains(Parts::DAMPING));
+    if parts.contains(Parts::DAMPING) {
+        out.real(damping.linear);
+        out.real(damping.angular);
+    }
+    out.flag(parts.contains(Parts::STATIC));
+    out.flag(parts.contains(Parts::KINEMATIC));
+    out.flag(parts.contains(Parts::REJECTED));
 }
 
 fn generators(world: &World, out: &mut Stream) {

@@ -80,11 +80,13 @@
 //! one ulp off for `f64`).
 
 mod checksum;
+mod record;
 mod rollback;
 #[cfg(feature = "serde")]
 mod snapshot;
 
 pub use checksum::{WorldChecksum, world_checksum};
-pub use rollback::{BodyRecord, Parts, RollbackError, RollbackSnapshot};
+pub use record::{BodyRecord, Parts};
+pub use rollback::{RollbackError, RollbackSnapshot};
 #[cfg(feature = "serde")]
 pub use snapshot::{BodyKind, BodySnapshot, SNAPSHOT_VERSION, Snapshot, SnapshotError};

@@ -3,7 +3,6 @@
 use bevy_ecs::component::Mutable;
 use bevy_ecs::prelude::*;
 use thiserror::Error;
-use tumble_core::math::Real;
 
 use crate::audit::{EnergyAudit, EnergyLedger, LedgerState};
 use crate::components::Rejected;
@@ -15,58 +14,7 @@ use crate::components::{
 use crate::integrate::HalfDrifted;
 use crate::integrate::StageCursor;
 
-/// Which optional parts a body had when it was captured (one bit each).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub struct Parts(u8);
-
-impl Parts {
-    /// A [`ForceAccumulator`].
-    pub const ACCUMULATOR: Self = Self(1);
-    /// A [`HeldLoad`] (comes with every accumulator).
-    pub const HELD_LOAD: Self = Self(1 << 1);
-    /// A [`GravityScale`].
-    pub const GRAVITY_SCALE: Self = Self(1 << 2);
-    /// [`Damping`].
-    pub const DAMPING: Self = Self(1 << 3);
-    /// The [`Static`] marker.
-    pub const STATIC: Self = Self(1 << 4);
-    /// The [`Kinematic`] marker.
-    pub const KINEMATIC: Self = Self(1 << 5);
-    /// Quarantined ([`Rejected`]).
-    pub const REJECTED: Self = Self(1 << 6);
-
-    /// Whether every bit of `part` is set.
-    pub fn contains(self, part: Self) -> bool {
-        self.0 & part.0 == part.0
-    }
-
-    fn with(self, part: Self, present: bool) -> Self {
-        if present { Self(self.0 | part.0) } else { self }
-    }
-}
-
-/// One rigid body as a rollback snapshot keeps it. Absent optional parts hold their defaults.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct BodyRecord {
-    /// The body (the same entity is written back).
-    pub entity: Entity,
-    /// Pose.
-    pub transform: Pose,
-    /// Velocity.
-    pub velocity: Velocity,
-    /// Mass properties.
-    pub mass: MassProps,
-    /// Pending loads.
-    pub accumulator: ForceAccumulator,
-    /// Loads held over a step of several stages.
-    pub held: HeldLoad,
-    /// Gravity scale.
-    pub gravity_scale: Real,
-    /// Damping.
-    pub damping: Damping,
-    /// Which optional parts the body had.
-    pub parts: Parts,
-}
+use super::record::{BodyRecord, Parts};
 
 /// What the next step depends on (see the module docs). Capture with
 /// [`capture`](Self::capture) (or [`capture_into`](Self::capture_into) to reuse the buffers),
@@ -229,25 +177,12 @@ impl RollbackSnapshot {
         for (entity, t, v, m, acc, held, scale, damping, fixed, kinematic, rejected) in
             query.iter(world)
         {
-            let parts = Parts::default()
-                .with(Parts::ACCUMULATOR, acc.is_some())
-                .with(Parts::HELD_LOAD, held.is_some())
-                .with(Parts::GRAVITY_SCALE, scale.is_some())
-                .with(Parts::DAMPING, damping.is_some())
-                .with(Parts::STATIC, fixed)
-                .with(Parts::KINEMATIC, kinematic)
-                .with(Parts::REJECTED, rejected);
-            self.bodies.push(BodyRecord {
+            self.bodies.push(BodyRecord::new(
                 entity,
-                transform: *t,
-                velocity: *v,
-                mass: *m,
-                accumulator: acc.copied().unwrap_or_default(),
-                held: held.copied().unwrap_or_default(),
-                gravity_scale: scale.copied().unwrap_or_default().0,
-                damping: damping.copied().unwrap_or_default(),
-                parts,
-            });
+                (t, v, m),
+                (acc, held, scale, damping),
+                (fixed, kinematic, rejected),
+            ));
         }
         for record in &self.bodies {
             if record.parts.contains(Parts::REJECTED)
@@ -421,21 +356,32 @@ fn write_body(
     record: &BodyRecord,
     (_, mut t, mut v, m, acc, held, scale, damping, fixed, kinematic, rejected): BodyItem<'_>,
 ) -> bool {
-    let parts = record.parts;
-    *t = record.transform;
-    *v = record.velocity;
-    let mut structural = *m != record.mass
+    // Whole, so that a part added to the record cannot be left out here.
+    let BodyRecord {
+        entity: _,
+        transform,
+        velocity,
+        mass,
+        accumulator,
+        held: held_load,
+        gravity_scale,
+        damping: body_damping,
+        parts,
+    } = *record;
+    *t = transform;
+    *v = velocity;
+    let mut structural = *m != mass
         || fixed != parts.contains(Parts::STATIC)
         || kinematic != parts.contains(Parts::KINEMATIC)
         || rejected != parts.contains(Parts::REJECTED);
-    structural |= write_part(acc, parts.contains(Parts::ACCUMULATOR), record.accumulator);
-    structural |= write_part(held, parts.contains(Parts::HELD_LOAD), record.held);
+    structural |= write_part(acc, parts.contains(Parts::ACCUMULATOR), accumulator);
+    structural |= write_part(held, parts.contains(Parts::HELD_LOAD), held_load);
     structural |= write_part(
         scale,
         parts.contains(Parts::GRAVITY_SCALE),
-        GravityScale(record.gravity_scale),
+        GravityScale(gravity_scale),
     );
-    structural |= write_part(damping, parts.contains(Parts::DAMPING), record.damping);
+    structural |= write_part(damping, parts.contains(Parts::DAMPING), body_damping);
     structural
 }
 

@@ -10,10 +10,12 @@ use crate::audit::{EnergyLedger, SavedAccount};
 use crate::components::{BodyError, BodyErrorKind, PhysicsErrors, Rejected};
 use crate::components::{ConstantForce, ConstantLocalForce, ConstantTorque, Spring, SpringEnd};
 use crate::components::{
-    Damping, ForceAccumulator, Gravity, GravityScale, Kinematic, MassProps, PhysicsSettings, Pose,
-    RigidBody, Static, Velocity,
+    Damping, ForceAccumulator, Gravity, GravityScale, HeldLoad, Kinematic, MassProps,
+    PhysicsSettings, Pose, RigidBody, Static, Velocity,
 };
 use crate::integrate::HalfDrifted;
+
+use super::record::{BodyRecord, Parts};
 use crate::parallel::Parallelism;
 
 /// How tumble treats a body.
@@ -42,12 +44,55 @@ pub struct BodySnapshot {
     pub mass: MassProps,
     /// Pending forces, if the body has an accumulator.
     pub accumulator: Option<ForceAccumulator>,
+    /// The load held over a step of several stages, if the body has an accumulator (absent in
+    /// snapshots saved before it was saved; between steps it only matters to a snapshot taken
+    /// mid-step).
+    #[serde(default)]
+    pub held: Option<HeldLoad>,
     /// Gravity scale, if set.
     pub gravity_scale: Option<GravityScale>,
     /// Damping, if set.
     pub damping: Option<Damping>,
     /// Why the body is quarantined, if it is.
     pub rejected: Option<String>,
+}
+
+impl BodySnapshot {
+    /// The saved form of `record`, with the quarantine's reason `rejected`.
+    fn of(record: &BodyRecord, rejected: Option<&Rejected>) -> Self {
+        let BodyRecord {
+            entity,
+            transform,
+            velocity,
+            mass,
+            accumulator,
+            held,
+            gravity_scale,
+            damping,
+            parts,
+        } = *record;
+        let kind = if parts.contains(Parts::STATIC) {
+            BodyKind::Static
+        } else if parts.contains(Parts::KINEMATIC) {
+            BodyKind::Kinematic
+        } else {
+            BodyKind::Dynamic
+        };
+        Self {
+            entity,
+            kind,
+            transform,
+            velocity,
+            mass,
+            accumulator: record.part(Parts::ACCUMULATOR, accumulator),
+            held: record.part(Parts::HELD_LOAD, held),
+            gravity_scale: record.part(Parts::GRAVITY_SCALE, GravityScale(gravity_scale)),
+            damping: record.part(Parts::DAMPING, damping),
+            rejected: rejected
+                .filter(|_| parts.contains(Parts::REJECTED))
+                .map(|r| r.0.kind.to_string()),
+        }
+    }
 }
 
 /// Every physics component and resource of a world.
@@ -107,35 +152,23 @@ impl Snapshot {
         let mut bodies = Vec::new();
         let mut query = world.query_filtered::<(
             Entity,
-            &Pose,
-            &Velocity,
-            &MassProps,
-            Option<&ForceAccumulator>,
-            Option<&GravityScale>,
-            Option<&Damping>,
-            Has<Static>,
-            Has<Kinematic>,
-            Option<&Rejected>,
+            (&Pose, &Velocity, &MassProps),
+            (
+                Option<&ForceAccumulator>,
+                Option<&HeldLoad>,
+                Option<&GravityScale>,
+                Option<&Damping>,
+            ),
+            (Has<Static>, Has<Kinematic>, Option<&Rejected>),
         ), With<RigidBody>>();
-        for (entity, t, v, m, acc, scale, damping, is_static, kinematic, rejected) in
-            query.iter(world)
-        {
-            let kind = match (is_static, kinematic) {
-                (true, _) => BodyKind::Static,
-                (false, true) => BodyKind::Kinematic,
-                _ => BodyKind::Dynamic,
-            };
-            bodies.push(BodySnapshot {
+        for (entity, required, optional, (fixed, kinematic, rejected)) in query.iter(world) {
+            let record = BodyRecord::new(
                 entity,
-                kind,
-                transform: *t,
-                velocity: *v,
-                mass: *m,
-                accumulator: acc.copied(),
-                gravity_scale: scale.copied(),
-                damping: damping.copied(),
-                rejected: rejected.map(|r| r.0.kind.to_string()),
-            });
+                required,
+                optional,
+                (fixed, kinematic, rejected.is_some()),
+            );
+            bodies.push(BodySnapshot::of(&record, rejected));
         }
         Self {
             version: SNAPSHOT_VERSION,
@@ -309,6 +342,9 @@ fn spawn_body(world: &mut World, b: &BodySnapshot) -> Entity {
     let mut e = world.spawn((RigidBody, b.mass, b.transform, b.velocity));
     if let Some(acc) = b.accumulator {
         e.insert(acc);
+    }
+    if let Some(held) = b.held {
+        e.insert(held);
     }
     if let Some(s) = b.gravity_scale {
         e.insert(s);
