@@ -2,6 +2,7 @@
 //!
 //! Every error is one line on stderr (`error: …`) and a documented exit code ([`exit`]).
 
+mod body_patterns;
 mod cli;
 mod compare;
 mod exit;
@@ -9,6 +10,8 @@ mod generate;
 mod interrupt;
 mod logging;
 mod memory;
+mod overrides;
+mod plan;
 mod run;
 mod stdout;
 mod summary;

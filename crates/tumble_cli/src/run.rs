@@ -4,22 +4,21 @@ use std::io::{IsTerminal, Write};
 use std::num::NonZeroU64;
 use std::ops::ControlFlow;
 use std::path::Path;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use bevy_ecs::prelude::*;
+use glam::DVec3;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressFinish, ProgressStyle};
 use tumble_core::math::{Real, to_f64};
 use tumble_ecs::prelude::*;
 use tumble_scene::output::{OutputError, OutputFile};
 use tumble_scene::text::{path_for_terminal, terminal_safe};
-use tumble_scene::{
-    BuiltScene, MAX_STEPS, MAX_SUBSTEPS, Recording, SceneError, TrajectoryError, csv_text_cell,
-};
+use tumble_scene::{BuiltScene, Recording, TrajectoryError, TrajectoryStats, csv_text_cell};
 
 use crate::cli::RunArgs;
 use crate::exit::{self, Failure};
 use crate::interrupt;
-use globset::{GlobBuilder, GlobSet, GlobSetBuilder};
+use crate::overrides::Overrides;
 
 use crate::summary::{self, Names, quarantine_line, warning_line};
 
@@ -35,188 +34,28 @@ const PROGRESS_EVERY: u64 = 1024;
 /// a full disk while writing is still an error that removes the temporary file.
 const VALUE_BYTES: u64 = if size_of::<Real>() == 4 { 16 } else { 25 };
 
-/// Names the command-line flag behind an error in an overridden world setting, so the message
-/// does not point at a line of a file the user never wrote.
-fn override_error(
-    e: SceneError,
-    dt: Option<f64>,
-    steps: Option<u64>,
-    integrator: bool,
-    springs: bool,
-    free_flow: bool,
-    substeps: bool,
-) -> Failure {
-    let flag = match e.field.as_str() {
-        "world.dt" if dt.is_some() => "--dt",
-        "world.steps" if steps.is_some() => "--steps",
-        "world.integrator" if integrator => "--integrator",
-        "world.springs" if springs => "--springs",
-        "world.free_flow" if free_flow => "--free-flow",
-        "world.substeps" if substeps => "--substeps",
-        _ => return e.into(),
-    };
-    Failure::new(exit::ERROR, format!("{flag}: {}", e.message))
-}
-
-/// The stages of a step of several (substeps, a composition), as `--plan` prints them: each
-/// stage's span as a multiple of `Δt`, and which substep it belongs to.
-fn stages_line(world: &World) -> Option<String> {
-    let settings = world.get_resource::<PhysicsSettings>()?;
-    let stages = settings.stages();
-    if stages.count() == 1 {
-        return None;
-    }
-    let dt = settings.dt();
-    let spans: Vec<String> = stages
-        .spans(dt)
-        .map(|s| format!("{:.6}", to_f64(s.h) / to_f64(dt)))
-        .collect();
-    Some(format!(
-        "stages per step: {} ({} substep(s) × {} of `{}`), h/Δt = {}",
-        stages.count(),
-        settings.substeps,
-        settings.integrator.composition().len(),
-        settings.integrator,
-        spans.join(", ")
-    ))
-}
-
-/// Which method steps which bodies, as `--plan` prints it: the integrator, and the bodies the
-/// planner gives another step now (the exact free flow of a split method under
-/// `free_flow = auto`, the implicit spring solve for stiff spring groups), with the first of
-/// each by name.
-fn methods_line(world: &mut World, names: &Names) -> String {
-    let Some(settings) = world.get_resource::<PhysicsSettings>().copied() else {
-        return String::new();
-    };
-    let mut out = format!(
-        "method: `{}` (free flow `{}`)",
-        settings.integrator, settings.free_flow
-    );
-    for warning in tumble_ecs::stability::check_stability(world) {
-        match warning {
-            StabilityWarning::ExactFreeFlow { body, bodies, .. } => out.push_str(&format!(
-                "; {bodies} {} the exact free flow (`{}`) now, first {}",
-                if bodies == 1 {
-                    "body takes"
-                } else {
-                    "bodies take"
-                },
-                settings
-                    .integrator
-                    .exact_counterpart()
-                    .map_or("exact", |m| m.name()),
-                names.of(body)
-            )),
-            StabilityWarning::ImplicitGroups { body, bodies, .. } => out.push_str(&format!(
-                "; {bodies} {} in stiff spring groups, stepped by the implicit spring solve, \
-                 first {}",
-                if bodies == 1 { "body" } else { "bodies" },
-                names.of(body)
-            )),
-            _ => {}
-        }
-    }
-    out.push('\n');
-    out
-}
-
-/// The count given to `flag`, if any, checked to be in `1..=max`: an error `flag: expected 1
-/// to {max} {unit}, got {n}` otherwise.
-fn count_up_to(
-    flag: &str,
-    given: Option<i64>,
-    max: u64,
-    unit: &str,
-) -> Result<Option<u64>, Failure> {
-    match given {
-        Some(n) if !(1..=max as i64).contains(&n) => Err(Failure::new(
-            exit::ERROR,
-            format!("{flag}: expected 1 to {max} {unit}, got {n}"),
-        )),
-        other => Ok(other.map(|n| n as u64)),
-    }
-}
-
 /// `tumble run`.
-pub(crate) fn run(args: RunArgs) -> Result<(), Failure> {
-    let every = u64::try_from(args.every)
-        .ok()
-        .and_then(NonZeroU64::new)
-        .ok_or_else(|| {
-            Failure::new(
-                exit::ERROR,
-                format!("--every: expected a value >= 1, got {}", args.every),
-            )
-        })?;
-    let steps = count_up_to("--steps", args.steps, MAX_STEPS, "steps")?;
-    let integrator = args
-        .integrator
-        .map(|v| crate::utf8("--integrator", v))
-        .transpose()?;
-    let springs = args
-        .springs
-        .map(|v| crate::utf8("--springs", v))
-        .transpose()?;
-    let free_flow = args
-        .free_flow
-        .map(|v| crate::utf8("--free-flow", v))
-        .transpose()?;
-    let substeps = count_up_to("--substeps", args.substeps, MAX_SUBSTEPS.into(), "substeps")?;
+pub(crate) fn run(mut args: RunArgs) -> Result<(), Failure> {
+    let every = every(args.every)?;
+    let overrides = Overrides::of(&mut args)?;
     let patterns = args
         .bodies
         .map(|v| crate::utf8("--bodies", v))
         .transpose()?
-        .map(|list| body_patterns(&list))
+        .map(|list| crate::body_patterns::body_patterns(&list))
         .transpose()?;
     let loaded = crate::load(&args.scene)?;
-    let mut scene = loaded.scene;
-    if steps.is_some()
-        || args.dt.is_some()
-        || integrator.is_some()
-        || springs.is_some()
-        || free_flow.is_some()
-        || substeps.is_some()
-    {
-        // Overrides are applied to the world settings, then validated like the file's.
-        let mut world = scene.file().world.clone();
-        world.steps = steps.unwrap_or(world.steps);
-        world.dt = args.dt.unwrap_or(world.dt);
-        let overridden = integrator.is_some();
-        world.integrator = integrator.or(world.integrator);
-        let springs_overridden = springs.is_some();
-        world.springs = springs.or(world.springs);
-        let free_flow_overridden = free_flow.is_some();
-        world.free_flow = free_flow.or(world.free_flow);
-        world.substeps = substeps.or(world.substeps);
-        scene = scene.with_world(world).map_err(|e| {
-            override_error(
-                e,
-                args.dt,
-                steps,
-                overridden,
-                springs_overridden,
-                free_flow_overridden,
-                substeps.is_some(),
-            )
-        })?;
-    }
+    let scene = overrides.apply(loaded.scene)?;
     let steps = scene.steps();
     let scene_name = terminal_safe(scene.name()).into_owned();
     let mut built = scene.into_built();
     if args.plan {
-        let mut out = format!("{}\n", PhysicsPlan::for_world(&mut built.world));
-        if let Some(line) = stages_line(&built.world) {
-            out.push_str(&format!("{line}\n"));
-        }
-        let names = Names::new(&mut built.world, &built.bodies);
-        out.push_str(&methods_line(&mut built.world, &names));
-        return crate::stdout::print(&out);
+        return crate::plan::print_plan(&mut built);
     }
     let record = Recording {
         every,
         bodies: patterns
-            .map(|p| select_bodies(&p, &built.bodies))
+            .map(|p| crate::body_patterns::select_bodies(&p, &built.bodies))
             .transpose()?,
     };
     let to_stdout = args.out.as_deref().is_some_and(crate::is_stdout);
@@ -248,7 +87,6 @@ pub(crate) fn run(args: RunArgs) -> Result<(), Failure> {
     if args.checksum {
         checksums.push((0, world_checksum(&built.world)));
     }
-    let mut written = None;
     let mut on_step = |step: u64, world: &World| {
         if step.is_multiple_of(PROGRESS_EVERY) {
             bar.set_position(step);
@@ -263,113 +101,63 @@ pub(crate) fn run(args: RunArgs) -> Result<(), Failure> {
             ControlFlow::Continue(())
         }
     };
-    let interrupted = |step: u64, path: Option<&Path>| {
-        let unchanged = match path {
-            Some(path) => format!("; {} was not written", path_for_terminal(path)),
-            None => String::new(),
-        };
-        Failure::new(
-            exit::INTERRUPTED,
-            format!("interrupted after step {step}{unchanged}"),
-        )
+    let destination = match (args.out.as_deref(), out_file.take()) {
+        (Some(path), Some(file)) => Destination::File(path, file),
+        (Some(_), None) => Destination::Stdout,
+        (None, _) => Destination::Nowhere,
     };
-    match args.out.as_deref() {
-        Some(_) if to_stdout => {
-            let stdout = std::io::stdout().lock();
-            written = Some(
-                tumble_scene::write_trajectory(&mut built, steps, &record, stdout, &mut on_step)
-                    .map_err(|e| match e {
-                        TrajectoryError::Stopped { step } => interrupted(step, None),
-                        e => Failure::new(exit::ERROR, format!("standard output: {e}")),
-                    })?,
-            );
-        }
-        Some(path) => {
-            let mut file = out_file
-                .take()
-                .expect("the output file is created above for every path but stdout");
-            written = Some(
-                tumble_scene::write_trajectory(&mut built, steps, &record, &mut file, &mut on_step)
-                    .map_err(|e| match e {
-                        TrajectoryError::Stopped { step } => interrupted(step, Some(path)),
-                        TrajectoryError::Io(e) => OutputError::io(path, e).into(),
-                        e => Failure::from(e),
-                    })?,
-            );
-            file.commit()?;
-        }
-        None => {
-            for step in 1..=steps {
-                built.step();
-                if on_step(step, &built.world).is_break() {
-                    return Err(interrupted(step, None));
-                }
-            }
-        }
-    }
+    let written = step_and_write(&mut built, steps, &record, destination, &mut on_step)?;
     bar.finish_and_clear();
     let wall = start.elapsed();
-    let after = summary::totals(&mut built.world);
-    let body_steps = (steps as f64) * built.bodies.len().max(1) as f64;
-    let (dt, integrator) = {
-        let settings = built.world.resource::<PhysicsSettings>();
-        let integrator = match settings.substeps.get() {
-            1 => settings.integrator.to_string(),
-            n => format!("{}, {n} substeps", settings.integrator),
-        };
-        (settings.dt(), integrator)
-    };
     let rejected = built.world.query::<&Rejected>().iter(&built.world).count();
+    if args.checksum && checksums.last().is_none_or(|&(step, _)| step != steps) {
+        checksums.push((steps, world_checksum(&built.world)));
+    }
+    let run = Summary {
+        scene_name: &scene_name,
+        steps,
+        wall,
+        before,
+        conserved: &conserved,
+        written,
+        rejected,
+        checksums: &checksums,
+    };
+    let lines = run.lines(&mut built);
+    write_summary(&lines, to_stdout)?;
+    if rejected > 0 {
+        return Err(Failure::new(
+            exit::REJECTED,
+            format!(
+                "{rejected} of {} bodies were rejected; their CSV rows stop at the step they were rejected on",
+                built.bodies.len()
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// `--every`: a step count of at least 1.
+fn every(given: i64) -> Result<NonZeroU64, Failure> {
+    u64::try_from(given)
+        .ok()
+        .and_then(NonZeroU64::new)
+        .ok_or_else(|| {
+            Failure::new(
+                exit::ERROR,
+                format!("--every: expected a value >= 1, got {given}"),
+            )
+        })
+}
+
+/// Writes the summary's `lines`: to stdout, or to stderr when the trajectory went to stdout.
+fn write_summary(lines: &[String], to_stdout: bool) -> Result<(), Failure> {
     // With the trajectory on stdout, the summary goes to stderr so that the CSV stays clean.
     let mut summary: Box<dyn Write> = if to_stdout {
         Box::new(std::io::stderr().lock())
     } else {
         Box::new(std::io::stdout().lock())
     };
-    let mut lines = vec![
-        format!("scene      {scene_name}"),
-        format!("bodies     {}", built.bodies.len()),
-        format!("steps      {steps} × {dt} s ({integrator})"),
-        format!(
-            "wall time  {:.3} s, {:.1} ns per body-step",
-            wall.as_secs_f64(),
-            wall.as_nanos() as f64 / body_steps
-        ),
-    ];
-    // Totals over every body, quarantined ones at their last valid state.
-    let energy = summary::drift(before.0, after.0, "J");
-    lines.push(match conserved.energy {
-        None => format!("energy     {energy} (kinetic + spring + gravity)"),
-        Some(why) => {
-            format!("energy     {energy} (kinetic + spring + gravity; not conserved: {why})")
-        }
-    });
-    let momentum = summary::drift(before.1.length(), after.1.length(), "kg·m²/s");
-    lines.push(match conserved.momentum {
-        None => format!("|L|        {momentum} (about the origin)"),
-        Some(why) => format!("|L|        {momentum} (about the origin; not conserved: {why})"),
-    });
-    if let Some(written) = written {
-        lines.push(format!(
-            "trajectory {} rows, {:.1} MB, written at {:.0} MB/s",
-            written.rows,
-            written.bytes as f64 / 1e6,
-            written.megabytes_per_second()
-        ));
-    }
-    if rejected > 0 {
-        lines.push(format!(
-            "rejected   {rejected} bodies (named above, on stderr)"
-        ));
-    }
-    if args.checksum {
-        if checksums.last().is_none_or(|&(step, _)| step != steps) {
-            checksums.push((steps, world_checksum(&built.world)));
-        }
-        for (step, checksum) in &checksums {
-            lines.push(format!("checksum   step {step}: {checksum}"));
-        }
-    }
     // A closed or full stdout is an error, not a success with the summary (and the checksums
     // a script reads) lost.
     let text: String = lines.iter().map(|line| format!("{line}\n")).collect();
@@ -384,16 +172,141 @@ pub(crate) fn run(args: RunArgs) -> Result<(), Failure> {
             format!("writing the summary to {place} failed: {e}"),
         ));
     }
-    if rejected > 0 {
-        return Err(Failure::new(
-            exit::REJECTED,
-            format!(
-                "{rejected} of {} bodies were rejected; their CSV rows stop at the step they were rejected on",
-                built.bodies.len()
-            ),
-        ));
-    }
     Ok(())
+}
+
+/// Where a run's trajectory goes.
+enum Destination<'a> {
+    /// To standard output.
+    Stdout,
+    /// To a file, written through a temporary one and committed at the end.
+    File(&'a Path, OutputFile),
+    /// Nowhere: the run only steps.
+    Nowhere,
+}
+
+/// Steps `built` through `steps` steps, writing the trajectory to `destination` as `record`
+/// says and calling `on_step` after each step (a break stops the run as interrupted). Returns
+/// what was written.
+fn step_and_write(
+    built: &mut BuiltScene,
+    steps: u64,
+    record: &Recording,
+    destination: Destination<'_>,
+    on_step: &mut impl FnMut(u64, &World) -> ControlFlow<()>,
+) -> Result<Option<TrajectoryStats>, Failure> {
+    let interrupted = |step: u64, path: Option<&Path>| {
+        let unchanged = match path {
+            Some(path) => format!("; {} was not written", path_for_terminal(path)),
+            None => String::new(),
+        };
+        Failure::new(
+            exit::INTERRUPTED,
+            format!("interrupted after step {step}{unchanged}"),
+        )
+    };
+    match destination {
+        Destination::Stdout => {
+            let stdout = std::io::stdout().lock();
+            let written = tumble_scene::write_trajectory(built, steps, record, stdout, on_step)
+                .map_err(|e| match e {
+                    TrajectoryError::Stopped { step } => interrupted(step, None),
+                    e => Failure::new(exit::ERROR, format!("standard output: {e}")),
+                })?;
+            Ok(Some(written))
+        }
+        Destination::File(path, mut file) => {
+            let written = tumble_scene::write_trajectory(built, steps, record, &mut file, on_step)
+                .map_err(|e| match e {
+                    TrajectoryError::Stopped { step } => interrupted(step, Some(path)),
+                    TrajectoryError::Io(e) => OutputError::io(path, e).into(),
+                    e => Failure::from(e),
+                })?;
+            file.commit()?;
+            Ok(Some(written))
+        }
+        Destination::Nowhere => {
+            for step in 1..=steps {
+                built.step();
+                if on_step(step, &built.world).is_break() {
+                    return Err(interrupted(step, None));
+                }
+            }
+            Ok(None)
+        }
+    }
+}
+
+/// What `tumble run` says at the end of a run.
+struct Summary<'a> {
+    scene_name: &'a str,
+    steps: u64,
+    wall: Duration,
+    /// Energy and angular momentum before the run.
+    before: (f64, DVec3),
+    conserved: &'a summary::Conserved,
+    written: Option<TrajectoryStats>,
+    rejected: usize,
+    /// `(step, checksum)` pairs, the last step's included; empty without `--checksum`.
+    checksums: &'a [(u64, WorldChecksum)],
+}
+
+impl Summary<'_> {
+    /// The summary's lines, with the world after the run in `built`.
+    fn lines(&self, built: &mut BuiltScene) -> Vec<String> {
+        let (steps, wall) = (self.steps, self.wall);
+        let after = summary::totals(&mut built.world);
+        let body_steps = (steps as f64) * built.bodies.len().max(1) as f64;
+        let (dt, integrator) = {
+            let settings = built.world.resource::<PhysicsSettings>();
+            let integrator = match settings.substeps.get() {
+                1 => settings.integrator.to_string(),
+                n => format!("{}, {n} substeps", settings.integrator),
+            };
+            (settings.dt(), integrator)
+        };
+        let mut lines = vec![
+            format!("scene      {}", self.scene_name),
+            format!("bodies     {}", built.bodies.len()),
+            format!("steps      {steps} × {dt} s ({integrator})"),
+            format!(
+                "wall time  {:.3} s, {:.1} ns per body-step",
+                wall.as_secs_f64(),
+                wall.as_nanos() as f64 / body_steps
+            ),
+        ];
+        // Totals over every body, quarantined ones at their last valid state.
+        let energy = summary::drift(self.before.0, after.0, "J");
+        lines.push(match self.conserved.energy {
+            None => format!("energy     {energy} (kinetic + spring + gravity)"),
+            Some(why) => {
+                format!("energy     {energy} (kinetic + spring + gravity; not conserved: {why})")
+            }
+        });
+        let momentum = summary::drift(self.before.1.length(), after.1.length(), "kg·m²/s");
+        lines.push(match self.conserved.momentum {
+            None => format!("|L|        {momentum} (about the origin)"),
+            Some(why) => format!("|L|        {momentum} (about the origin; not conserved: {why})"),
+        });
+        if let Some(written) = &self.written {
+            lines.push(format!(
+                "trajectory {} rows, {:.1} MB, written at {:.0} MB/s",
+                written.rows,
+                written.bytes as f64 / 1e6,
+                written.megabytes_per_second()
+            ));
+        }
+        if self.rejected > 0 {
+            lines.push(format!(
+                "rejected   {} bodies (named above, on stderr)",
+                self.rejected
+            ));
+        }
+        for (step, checksum) in self.checksums {
+            lines.push(format!("checksum   step {step}: {checksum}"));
+        }
+        lines
+    }
 }
 
 /// A progress bar on stderr for long runs when stderr is a terminal, hidden otherwise.
@@ -411,90 +324,6 @@ fn progress_bar(steps: u64, bodies: usize) -> ProgressBar {
         bar.set_style(style);
     }
     bar
-}
-
-/// The patterns of `--bodies`, compiled once into one matcher, with the text of each (in
-/// order) for the error that names a pattern matching nothing.
-struct BodyPatterns {
-    items: Vec<String>,
-    set: GlobSet,
-}
-
-/// The comma-separated patterns of `--bodies`, each checked: shell globs as `globset` reads
-/// them (`*`, `?`, `[abc]`, `[a-z]`, `[!abc]` and `[^abc]` for "not one of", `{a,b}` is not
-/// available since `,` separates patterns, `\` escapes the next character). Patterns are
-/// composed (Unicode form C) as the scene's names are, so `é` typed either way finds `é`.
-fn body_patterns(list: &str) -> Result<BodyPatterns, Failure> {
-    let mut items = Vec::new();
-    let mut set = GlobSetBuilder::new();
-    let list = tumble_scene::text::composed(list);
-    for item in list.split(',') {
-        let item = item.trim();
-        if item.is_empty() {
-            return Err(Failure::new(
-                exit::ERROR,
-                format!(
-                    "--bodies: an empty name in `{}`; expected names or patterns separated by \
-                     commas",
-                    terminal_safe(&list)
-                ),
-            ));
-        }
-        let glob = GlobBuilder::new(item)
-            .literal_separator(false)
-            .backslash_escape(true)
-            .build()
-            .map_err(|e| {
-                Failure::new(
-                    exit::ERROR,
-                    format!(
-                        "--bodies: `{}` is not a pattern: {}",
-                        terminal_safe(item),
-                        terminal_safe(&e.kind().to_string())
-                    ),
-                )
-            })?;
-        set.add(glob);
-        items.push(item.to_owned());
-    }
-    let set = set.build().map_err(|e| {
-        Failure::new(
-            exit::ERROR,
-            format!("--bodies: {}", terminal_safe(&e.to_string())),
-        )
-    })?;
-    Ok(BodyPatterns { items, set })
-}
-
-/// Indices of the bodies that match any of `patterns`, in file order; a pattern that matches
-/// none is an error (a typo must not give an empty trajectory). One pass of the compiled set
-/// over the names: linear in the names, not in names × patterns.
-fn select_bodies(
-    patterns: &BodyPatterns,
-    bodies: &[(String, Entity)],
-) -> Result<Vec<usize>, Failure> {
-    let mut used = vec![false; patterns.items.len()];
-    let mut selected = Vec::new();
-    let mut hits = Vec::new();
-    for (i, (name, _)) in bodies.iter().enumerate() {
-        patterns.set.matches_into(name.as_str(), &mut hits);
-        if !hits.is_empty() {
-            selected.push(i);
-        }
-        for &k in &hits {
-            used[k] = true;
-        }
-    }
-    if let Some(k) = used.iter().position(|used| !used) {
-        return Err(Failure::new(
-            exit::ERROR,
-            format!(
-                "--bodies: `{}` matches no body of the scene",
-                terminal_safe(&patterns.items[k])
-            ),
-        ));
-    }
-    Ok(selected)
 }
 
 /// The estimated CSV size: `(rows, bytes per row)`, the row size a bound for the usual
@@ -664,47 +493,6 @@ fn report_quarantines(world: &World, names: &Names, step: u64, reported: usize) 
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn names(names: &[&str]) -> Vec<(String, Entity)> {
-        names
-            .iter()
-            .enumerate()
-            .map(|(i, n)| ((*n).to_owned(), Entity::from_raw_u32(i as u32).unwrap()))
-            .collect()
-    }
-
-    fn selected(list: &str, bodies: &[&str]) -> Result<Vec<usize>, String> {
-        let patterns = body_patterns(list).map_err(|f| f.message)?;
-        select_bodies(&patterns, &names(bodies)).map_err(|f| f.message)
-    }
-
-    /// The syntax a shell user knows: `[!..]` and `[^..]` negate, `\` escapes, `*` and `?`
-    /// match any run and one character, including `/` (names are not paths).
-    #[test]
-    fn body_patterns_are_shell_globs() {
-        let bodies = ["m1", "m2", "m*", "a/b", "b12"];
-        assert_eq!(selected("m[^1]", &bodies), Ok(vec![1, 2]));
-        assert_eq!(selected("m[!1]", &bodies), Ok(vec![1, 2]));
-        assert_eq!(selected("m\\*", &bodies), Ok(vec![2]));
-        assert_eq!(selected("a*", &bodies), Ok(vec![3]));
-        assert_eq!(selected("b1?,m1", &bodies), Ok(vec![0, 4]));
-        let error = selected("m1,zz*", &bodies).unwrap_err();
-        assert_eq!(error, "--bodies: `zz*` matches no body of the scene");
-    }
-
-    /// 5000 patterns against 2000 names: one compiled set, one pass over the names. The bound
-    /// is loose for a shared machine; the pattern-by-pattern loop it replaced took 32 s.
-    #[test]
-    fn many_patterns_against_many_names_are_quick() {
-        let bodies: Vec<String> = (0..2000).map(|i| format!("body{i}")).collect();
-        let refs: Vec<&str> = bodies.iter().map(String::as_str).collect();
-        let list: Vec<String> = (0..5000).map(|i| format!("body{}*", i % 2000)).collect();
-        let start = std::time::Instant::now();
-        let picked = selected(&list.join(","), &refs).unwrap();
-        assert_eq!(picked.len(), 2000);
-        let took = start.elapsed();
-        assert!(took < std::time::Duration::from_secs(5), "{took:?}");
-    }
 
     #[test]
     fn sizes_read_with_binary_units() {
