@@ -14,6 +14,7 @@
 #![warn(missing_docs)]
 
 mod build;
+mod checks;
 mod error;
 mod format;
 mod json;
@@ -25,9 +26,8 @@ mod tool;
 mod trajectory;
 mod validate;
 
-pub use build::{
-    BuiltScene, MAX_NAME_BYTES, MAX_STEPS, MAX_SUBSTEPS, Scene, SceneBody, SceneForce, SceneSyntax,
-};
+pub use build::{BuiltScene, MAX_STEPS, MAX_SUBSTEPS, Scene, SceneBody, SceneForce, SceneSyntax};
+pub use checks::MAX_NAME_BYTES;
 pub use error::{SaveError, SceneError};
 pub use format::{BodyDef, ForceDef, SceneFile, ShapeDef, WorldDef};
 pub use trajectory::{
