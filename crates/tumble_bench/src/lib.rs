@@ -248,46 +248,7 @@ pub fn run_bench(options: &BenchOptions, mut progress: impl FnMut(&str)) -> Benc
         "two independent one-thread loops of {half} bodies"
     ));
     let two_copy_ceiling = scaling::two_copy_ceiling(half, effort.steps(half), effort.repetitions);
-    let threaded = Parallelism::default();
-    let single = Parallelism::SINGLE_THREAD;
-    let mut rows = Vec::new();
-    for &n in &sizes {
-        let scene = population::scene(n);
-        let mut rapier = (n <= options.rapier_max_bodies).then(|| Rapier::new(&scene));
-        for (k, &integrator) in INTEGRATORS.iter().enumerate() {
-            progress(&format!("{n} bodies · {integrator}"));
-            let mut raw1 = RawLoop::new(&scene, integrator, single);
-            let mut raw2 = RawLoop::new(&scene, integrator, threaded);
-            let mut ecs1 = Ecs::new(&scene, integrator, single);
-            let mut ecs2 = Ecs::new(&scene, integrator, threaded);
-            let mut engines: Vec<&mut dyn Engine> =
-                vec![&mut raw1, &mut raw2, &mut ecs1, &mut ecs2];
-            // rapier does not depend on tumble's integrator: timed once per size.
-            let with_rapier = k == 0 && rapier.is_some();
-            if with_rapier && let Some(r) = rapier.as_mut() {
-                engines.push(r);
-            }
-            let ns = compare(&mut engines, n, &effort);
-            check_moved(&raw1, &ecs1, &scene);
-            rows.push(Row {
-                integrator: integrator.name().to_owned(),
-                bodies: n,
-                steps: effort.steps(n),
-                raw_1t: ns[0],
-                raw_2t: ns[1],
-                ecs_1t: ns[2],
-                ecs_2t: ns[3],
-                rapier: if with_rapier {
-                    Some(ns[4])
-                } else {
-                    rows.iter()
-                        .rev()
-                        .find(|r: &&Row| r.bodies == n)
-                        .and_then(|r| r.rapier)
-                },
-            });
-        }
-    }
+    let rows = free_body_rows(&sizes, options.rapier_max_bodies, &effort, &mut progress);
     let fixed_cost_ns = INTEGRATORS
         .iter()
         .filter_map(|i| {
@@ -349,6 +310,57 @@ pub fn run_bench(options: &BenchOptions, mut progress: impl FnMut(&str)) -> Benc
     };
     results.targets = output::targets(&results);
     results
+}
+
+/// The free-body rows: every size of `sizes` and integrator of the bench, stepped by the raw
+/// loop and the ECS on one and two threads, and by rapier up to `rapier_max_bodies` bodies.
+fn free_body_rows(
+    sizes: &[usize],
+    rapier_max_bodies: usize,
+    effort: &Effort,
+    progress: &mut impl FnMut(&str),
+) -> Vec<Row> {
+    let threaded = Parallelism::default();
+    let single = Parallelism::SINGLE_THREAD;
+    let mut rows = Vec::new();
+    for &n in sizes {
+        let scene = population::scene(n);
+        let mut rapier = (n <= rapier_max_bodies).then(|| Rapier::new(&scene));
+        for (k, &integrator) in INTEGRATORS.iter().enumerate() {
+            progress(&format!("{n} bodies · {integrator}"));
+            let mut raw1 = RawLoop::new(&scene, integrator, single);
+            let mut raw2 = RawLoop::new(&scene, integrator, threaded);
+            let mut ecs1 = Ecs::new(&scene, integrator, single);
+            let mut ecs2 = Ecs::new(&scene, integrator, threaded);
+            let mut engines: Vec<&mut dyn Engine> =
+                vec![&mut raw1, &mut raw2, &mut ecs1, &mut ecs2];
+            // rapier does not depend on tumble's integrator: timed once per size.
+            let with_rapier = k == 0 && rapier.is_some();
+            if with_rapier && let Some(r) = rapier.as_mut() {
+                engines.push(r);
+            }
+            let ns = compare(&mut engines, n, effort);
+            check_moved(&raw1, &ecs1, &scene);
+            rows.push(Row {
+                integrator: integrator.name().to_owned(),
+                bodies: n,
+                steps: effort.steps(n),
+                raw_1t: ns[0],
+                raw_2t: ns[1],
+                ecs_1t: ns[2],
+                ecs_2t: ns[3],
+                rapier: if with_rapier {
+                    Some(ns[4])
+                } else {
+                    rows.iter()
+                        .rev()
+                        .find(|r: &&Row| r.bodies == n)
+                        .and_then(|r| r.rapier)
+                },
+            });
+        }
+    }
+    rows
 }
 
 /// The CPU's model name from `/proc/cpuinfo` (Linux), or `unknown CPU`.

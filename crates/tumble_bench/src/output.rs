@@ -39,6 +39,17 @@ fn target(name: &str, value: f64, relation: &str, bound: f64) -> Target {
 /// measured).
 pub fn targets(results: &BenchResults) -> Vec<Target> {
     let mut out = Vec::new();
+    ecs_over_raw_targets(results, &mut out);
+    against_rapier_targets(results, &mut out);
+    memory_floor_targets(results, &mut out);
+    springs_targets(results, &mut out);
+    fixed_costs_targets(results, &mut out);
+    exact_and_implicit_targets(results, &mut out);
+    out
+}
+
+/// Free-body targets: the ECS against the raw loop, for the default and the simplest method.
+fn ecs_over_raw_targets(results: &BenchResults, out: &mut Vec<Target>) {
     for integrator in [DEFAULT, "symplectic-euler"] {
         let big: Vec<&Row> = rows_of(results, integrator)
             .filter(|r| r.bodies >= 10_000)
@@ -60,6 +71,10 @@ pub fn targets(results: &BenchResults) -> Vec<Target> {
             ));
         }
     }
+}
+
+/// Free-body targets against rapier and for two threads.
+fn against_rapier_targets(results: &BenchResults, out: &mut Vec<Target>) {
     if let Some(r) = row(results, DEFAULT, 100_000) {
         if let Some(rapier) = r.rapier {
             out.push(target(
@@ -102,6 +117,10 @@ pub fn targets(results: &BenchResults) -> Vec<Target> {
             8.0,
         ));
     }
+}
+
+/// Free-body targets against the memory floor.
+fn memory_floor_targets(results: &BenchResults, out: &mut Vec<Target>) {
     let floor = results.bytes_per_body_step as f64 / results.bandwidth_gb_s[0];
     for n in [100_000, 1_000_000] {
         if let Some(r) = row(results, DEFAULT, n) {
@@ -113,6 +132,10 @@ pub fn targets(results: &BenchResults) -> Vec<Target> {
             ));
         }
     }
+}
+
+/// Spring-chain targets: loaded explicit chains against a free body and rapier.
+fn springs_targets(results: &BenchResults, out: &mut Vec<Target>) {
     let springs = &results.springs;
     for r in springs.throughput.iter().filter(|r| r.threads == 1) {
         let Some(free) = row(results, DEFAULT, r.springs).map(|f| f.ecs_1t) else {
@@ -142,6 +165,10 @@ pub fn targets(results: &BenchResults) -> Vec<Target> {
             ));
         }
     }
+}
+
+/// Fixed costs, flat costs and features that must cost nothing unused.
+fn fixed_costs_targets(results: &BenchResults, out: &mut Vec<Target>) {
     for (integrator, ns) in &results.fixed_cost_ns {
         out.push(target(
             &format!("{integrator}: fixed cost per step at N = 1 (µs)"),
@@ -185,6 +212,10 @@ pub fn targets(results: &BenchResults) -> Vec<Target> {
             0.01,
         ));
     }
+}
+
+/// `exact` against `splitting`, and the implicit spring step against the explicit one.
+fn exact_and_implicit_targets(results: &BenchResults, out: &mut Vec<Target>) {
     for row in &results.exact {
         out.push(target(
             &format!("exact / splitting, ECS 1 thread, {} bodies", row.bodies),
@@ -211,7 +242,6 @@ pub fn targets(results: &BenchResults) -> Vec<Target> {
             ));
         }
     }
-    out
 }
 
 fn fmt_ns(ns: f64) -> String {

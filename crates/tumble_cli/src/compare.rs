@@ -2,7 +2,7 @@
 
 use std::fmt::Write as _;
 
-use glam::DQuat;
+use glam::{DQuat, DVec3};
 use tumble_core::math::{Narrow, Quat, Real, Vec3, Widen, to_f64};
 use tumble_core::{BodyState, Integrator};
 use tumble_ecs::prelude::{FreeFlow, SpringSolver};
@@ -53,58 +53,8 @@ pub(crate) fn run(scene: &Scene, settings: Settings) -> Result<(), Failure> {
             sprung[body] = true;
         }
     }
-    // Exact solutions for bodies without loads or damping: the position is the parabola
-    // x₀ + v₀t + ½ g s t²; the orientation is a steady rotation for a spherical body, or the
-    // elliptic torque-free top for distinct moments (identity principal frame).
-    let gravity = scene.gravity().unwrap_or(Vec3::ZERO).widen();
-    let exact_for: Vec<Option<(Option<TorqueFreeTop>, bool)>> = comparison
-        .bodies
-        .iter()
-        .zip(&sprung)
-        .map(|(b, &sprung)| {
-            let free = !sprung
-                && b.loads.is_empty()
-                && b.linear_damping == 0.0
-                && b.angular_damping == 0.0;
-            if !free {
-                return None;
-            }
-            if b.mass.is_spherical() {
-                return Some((None, true));
-            }
-            if b.mass.principal_frame() != Quat::IDENTITY {
-                return None;
-            }
-            let w_body = b.state.rotation.inverse() * b.state.angular_velocity;
-            TorqueFreeTop::new(
-                b.mass.principal_inertia().widen(),
-                w_body.widen(),
-                b.state.rotation.widen(),
-            )
-            .ok()
-            .map(|top| (Some(top), false))
-        })
-        .collect();
-    let exact = |i: usize, t: f64| -> Option<BodyState> {
-        let (top, spherical) = exact_for[i].as_ref()?;
-        let b = &comparison.bodies[i];
-        let q: DQuat = match top {
-            Some(top) => top.orientation(t),
-            None if *spherical => {
-                DQuat::from_scaled_axis(b.state.angular_velocity.widen() * t)
-                    * b.state.rotation.widen()
-            }
-            None => return None,
-        };
-        let x = b.state.position.widen()
-            + b.state.linear_velocity.widen() * t
-            + 0.5 * gravity * to_f64(b.gravity_scale) * t * t;
-        Some(BodyState {
-            position: x.narrow(),
-            rotation: Quat::from_xyzw(q.x as Real, q.y as Real, q.z as Real, q.w as Real),
-            ..Default::default()
-        })
-    };
+    let exact = ExactSolutions::of(&comparison, scene.gravity().unwrap_or(Vec3::ZERO).widen());
+    let exact = |i: usize, t: f64| exact.at(i, t);
     let options = ComparisonOptions {
         integrator,
         gyroscopic,
@@ -170,6 +120,89 @@ pub(crate) fn run(scene: &Scene, settings: Settings) -> Result<(), Failure> {
         result.speed_ratio()
     );
     crate::stdout::print(&out)?;
+    report_unclean(&result)
+}
+
+/// Exact solutions for the bodies without loads, springs or damping: the position is the
+/// parabola `x₀ + v₀t + ½ g s t²`; the orientation is a steady rotation for a spherical body, or
+/// the elliptic torque-free top for distinct moments (identity principal frame).
+struct ExactSolutions<'a> {
+    scene: &'a ComparisonScene,
+    gravity: DVec3,
+    /// Per body: the top (`None` for a spherical body) and whether it is spherical; `None`
+    /// where no exact solution is known.
+    tops: Vec<Option<(Option<TorqueFreeTop>, bool)>>,
+}
+
+impl<'a> ExactSolutions<'a> {
+    fn of(comparison: &'a ComparisonScene, gravity: DVec3) -> Self {
+        let mut sprung = vec![false; comparison.bodies.len()];
+        for spring in &comparison.springs {
+            sprung[spring.a] = true;
+            if let ComparisonSpringEnd::Body { body, .. } = spring.b {
+                sprung[body] = true;
+            }
+        }
+        let tops = comparison
+            .bodies
+            .iter()
+            .zip(&sprung)
+            .map(|(b, &sprung)| {
+                let free = !sprung
+                    && b.loads.is_empty()
+                    && b.linear_damping == 0.0
+                    && b.angular_damping == 0.0;
+                if !free {
+                    return None;
+                }
+                if b.mass.is_spherical() {
+                    return Some((None, true));
+                }
+                if b.mass.principal_frame() != Quat::IDENTITY {
+                    return None;
+                }
+                let w_body = b.state.rotation.inverse() * b.state.angular_velocity;
+                TorqueFreeTop::new(
+                    b.mass.principal_inertia().widen(),
+                    w_body.widen(),
+                    b.state.rotation.widen(),
+                )
+                .ok()
+                .map(|top| (Some(top), false))
+            })
+            .collect();
+        Self {
+            scene: comparison,
+            gravity,
+            tops,
+        }
+    }
+
+    /// Body `i`'s exact position and orientation at time `t`, if known.
+    fn at(&self, i: usize, t: f64) -> Option<BodyState> {
+        let (top, spherical) = self.tops[i].as_ref()?;
+        let b = &self.scene.bodies[i];
+        let q: DQuat = match top {
+            Some(top) => top.orientation(t),
+            None if *spherical => {
+                DQuat::from_scaled_axis(b.state.angular_velocity.widen() * t)
+                    * b.state.rotation.widen()
+            }
+            None => return None,
+        };
+        let x = b.state.position.widen()
+            + b.state.linear_velocity.widen() * t
+            + 0.5 * self.gravity * to_f64(b.gravity_scale) * t * t;
+        Some(BodyState {
+            position: x.narrow(),
+            rotation: Quat::from_xyzw(q.x as Real, q.y as Real, q.z as Real, q.w as Real),
+            ..Default::default()
+        })
+    }
+}
+
+/// Names the bodies that did not run cleanly in either engine; an error if any did not.
+fn report_unclean(result: &Comparison) -> Result<(), Failure> {
     let unclean: Vec<_> = result.bodies.iter().filter(|d| !d.is_clean()).collect();
     for d in &unclean {
         let name = terminal_safe(&d.name);

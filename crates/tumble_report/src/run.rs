@@ -8,7 +8,7 @@ use tumble_scene::text::path_for_terminal;
 
 use crate::energy::{spins, traces};
 use crate::output::{Machine, Results, headline_table, markdown, plot_energy, plot_scene};
-use crate::reference::cases;
+use crate::reference::{Case, cases};
 use crate::spring_output::plot_spring_energy;
 use crate::springs::spring_runs;
 use crate::stability::matrix;
@@ -48,104 +48,15 @@ pub fn run_report(options: &ReportOptions) -> Result<(), Box<dyn std::error::Err
         with_sections(readme, &[("report", "")])?;
         OutputSet::check(readme)?;
     }
-    let dts: Vec<f64> = if options.quick {
-        [15.0, 30.0, 60.0, 120.0, 240.0, 480.0]
-            .iter()
-            .map(|n| 1.0 / n)
-            .collect()
-    } else {
-        [15.0, 30.0, 60.0, 120.0, 240.0, 480.0, 960.0, 1920.0]
-            .iter()
-            .map(|n| 1.0 / n)
-            .collect()
-    };
-    let effort = if options.quick {
-        Effort {
-            batch: 8,
-            repetitions: 1,
-        }
-    } else {
-        Effort {
-            batch: 64,
-            repetitions: 3,
-        }
-    };
     let cases = cases();
-    let methods = Method::all();
-    let integrators = tumble_core::Integrator::ALL;
-    let total = cases.len() * methods.len() * dts.len()
-        + integrators.len() * dts.len()
-        + tumble_core::Integrator::ALL.len()
-        + 2 * crate::springs::OMEGA_DTS.len();
-    let bar = ProgressBar::new(total as u64);
-    bar.set_style(ProgressStyle::with_template(
-        "{bar:40} {pos}/{len} {msg} [{elapsed}]",
-    )?);
-    let mut points = Vec::new();
-    for case in &cases {
-        for &method in &methods {
-            if method == Method::Rapier && !case.rapier {
-                bar.inc(dts.len() as u64);
-                continue;
-            }
-            bar.set_message(format!("{} · {}", case.name, method.name()));
-            for &dt in &dts {
-                points.push(measure(case, method, dt, effort));
-                bar.inc(1);
-            }
-        }
-    }
-    bar.set_message(format!("{} · reference", crate::linkage::NAME));
-    let exact = crate::linkage::reference(crate::linkage::HORIZON, crate::linkage::REFERENCE_STEPS);
-    for &integrator in integrators {
-        bar.set_message(format!("{} · {integrator}", crate::linkage::NAME));
-        for &dt in &dts {
-            points.push(crate::linkage::measure(
-                integrator,
-                dt,
-                effort.batch,
-                effort.repetitions,
-                &exact,
-            ));
-            bar.inc(1);
-        }
-    }
-    bar.set_message("stability matrix");
-    let cells = matrix(options.quick, || bar.inc(1));
-    bar.set_message("thin plate");
-    let thin_plate = crate::thin::table();
-    bar.set_message("energy over time");
-    let energy = traces(if options.quick { 30 } else { 120 });
-    bar.set_message("springs against rapier");
-    let springs = spring_runs(if options.quick { 120 } else { 600 }, || bar.inc(1));
-    bar.finish_and_clear();
-
-    let results = Results::new(
-        Machine::detect(options.quick),
-        points,
-        cells,
-        energy,
-        springs,
-        thin_plate,
-    );
+    let results = measure_everything(options.quick, &cases)?;
     // The plots are drawn into a private directory (plotters opens its path as it is), then
     // each joins the set by the same safe route as the other files.
     let staging = tempfile::Builder::new()
         .prefix(".tumble-plots-")
         .tempdir_in(out)
         .map_err(|e| OutputError::io(out, e))?;
-    let mut plots = Vec::new();
-    for name in cases.iter().map(|c| c.name).chain([crate::linkage::NAME]) {
-        plots.push(plot_scene(staging.path(), name, &results.work_precision)?);
-    }
-    for (spin, _) in spins() {
-        plots.push(plot_energy(staging.path(), spin, &results.energy)?);
-    }
-    plots.push(crate::output::plot_stability(
-        staging.path(),
-        &results.stability,
-    )?);
-    plots.push(plot_spring_energy(staging.path(), &results.springs)?);
+    let plots = draw_plots(staging.path(), &cases, &results)?;
     let mut files = OutputSet::new();
     for plot in &plots {
         let drawn = staging.path().join(plot);
@@ -189,4 +100,108 @@ pub fn run_report(options: &ReportOptions) -> Result<(), Box<dyn std::error::Err
         plots.len()
     ))?;
     Ok(())
+}
+
+/// Every measurement of the report (`quick`: the short version CI runs): work–precision on
+/// `cases` and the linkage, the stability matrix, the thin plate, energy over time and the
+/// springs against rapier, with a progress bar.
+fn measure_everything(quick: bool, cases: &[Case]) -> Result<Results, Box<dyn std::error::Error>> {
+    let dts: Vec<f64> = if quick {
+        [15.0, 30.0, 60.0, 120.0, 240.0, 480.0]
+            .iter()
+            .map(|n| 1.0 / n)
+            .collect()
+    } else {
+        [15.0, 30.0, 60.0, 120.0, 240.0, 480.0, 960.0, 1920.0]
+            .iter()
+            .map(|n| 1.0 / n)
+            .collect()
+    };
+    let effort = if quick {
+        Effort {
+            batch: 8,
+            repetitions: 1,
+        }
+    } else {
+        Effort {
+            batch: 64,
+            repetitions: 3,
+        }
+    };
+    let methods = Method::all();
+    let integrators = tumble_core::Integrator::ALL;
+    let total = cases.len() * methods.len() * dts.len()
+        + integrators.len() * dts.len()
+        + tumble_core::Integrator::ALL.len()
+        + 2 * crate::springs::OMEGA_DTS.len();
+    let bar = ProgressBar::new(total as u64);
+    bar.set_style(ProgressStyle::with_template(
+        "{bar:40} {pos}/{len} {msg} [{elapsed}]",
+    )?);
+    let mut points = Vec::new();
+    for case in cases {
+        for &method in &methods {
+            if method == Method::Rapier && !case.rapier {
+                bar.inc(dts.len() as u64);
+                continue;
+            }
+            bar.set_message(format!("{} · {}", case.name, method.name()));
+            for &dt in &dts {
+                points.push(measure(case, method, dt, effort));
+                bar.inc(1);
+            }
+        }
+    }
+    bar.set_message(format!("{} · reference", crate::linkage::NAME));
+    let exact = crate::linkage::reference(crate::linkage::HORIZON, crate::linkage::REFERENCE_STEPS);
+    for &integrator in integrators {
+        bar.set_message(format!("{} · {integrator}", crate::linkage::NAME));
+        for &dt in &dts {
+            points.push(crate::linkage::measure(
+                integrator,
+                dt,
+                effort.batch,
+                effort.repetitions,
+                &exact,
+            ));
+            bar.inc(1);
+        }
+    }
+    bar.set_message("stability matrix");
+    let cells = matrix(quick, || bar.inc(1));
+    bar.set_message("thin plate");
+    let thin_plate = crate::thin::table();
+    bar.set_message("energy over time");
+    let energy = traces(if quick { 30 } else { 120 });
+    bar.set_message("springs against rapier");
+    let springs = spring_runs(if quick { 120 } else { 600 }, || bar.inc(1));
+    bar.finish_and_clear();
+
+    let results = Results::new(
+        Machine::detect(quick),
+        points,
+        cells,
+        energy,
+        springs,
+        thin_plate,
+    );
+    Ok(results)
+}
+
+/// Draws every plot of `results` into `dir`; returns their file names.
+fn draw_plots(
+    dir: &Path,
+    cases: &[Case],
+    results: &Results,
+) -> Result<Vec<String>, Box<dyn std::error::Error>> {
+    let mut plots = Vec::new();
+    for name in cases.iter().map(|c| c.name).chain([crate::linkage::NAME]) {
+        plots.push(plot_scene(dir, name, &results.work_precision)?);
+    }
+    for (spin, _) in spins() {
+        plots.push(plot_energy(dir, spin, &results.energy)?);
+    }
+    plots.push(crate::output::plot_stability(dir, &results.stability)?);
+    plots.push(plot_spring_energy(dir, &results.springs)?);
+    Ok(plots)
 }
