@@ -280,12 +280,36 @@ fn quickhull(points: &[DVec3]) -> Result<Vec<[u32; 3]>, HullError> {
         .iter()
         .fold(0.0_f64, |m, p| m.max(p.abs().max_element()));
     let eps = 1e-11 * scale;
+    let [i0, i1, i2, i3] = initial_tetrahedron(points, eps)?;
+    let mut faces = vec![
+        Face::new([i0, i1, i2], points),
+        Face::new([i0, i3, i1], points),
+        Face::new([i1, i3, i2], points),
+        Face::new([i2, i3, i0], points),
+    ];
+    link_all(&mut faces)?;
+    for i in 0..points.len() as u32 {
+        if [i0, i1, i2, i3].contains(&i) {
+            continue;
+        }
+        for f in faces.iter_mut() {
+            if f.take(i, points, eps) {
+                break;
+            }
+        }
+    }
+    expand(&mut faces, points, eps)?;
+    Ok(faces.iter().filter(|f| f.alive).map(|f| f.v).collect())
+}
+
+/// The initial tetrahedron: the farthest pair among the axis extremes, the point farthest from
+/// their line, the point farthest from their plane; the base `(i0, i1, i2)` oriented so that
+/// `i3` is below it. An error when the points span less than a volume (within `eps`).
+fn initial_tetrahedron(points: &[DVec3], eps: f64) -> Result<[u32; 4], HullError> {
     let degenerate = || HullError::Degenerate {
         volume: 0.0,
         bounding_box_volume: 0.0,
     };
-    // Initial tetrahedron: the farthest pair among the axis extremes, the point farthest from
-    // their line, the point farthest from their plane.
     let mut extremes = [0usize; 6];
     for (i, p) in points.iter().enumerate() {
         for axis in 0..3 {
@@ -336,23 +360,13 @@ fn quickhull(points: &[DVec3]) -> Result<Vec<[u32; 3]>, HullError> {
     } else {
         (i1, i2)
     };
-    let mut faces = vec![
-        Face::new([i0, i1, i2], points),
-        Face::new([i0, i3, i1], points),
-        Face::new([i1, i3, i2], points),
-        Face::new([i2, i3, i0], points),
-    ];
-    link_all(&mut faces)?;
-    for i in 0..points.len() as u32 {
-        if [i0, i1, i2, i3].contains(&i) {
-            continue;
-        }
-        for f in faces.iter_mut() {
-            if f.take(i, points, eps) {
-                break;
-            }
-        }
-    }
+    Ok([i0, i1, i2, i3])
+}
+
+/// Grows the hull `faces` (each holding the points above it) until no face has a point above
+/// it: each step takes a face's farthest point (the eye), removes the faces the eye sees and
+/// closes the hole with a cone of new faces from its horizon to the eye.
+fn expand(faces: &mut Vec<Face>, points: &[DVec3], eps: f64) -> Result<(), HullError> {
     let mut pending: Vec<u32> = (0..4).collect();
     let mut visible = Vec::new();
     let mut stack = Vec::new();
@@ -456,7 +470,7 @@ fn quickhull(points: &[DVec3]) -> Result<Vec<[u32; 3]>, HullError> {
         }
         pending.extend_from_slice(&created);
     }
-    Ok(faces.iter().filter(|f| f.alive).map(|f| f.v).collect())
+    Ok(())
 }
 
 /// Links the neighbours of the initial tetrahedron's faces.

@@ -22,6 +22,7 @@
 pub mod energy;
 pub mod linkage;
 pub mod output;
+pub mod plots;
 pub mod reference;
 pub mod run;
 pub mod spring_output;

@@ -7,7 +7,8 @@ use tumble_scene::output::{OutputError, OutputSet, print_to_stdout, with_section
 use tumble_scene::text::path_for_terminal;
 
 use crate::energy::{spins, traces};
-use crate::output::{Machine, Results, headline_table, markdown, plot_energy, plot_scene};
+use crate::output::{Machine, Results, headline_table, markdown};
+use crate::plots::{plot_energy, plot_scene};
 use crate::reference::{Case, cases};
 use crate::spring_output::plot_spring_energy;
 use crate::springs::spring_runs;
@@ -201,7 +202,7 @@ fn draw_plots(
     for (spin, _) in spins() {
         plots.push(plot_energy(dir, spin, &results.energy)?);
     }
-    plots.push(crate::output::plot_stability(dir, &results.stability)?);
+    plots.push(crate::plots::plot_stability(dir, &results.stability)?);
     plots.push(plot_spring_energy(dir, &results.springs)?);
     Ok(plots)
 }

@@ -70,7 +70,7 @@ pub fn plot_spring_energy(
     dir: &Path,
     runs: &[SpringRun],
 ) -> Result<String, Box<dyn std::error::Error>> {
-    crate::output::svg(dir, SPRING_PLOT.to_owned(), (1200, 460), |root| {
+    crate::plots::svg(dir, SPRING_PLOT.to_owned(), (1200, 460), |root| {
         let panels = root.split_evenly((1, OMEGA_DTS.len()));
         let dt = 1.0 / 60.0;
         for (panel, omega_dt) in panels.iter().zip(OMEGA_DTS) {
@@ -116,7 +116,7 @@ pub fn plot_spring_energy(
                         color.stroke_width(2),
                     )))?;
                 }
-                crate::output::legend_line(&mut chart, series, color, label)?;
+                crate::plots::legend_line(&mut chart, series, color, label)?;
             }
             chart
                 .configure_series_labels()
