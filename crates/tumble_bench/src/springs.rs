@@ -220,6 +220,25 @@ pub const OMEGA_DTS: [Real; 5] = [0.5, 2.0, 10.0, 30.0, 100.0];
 
 /// Runs the spring measurements; `progress` receives one line per measurement.
 pub fn run(quick: bool, mut progress: impl FnMut(&str)) -> SpringResults {
+    let stiffness = stiffness_rows(quick, &mut progress);
+    let sizes: &[usize] = if quick { &[1_000] } else { &[1_000, 100_000] };
+    let effort = Effort {
+        body_steps: if quick { 10_000 } else { 300_000 },
+        min_steps: 2,
+        max_steps: 200,
+        // See the free-body rows' effort: the median of five survives two spoiled timings.
+        repetitions: if quick { 3 } else { 5 },
+    };
+    SpringResults {
+        stiffness,
+        throughput: throughput_rows(sizes, &effort, &mut progress),
+        stages: stage_rows(sizes, &effort, &mut progress),
+    }
+}
+
+/// One chain, relaxed and stretched, explicit at ωΔt 0.5 and implicit at every ωΔt of
+/// [`OMEGA_DTS`]: microseconds per step.
+fn stiffness_rows(quick: bool, progress: &mut impl FnMut(&str)) -> Vec<StiffnessRow> {
     let chain_effort = Effort {
         body_steps: if quick { 30 } else { 600 },
         min_steps: 1,
@@ -251,15 +270,17 @@ pub fn run(quick: bool, mut progress: impl FnMut(&str)) -> SpringResults {
             });
         }
     }
+    stiffness
+}
+
+/// Loaded chains of `sizes` springs: tumble explicit (one thread and the pool), implicit at
+/// ωΔt 0.5 and 10, and rapier's `SpringJoint`, in ns per spring-step.
+fn throughput_rows(
+    sizes: &[usize],
+    effort: &Effort,
+    progress: &mut impl FnMut(&str),
+) -> Vec<ThroughputRow> {
     let mut throughput = Vec::new();
-    let sizes: &[usize] = if quick { &[1_000] } else { &[1_000, 100_000] };
-    let effort = Effort {
-        body_steps: if quick { 10_000 } else { 300_000 },
-        min_steps: 2,
-        max_steps: 200,
-        // See the free-body rows' effort: the median of five survives two spoiled timings.
-        repetitions: if quick { 3 } else { 5 },
-    };
     for &springs in sizes {
         let chains = springs / 10;
         // One thread, as the free-body rows they are compared with; the explicit step again on
@@ -289,7 +310,7 @@ pub fn run(quick: bool, mut progress: impl FnMut(&str)) -> SpringResults {
                 Loads::GravityForcesDamping,
             )
             .with_parallelism(parallelism);
-            let ns = compare(&mut [&mut world], springs, &effort)[0];
+            let ns = compare(&mut [&mut world], springs, effort)[0];
             throughput.push(ThroughputRow {
                 springs,
                 mode: mode_name(mode).to_owned(),
@@ -308,7 +329,7 @@ pub fn run(quick: bool, mut progress: impl FnMut(&str)) -> SpringResults {
             Loads::GravityForcesDamping,
         );
         let mut rapier = Rapier::new(&scene);
-        let ns = compare(&mut [&mut rapier], springs, &effort)[0];
+        let ns = compare(&mut [&mut rapier], springs, effort)[0];
         throughput.push(ThroughputRow {
             springs,
             mode: RAPIER_JOINT.to_owned(),
@@ -317,6 +338,11 @@ pub fn run(quick: bool, mut progress: impl FnMut(&str)) -> SpringResults {
             ns_per_spring_step: ns,
         });
     }
+    throughput
+}
+
+/// Loaded chains stepped in several stages (substeps, `yoshida4`), against one stage.
+fn stage_rows(sizes: &[usize], effort: &Effort, progress: &mut impl FnMut(&str)) -> Vec<StagesRow> {
     let mut stages = Vec::new();
     for &springs in sizes {
         let chains = springs / 10;
@@ -340,7 +366,7 @@ pub fn run(quick: bool, mut progress: impl FnMut(&str)) -> SpringResults {
                 integrator,
                 substeps,
             );
-            let ns = compare(&mut [&mut world], chains * 10, &effort)[0];
+            let ns = compare(&mut [&mut world], chains * 10, effort)[0];
             let base = *one_stage.get_or_insert(ns);
             stages.push(StagesRow {
                 bodies: chains * 10,
@@ -352,9 +378,5 @@ pub fn run(quick: bool, mut progress: impl FnMut(&str)) -> SpringResults {
             });
         }
     }
-    SpringResults {
-        stiffness,
-        throughput,
-        stages,
-    }
+    stages
 }

@@ -216,86 +216,10 @@ impl TorqueFreeTop {
             return Ok(top);
         }
 
-        let mut order = [0usize, 1, 2];
-        order.sort_by(|&a, &b| arr[a].total_cmp(&arr[b]));
-        let i = [arr[order[0]], arr[order[1]], arr[order[2]]];
-        let axis = |k: usize| DVec3::AXES[order[k]];
-        let handed = axis(0).cross(axis(1)).dot(axis(2));
-        let sorted = DMat3::from_cols(axis(0), axis(1), axis(2) * handed);
-        let w = (sorted.transpose() * body_omega0).to_array();
-
-        // Cancellation-free invariant combinations.
-        let t = [i[0] * w[0] * w[0], i[1] * w[1] * w[1], i[2] * w[2] * w[2]];
-        let m_plus = t[0] * (i[2] - i[0]) + t[1] * (i[2] - i[1]); // 2EI₃ − M²
-        let m_minus = t[1] * (i[1] - i[0]) + t[2] * (i[2] - i[0]); // M² − 2EI₁
-        let (d_up, d_down) = (t[2] * (i[2] - i[1]), t[0] * (i[1] - i[0]));
-        let d = d_up - d_down; // M² − 2EI₂
-        if m_plus == 0.0 || m_minus == 0.0 || (w[0] == 0.0 && w[2] == 0.0) {
-            return Ok(top);
+        if let Some((elliptic, motion)) = Elliptic::new(arr, body_omega0, q0) {
+            top.motion = motion;
+            top.kind = Kind::Elliptic(Box::new(elliptic));
         }
-        let separatrix = d.abs() <= 8.0 * f64::EPSILON * (d_up + d_down);
-        let (i1, i2, i3) = (i[0], i[1], i[2]);
-        let momentum = (0..3)
-            .map(|k| i[k] * w[k])
-            .fold(0.0f64, |acc, x| acc.hypot(x));
-
-        // The two cases (momentum about the largest or the smallest axis) are one formula with
-        // the roles of `(M² − 2EI₁, I₃ − I₂)` and `(2EI₃ − M², I₂ − I₁)` exchanged.
-        let about_smallest = !(d > 0.0 || separatrix);
-        let (a, gap_a, b, gap_b, d_signed) = if about_smallest {
-            (m_plus, i2 - i1, m_minus, i3 - i2, -d)
-        } else {
-            (m_minus, i3 - i2, m_plus, i2 - i1, d)
-        };
-        let (s1, s3) = (sign(w[0]), sign(w[2]));
-        let coeff = [
-            s1 * (m_plus / (i1 * (i3 - i1))).sqrt(),
-            s1 * s3 * (b / (i2 * gap_a)).sqrt(),
-            s3 * (m_minus / (i3 * (i3 - i1))).sqrt(),
-        ];
-        let lambda = (gap_a * a / (i1 * i2 * i3)).sqrt();
-        let (m, m1) = if separatrix {
-            (1.0, 0.0)
-        } else {
-            (gap_b * b / (gap_a * a), (i3 - i1) * d_signed / (gap_a * a))
-        };
-        // Euler axes (a, b, c) = sorted (2, 3, 1) in both cases: the cyclic relabelling
-        // x → y → z → x is the rotation by 120° about (1, 1, 1).
-        let cyclic = DQuat::from_axis_angle(DVec3::ONE.normalize(), 2.0 * FRAC_PI_3);
-        let euler_frame = DQuat::from_mat3(&sorted) * cyclic;
-        let cn_axis = if about_smallest { 2 } else { 0 };
-        let sn0 = w[1] / coeff[1];
-        let cn0 = w[cn_axis] / coeff[cn_axis];
-        let tau0 = incomplete_f_sin_cos(sn0, cn0, m, m1);
-        let quarter = complete_k_complement(m1);
-        let mut elliptic = Elliptic {
-            sorted,
-            i,
-            about_smallest,
-            coeff,
-            lambda,
-            m,
-            m1,
-            quarter,
-            tau0,
-            euler_frame,
-            world_from_l: DQuat::IDENTITY,
-            momentum,
-            phi_period: 0.0,
-        };
-        elliptic.world_from_l = q0 * euler_frame * elliptic.euler_rotation(0.0, 0.0).inverse();
-        if quarter.is_finite() {
-            let period = 2.0 * quarter / lambda;
-            elliptic.phi_period = elliptic.integrate(0.0, period, |t| elliptic.phi_rate(t));
-        }
-        top.motion = if separatrix {
-            TopMotion::Separatrix
-        } else if about_smallest {
-            TopMotion::AboutSmallest
-        } else {
-            TopMotion::AboutLargest
-        };
-        top.kind = Kind::Elliptic(Box::new(elliptic));
         Ok(top)
     }
 
@@ -397,6 +321,92 @@ impl TorqueFreeTop {
 }
 
 impl Elliptic {
+    /// The elliptic solution for distinct principal moments `arr` (body frame), initial body
+    /// rates `body_omega0` and unit orientation `q0`, with the motion it describes; `None` for a
+    /// steady spin about a principal axis (no elliptic motion).
+    fn new(arr: [f64; 3], body_omega0: DVec3, q0: DQuat) -> Option<(Self, TopMotion)> {
+        let mut order = [0usize, 1, 2];
+        order.sort_by(|&a, &b| arr[a].total_cmp(&arr[b]));
+        let i = [arr[order[0]], arr[order[1]], arr[order[2]]];
+        let axis = |k: usize| DVec3::AXES[order[k]];
+        let handed = axis(0).cross(axis(1)).dot(axis(2));
+        let sorted = DMat3::from_cols(axis(0), axis(1), axis(2) * handed);
+        let w = (sorted.transpose() * body_omega0).to_array();
+
+        // Cancellation-free invariant combinations.
+        let t = [i[0] * w[0] * w[0], i[1] * w[1] * w[1], i[2] * w[2] * w[2]];
+        let m_plus = t[0] * (i[2] - i[0]) + t[1] * (i[2] - i[1]); // 2EI₃ − M²
+        let m_minus = t[1] * (i[1] - i[0]) + t[2] * (i[2] - i[0]); // M² − 2EI₁
+        let (d_up, d_down) = (t[2] * (i[2] - i[1]), t[0] * (i[1] - i[0]));
+        let d = d_up - d_down; // M² − 2EI₂
+        if m_plus == 0.0 || m_minus == 0.0 || (w[0] == 0.0 && w[2] == 0.0) {
+            return None;
+        }
+        let separatrix = d.abs() <= 8.0 * f64::EPSILON * (d_up + d_down);
+        let (i1, i2, i3) = (i[0], i[1], i[2]);
+        let momentum = (0..3)
+            .map(|k| i[k] * w[k])
+            .fold(0.0f64, |acc, x| acc.hypot(x));
+
+        // The two cases (momentum about the largest or the smallest axis) are one formula with
+        // the roles of `(M² − 2EI₁, I₃ − I₂)` and `(2EI₃ − M², I₂ − I₁)` exchanged.
+        let about_smallest = !(d > 0.0 || separatrix);
+        let (a, gap_a, b, gap_b, d_signed) = if about_smallest {
+            (m_plus, i2 - i1, m_minus, i3 - i2, -d)
+        } else {
+            (m_minus, i3 - i2, m_plus, i2 - i1, d)
+        };
+        let (s1, s3) = (sign(w[0]), sign(w[2]));
+        let coeff = [
+            s1 * (m_plus / (i1 * (i3 - i1))).sqrt(),
+            s1 * s3 * (b / (i2 * gap_a)).sqrt(),
+            s3 * (m_minus / (i3 * (i3 - i1))).sqrt(),
+        ];
+        let lambda = (gap_a * a / (i1 * i2 * i3)).sqrt();
+        let (m, m1) = if separatrix {
+            (1.0, 0.0)
+        } else {
+            (gap_b * b / (gap_a * a), (i3 - i1) * d_signed / (gap_a * a))
+        };
+        // Euler axes (a, b, c) = sorted (2, 3, 1) in both cases: the cyclic relabelling
+        // x → y → z → x is the rotation by 120° about (1, 1, 1).
+        let cyclic = DQuat::from_axis_angle(DVec3::ONE.normalize(), 2.0 * FRAC_PI_3);
+        let euler_frame = DQuat::from_mat3(&sorted) * cyclic;
+        let cn_axis = if about_smallest { 2 } else { 0 };
+        let sn0 = w[1] / coeff[1];
+        let cn0 = w[cn_axis] / coeff[cn_axis];
+        let tau0 = incomplete_f_sin_cos(sn0, cn0, m, m1);
+        let quarter = complete_k_complement(m1);
+        let mut elliptic = Elliptic {
+            sorted,
+            i,
+            about_smallest,
+            coeff,
+            lambda,
+            m,
+            m1,
+            quarter,
+            tau0,
+            euler_frame,
+            world_from_l: DQuat::IDENTITY,
+            momentum,
+            phi_period: 0.0,
+        };
+        elliptic.world_from_l = q0 * euler_frame * elliptic.euler_rotation(0.0, 0.0).inverse();
+        if quarter.is_finite() {
+            let period = 2.0 * quarter / lambda;
+            elliptic.phi_period = elliptic.integrate(0.0, period, |t| elliptic.phi_rate(t));
+        }
+        let motion = if separatrix {
+            TopMotion::Separatrix
+        } else if about_smallest {
+            TopMotion::AboutSmallest
+        } else {
+            TopMotion::AboutLargest
+        };
+        Some((elliptic, motion))
+    }
+
     /// `(sn τ, cn τ, dn τ)` at time `t`.
     fn jacobi(&self, t: f64) -> (f64, f64, f64) {
         jacobi_sn_cn_dn_complement(self.lambda * t + self.tau0, self.m, self.m1)
