@@ -25,6 +25,8 @@ pub mod integrate;
 pub mod invariants;
 pub mod mass;
 pub mod math;
+// Plumbing of the ECS layer's batch loops, public only so that `tumble_ecs` can reach it.
+#[doc(hidden)]
 pub mod prefetch;
 pub mod rotation;
 #[cfg(any(feature = "parry", feature = "parry-f64"))]

@@ -28,5 +28,6 @@ pub mod run;
 pub mod spring_output;
 pub mod springs;
 pub mod stability;
+pub mod storage;
 pub mod thin;
 pub mod workprec;

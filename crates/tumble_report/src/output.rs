@@ -9,6 +9,7 @@ use crate::energy::EnergyTrace;
 use crate::springs::SpringRun;
 use crate::stability::Cell;
 use crate::workprec::Point;
+use tumble_core::math::REAL_NAME;
 
 /// Where and on what the report was measured.
 #[derive(Debug, Clone, Serialize)]
@@ -23,6 +24,9 @@ pub struct Machine {
     pub tumble_version: String,
     /// Quick mode (fewer, shorter runs).
     pub quick: bool,
+    /// The precision of the simulated state, `f32` or `f64` (the feature `f64`): every
+    /// tumble number of the report is in it; rapier's are in `f32`.
+    pub precision: String,
 }
 
 impl Machine {
@@ -43,6 +47,7 @@ impl Machine {
             os: std::env::consts::OS.to_owned(),
             tumble_version: env!("CARGO_PKG_VERSION").to_owned(),
             quick,
+            precision: REAL_NAME.to_owned(),
         }
     }
 }
@@ -66,6 +71,8 @@ pub struct Results {
     pub springs: Vec<SpringRun>,
     /// The thin asymmetric plate at every spin rate (see [`crate::thin`]).
     pub thin_plate: Vec<crate::thin::ThinRow>,
+    /// What `f32` state costs each scene (see [`crate::storage`]); empty in an `f32` build.
+    pub f32_storage: Vec<crate::storage::StorageRow>,
 }
 
 impl Results {
@@ -107,6 +114,7 @@ impl Results {
             energy,
             springs,
             thin_plate,
+            f32_storage: Vec::new(),
         }
     }
 }
@@ -255,12 +263,14 @@ pub fn markdown(results: &Results, plots: &[String]) -> String {
     let _ = writeln!(out, "# tumble accuracy report\n");
     let _ = writeln!(
         out,
-        "Machine: {} ({} cores, {}), tumble {}{}.\n",
+        "Machine: {} ({} cores, {}), tumble {}{}. State in `{}`: every tumble number below is \
+         in it (rapier's are in `f32`).\n",
         m.cpu,
         m.cores,
         m.os,
         m.tumble_version,
-        if m.quick { ", quick mode" } else { "" }
+        if m.quick { ", quick mode" } else { "" },
+        m.precision
     );
     let _ = writeln!(
         out,
@@ -305,6 +315,7 @@ pub fn markdown(results: &Results, plots: &[String]) -> String {
         }
         out.push('\n');
     }
+    out.push_str(&crate::storage::storage_section(&results.f32_storage));
     out.push_str(&thin_plate_section(&results.thin_plate));
     let _ = writeln!(
         out,

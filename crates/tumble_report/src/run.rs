@@ -178,7 +178,7 @@ fn measure_everything(quick: bool, cases: &[Case]) -> Result<Results, Box<dyn st
     let springs = spring_runs(if quick { 120 } else { 600 }, || bar.inc(1));
     bar.finish_and_clear();
 
-    let results = Results::new(
+    let mut results = Results::new(
         Machine::detect(quick),
         points,
         cells,
@@ -186,6 +186,7 @@ fn measure_everything(quick: bool, cases: &[Case]) -> Result<Results, Box<dyn st
         springs,
         thin_plate,
     );
+    results.f32_storage = crate::storage::storage_table(cases);
     Ok(results)
 }
 

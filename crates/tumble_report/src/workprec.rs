@@ -85,7 +85,12 @@ fn energy(case: &Case, s: &BodyState) -> f64 {
 /// `batch` copies of the case's body at step `dt`, with its load as the ECS and rapier see it:
 /// gravity as the world's, a force at a point as the body's load, and (for tumble; `springs`)
 /// a spring from the centre of mass to the world origin.
-fn comparison_scene(case: &Case, dt: Real, batch: usize, springs: bool) -> ComparisonScene {
+pub(crate) fn comparison_scene(
+    case: &Case,
+    dt: Real,
+    batch: usize,
+    springs: bool,
+) -> ComparisonScene {
     let mut body = ComparisonBody::new(case.name, case.mass, case.initial);
     let gravity = match case.load {
         Load::Gravity(g) => Some(g),

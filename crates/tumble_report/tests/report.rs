@@ -87,7 +87,7 @@ fn results_json_has_the_documented_shape() {
     let results = Results::new(Machine::detect(true), points, cells, energy, springs, thin);
     let json: serde_json::Value = serde_json::to_value(&results).unwrap();
     assert_eq!(json["schema"], 1);
-    let machine = ["cpu", "cores", "os", "tumble_version", "quick"];
+    let machine = ["cpu", "cores", "os", "tumble_version", "quick", "precision"];
     assert_has_keys(&json["machine"], "machine", &machine);
     let p = &json["work_precision"][0];
     let point = [
@@ -173,4 +173,69 @@ fn readme_markers_are_replaced() {
         "intro\n<!-- report:begin -->\n| new |\n<!-- report:end -->\nrest"
     );
     assert!(replace_between_markers("no markers", "report", "x").is_none());
+}
+
+/// Storing the state in `f32` rounds every stored number in an `f64` build and changes nothing
+/// in an `f32` build, where the state already is `f32`.
+#[test]
+fn f32_storage_rounds_exactly_what_the_f32_build_stores() {
+    use bevy_ecs::prelude::*;
+    use tumble_core::math::{DOUBLE_PRECISION, Quat, Real, Vec3};
+    use tumble_ecs::prelude::{Pose, RigidBody, Velocity};
+    let mut world = World::new();
+    let tenth = 0.1 as Real;
+    let body = world
+        .spawn((
+            RigidBody,
+            Pose::from_translation(Vec3::splat(tenth)),
+            Velocity::new(Vec3::splat(tenth), Vec3::splat(tenth)),
+        ))
+        .id();
+    world.get_mut::<Pose>(body).unwrap().rotation =
+        Quat::from_xyzw(tenth, 0.0, 0.0, (1.0 - tenth * tenth).sqrt());
+    tumble_report::storage::store_as_f32(&mut world);
+    let stored = 0.1f32 as Real;
+    let (pose, velocity) = (
+        world.get::<Pose>(body).unwrap(),
+        world.get::<Velocity>(body).unwrap(),
+    );
+    for x in [
+        pose.translation.x,
+        pose.rotation.x,
+        velocity.linear.y,
+        velocity.angular.z,
+    ] {
+        assert_eq!(x.to_bits(), stored.to_bits());
+    }
+    assert_eq!(stored == tenth, !DOUBLE_PRECISION);
+}
+
+/// The table has a row per scene in an `f64` build, with the storage cost measured (finite and
+/// non-zero on the spinning tops: thousands of roundings do move them), and none in an `f32`
+/// build.
+#[test]
+fn the_f32_storage_table_measures_every_scene_in_f64_only() {
+    let cases = cases();
+    let rows = tumble_report::storage::storage_table(&cases);
+    if !tumble_core::math::DOUBLE_PRECISION {
+        assert!(rows.is_empty());
+        return;
+    }
+    assert_eq!(rows.len(), cases.len());
+    for r in &rows {
+        assert!(
+            r.f64_error_rad.is_finite() && r.f64_error_m.is_finite(),
+            "{r:?}"
+        );
+        assert!(
+            r.f32_storage_rad.is_finite() && r.f32_storage_m.is_finite(),
+            "{r:?}"
+        );
+    }
+    for top in ["top-largest", "top-smallest", "dzhanibekov"] {
+        let r = rows.iter().find(|r| r.scene == top).unwrap();
+        // f32 rounding is 6e-8 relative per number; thousands of steps leave far more than the
+        // f64 state's own 1e-16, and far less than a radian.
+        assert!(r.f32_storage_rad > 1e-9 && r.f32_storage_rad < 0.5, "{r:?}");
+    }
 }
