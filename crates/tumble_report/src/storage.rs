@@ -34,6 +34,10 @@ pub struct StorageRow {
 }
 
 /// `x` rounded to the nearest `f32` (a no-op in an `f32` build).
+#[allow(
+    clippy::unnecessary_cast,
+    reason = "the cast rounds in an f64 build and is a no-op only where `Real` is f32"
+)]
 fn to_f32(x: Real) -> Real {
     x as f32 as Real
 }
