@@ -165,12 +165,14 @@ pub fn check_stability(world: &mut World) -> Vec<StabilityWarning> {
     if crate::springs::classification_is_stale(world) {
         crate::springs::classify_springs(world);
     }
+    // The spin checks judge one substep, `Δt/N`, which every stage of it shares.
+    let substep = settings.stages().span(settings.dt(), 0).substep;
     let mut warnings = Vec::new();
     check_springs(world, dt, &mut warnings);
     check_positions(world, dt, &mut warnings);
-    check_free_rotation(world, &settings, &mut warnings);
-    check_first_order(world, &settings, &mut warnings);
-    check_rk4(world, &settings, &mut warnings);
+    check_free_rotation(world, &settings, substep, &mut warnings);
+    check_first_order(world, &settings, substep, &mut warnings);
+    check_rk4(world, &settings, substep, &mut warnings);
     check_explicit_gyroscopic(world, &settings, dt, &mut warnings);
     note_implicit_groups(world, &settings, &mut warnings);
     warnings
@@ -244,13 +246,13 @@ fn check_positions(world: &mut World, dt: Real, warnings: &mut Vec<StabilityWarn
 fn check_free_rotation(
     world: &mut World,
     settings: &PhysicsSettings,
+    substep: Real,
     warnings: &mut Vec<StabilityWarning>,
 ) {
     // The split methods' free rotation. Under `auto` the step judges each body itself
     // (`ExactSwitch`) and gives the exact flow to those it would integrate badly: one notice
     // names the bodies that take it now. Under `method` each body whose split errs by more
     // than the limit a stage is warned of.
-    let substep = settings.dt() / settings.substeps.get() as Real;
     let mut spins = world.query_filtered::<(Entity, &MassProps, &Pose, &Velocity), (
         With<RigidBody>,
         Without<ImplicitBody>,
@@ -318,13 +320,13 @@ fn check_free_rotation(
 fn check_first_order(
     world: &mut World,
     settings: &PhysicsSettings,
+    h: Real,
     warnings: &mut Vec<StabilityWarning>,
 ) {
     if matches!(
         settings.integrator,
         Integrator::Lclamp | Integrator::ImplicitGyroscopic
     ) {
-        let h = settings.dt() / settings.substeps.get() as Real;
         let mut spins = world.query_filtered::<
             (Entity, &MassProps, &Velocity),
             (With<RigidBody>, Without<ImplicitBody>),
@@ -348,9 +350,13 @@ fn check_first_order(
 }
 
 /// Bodies whose `rk4` rotation is stiff.
-fn check_rk4(world: &mut World, settings: &PhysicsSettings, warnings: &mut Vec<StabilityWarning>) {
+fn check_rk4(
+    world: &mut World,
+    settings: &PhysicsSettings,
+    h: Real,
+    warnings: &mut Vec<StabilityWarning>,
+) {
     if settings.integrator == Integrator::Rk4 {
-        let h = settings.dt() / settings.substeps.get() as Real;
         let mut spins = world.query_filtered::<
             (Entity, &MassProps, &Pose, &Velocity),
             (With<RigidBody>, Without<ImplicitBody>),

@@ -88,9 +88,7 @@ impl BodySnapshot {
             held: record.part(Parts::HELD_LOAD, held),
             gravity_scale: record.part(Parts::GRAVITY_SCALE, GravityScale(gravity_scale)),
             damping: record.part(Parts::DAMPING, damping),
-            rejected: rejected
-                .filter(|_| parts.contains(Parts::REJECTED))
-                .map(|r| r.0.kind.to_string()),
+            rejected: rejected.map(|r| r.0.kind.to_string()),
         }
     }
 }
