@@ -40,6 +40,8 @@ pub use free_flow::{
 };
 mod implicit_gyroscopic;
 mod lclamp;
+mod momentum_flow;
+pub(crate) use momentum_flow::free_turn;
 mod rk4;
 mod splitting;
 mod stages;
@@ -187,6 +189,15 @@ impl Integrator {
             Integrator::Yoshida4 => Some(Integrator::Exact4),
             _ => None,
         }
+    }
+
+    /// True when the method turns a body by a torque-free flow that keeps the world momentum
+    /// (the drift–kick–drift methods: `splitting`, `splitting-xyz`, `yoshida4`, `rk4`, `exact`,
+    /// `exact4`): the methods the implicit spring step can run inside a stiff spring group (see
+    /// [`crate::springs::implicit`]). The first-order methods update `ω` with a gyroscopic
+    /// term instead.
+    pub fn turns_at_constant_momentum(self) -> bool {
+        self.samples_forces_at_midpoint()
     }
 
     /// True when the method drifts half a stage before forces are sampled (see

@@ -300,3 +300,30 @@ pub(crate) fn drift_kick_drift(
         rotation(state, mass, free_rotation_span(half, dt), impulse);
     }
 }
+
+impl FreeBody {
+    /// Exact flow of the Casimir `½ k |m|²` for time `h`: rotation about the body momentum by
+    /// `h k |m|` (`Q ← Q exp(θ m̂)`; `m` lies on the axis and is unchanged).
+    #[inline]
+    fn momentum_flow(&mut self, k: f64, h: f64) {
+        let length = self.m.length();
+        if length > 0.0 && k != 0.0 {
+            let (s, c) = crate::simd::sin_cos(0.5 * h * k * length);
+            let axis = self.m * (s / length);
+            self.q *= DQuat::from_xyzw(axis.x, axis.y, axis.z, c);
+        }
+    }
+}
+
+/// `splitting`'s free flow over `h` on a [`FreeBody`], in `f64`: `R(h/2) ∘ S(h) ∘ R(h/2)` with
+/// `odd` the axis `a` and `(b, c) = (a + 1, a + 2)` the symmetric pair, the sequence the lane
+/// kernel runs on its relabelled axes (see `symmetric_kernel`). The same method as the batched
+/// step, not the same bits (the kernel rounds its input to the engine's precision first).
+pub(super) fn symmetric_free_flow(body: &mut FreeBody, r: DVec3, odd: usize, h: f64) {
+    let (a, b, c) = (odd, (odd + 1) % 3, (odd + 2) % 3);
+    let residual = r[c] - r[b];
+    body.axis_flow(c, residual, 0.5 * h);
+    body.momentum_flow(r[b], h);
+    body.axis_flow(a, r[a] - r[b], h);
+    body.axis_flow(c, residual, 0.5 * h);
+}

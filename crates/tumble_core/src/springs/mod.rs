@@ -10,7 +10,9 @@ pub mod implicit;
 mod linear;
 mod sparse;
 
-pub use implicit::{GroupBody, GroupSpring, ImplicitSpringError, ImplicitSpringSolver, LinkEnd};
+pub use implicit::{
+    GroupBody, GroupRotation, GroupSpring, ImplicitSpringError, ImplicitSpringSolver, LinkEnd,
+};
 
 use crate::mass::MassProperties;
 use crate::math::{Real, Vec3};

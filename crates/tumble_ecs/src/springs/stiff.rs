@@ -5,7 +5,7 @@ use bevy_ecs::prelude::*;
 
 use tumble_core::math::{Real, Vec3};
 use tumble_core::springs::{
-    GroupBody, GroupSpring, IMPLICIT_OMEGA_DT, ImplicitSpringSolver, LinkEnd,
+    GroupBody, GroupRotation, GroupSpring, IMPLICIT_OMEGA_DT, ImplicitSpringSolver, LinkEnd,
     inverse_effective_mass_bound, omega_dt_bound,
 };
 
@@ -279,6 +279,7 @@ pub fn solve_implicit_springs(
             mass: m.0,
             load: acc.take(),
             load_moment: implicit.take_load_moment(),
+            rotation: GroupRotation::Midpoint,
         });
     }
     let groups = s.group_bodies(&springs);

@@ -17,8 +17,16 @@ impl ImplicitSpringSolver {
             let z = &self.z[6 * i..6 * i + 6];
             let vbar = v3(&z[..3]);
             let wbar = s.free * v3(&z[3..]);
-            let q1 = (s.q * cayley(h * wbar)).normalize();
+            let turn = s.turn(h, wbar);
+            let q1 = (s.q * turn).normalize();
             let pi1 = s.free * (2.0 * s.inertia * wbar - s.pi);
+            // A method's turn keeps the world momentum: the end's body momentum is the world's
+            // `L₁ = Q₀ (2 I Ω̄ − Π₀)` in the turned frame.
+            let pi1 = if s.method.is_some() {
+                turn.inverse() * pi1
+            } else {
+                pi1
+            };
             let omega1 = s.angular_velocity(pi1);
             let end = Pose {
                 x: s.x + h * vbar,

@@ -25,6 +25,10 @@ impl ImplicitSpringSolver {
             by_turn += skew(f0) * self.cayley_derivative[i] * skew(b);
         }
         let free = DMat3::from_diagonal(s.free);
+        if s.method.is_some() {
+            // Unturned torques (see `evaluate`): only the arms turn.
+            return free * (0.5 * h) * by_turn;
+        }
         let unturn = DMat3::IDENTITY - skew(0.5 * h * w);
         free * (0.5 * h) * (skew(c) + unturn * by_turn)
     }
@@ -39,7 +43,11 @@ impl ImplicitSpringSolver {
         }
         // ∂/∂Ω̄ of I Ω̄ + ½ h Ω̄ × I Ω̄ = I + ½ h ([Ω̄]× I − [I Ω̄]×).
         let inertia = DMat3::from_diagonal(s.inertia);
-        let gyro = 0.5 * h * (skew(w) * inertia - skew(s.inertia * w));
+        let gyro = if s.method.is_none() {
+            0.5 * h * (skew(w) * inertia - skew(s.inertia * w))
+        } else {
+            DMat3::ZERO
+        };
         let m = inertia + gyro;
         for a in 0..3 {
             if s.free[a] > 0.0 {
@@ -327,6 +335,7 @@ mod jacobian_tests {
             mass: MassProperties::new(Mass::new(m).unwrap(), Vec3::new(0.02, 0.03, 0.04)).unwrap(),
             load,
             load_moment: DMat3::ZERO,
+            rotation: GroupRotation::Midpoint,
         }
     }
 

@@ -84,6 +84,7 @@ use thiserror::Error;
 
 use super::linear::{Block, Krylov, block_mul, invert};
 use super::sparse::BlockLu;
+use crate::integrate::{Integrator, free_turn};
 use crate::mass::MassProperties;
 use crate::math::{Narrow, Real, Vec3, Widen};
 use crate::state::{BodyState, Wrench};
@@ -109,6 +110,36 @@ pub struct GroupBody {
     /// exactly the work `Fᵢ·Δpᵢ` and keeps the step symmetric. `load.torque` must not contain
     /// it.
     pub load_moment: DMat3,
+    /// How the step turns the body: the energy-exact Cayley midpoint, or a method's free
+    /// rotation at the step's mean momentum (see the module docs).
+    pub rotation: GroupRotation,
+}
+
+/// How the implicit step turns a body of the group (see the module docs).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum GroupRotation {
+    /// The Cayley rotation by the mean body rate, with Euler's equations at the midpoint:
+    /// kinetic plus elastic energy conserved exactly at any step.
+    #[default]
+    Midpoint,
+    /// The torque-free rotation of a drift–kick–drift method (see
+    /// [`Integrator::turns_at_constant_momentum`]) at the step's mean world momentum `L̄`:
+    /// torque-free, exactly that method's step; momenta conserved exactly, energy to the
+    /// method's accuracy.
+    Method(Integrator),
+}
+
+impl GroupRotation {
+    /// The rotation of `integrator` in a stiff group: [`GroupRotation::Method`], or
+    /// [`ImplicitSpringError::CannotCombine`] for a method without a free rotation at constant
+    /// momentum (the first-order methods).
+    pub fn of(integrator: Integrator) -> Result<Self, ImplicitSpringError> {
+        if integrator.turns_at_constant_momentum() {
+            Ok(GroupRotation::Method(integrator))
+        } else {
+            Err(ImplicitSpringError::CannotCombine { integrator })
+        }
+    }
 }
 
 /// The second end of a [`GroupSpring`].
@@ -160,6 +191,18 @@ pub enum ImplicitSpringError {
     /// A value became NaN or infinite.
     #[error("implicit spring step produced a non-finite value")]
     NonFinite,
+    /// The body's method cannot run inside the implicit step: a first-order method updates
+    /// `ω` with its own gyroscopic term, not by a free rotation at constant momentum (see
+    /// [`GroupRotation::of`]).
+    #[error(
+        "`{integrator}` cannot step a stiff spring group (its gyroscopic update is not a free \
+         rotation at constant momentum): choose `splitting`, `splitting-xyz`, `yoshida4`, `rk4`, \
+         `exact` or `exact4`, or springs = `explicit` with a time step small enough for them"
+    )]
+    CannotCombine {
+        /// The method.
+        integrator: Integrator,
+    },
     /// A spring names a body index outside the group.
     #[error("spring names body {index} of a group of {len}")]
     BadIndex {
@@ -217,12 +260,29 @@ struct Start {
     moment: DMat3,
     /// Inertia scale of the locked-axis rows (keeps the block well conditioned).
     lock_scale: f64,
+    /// The method whose free rotation turns the body, `None` for the Cayley midpoint.
+    method: Option<Integrator>,
+    /// `splitting`'s odd axis of the body (see [`free_turn`]).
+    odd: usize,
 }
 
 impl Start {
     /// The body-frame angular velocity `I⁻¹ Π` of a body momentum, 0 on a locked axis.
     fn angular_velocity(&self, pi: DVec3) -> DVec3 {
         self.free * pi / self.inertia.max(DVec3::splat(f64::MIN_POSITIVE))
+    }
+
+    /// The turn `Q₀ᵀQ₁` of the step at the mean body rate `Ω̄` (masked): `cay(hΩ̄)`, or the
+    /// method's free rotation over `h` from the mean body momentum `I Ω̄`.
+    fn turn(&self, h: f64, wbar: DVec3) -> DQuat {
+        match self.method {
+            None => cayley(h * wbar),
+            Some(method) => {
+                let r = self.angular_velocity(DVec3::ONE);
+                free_turn(method, self.inertia * wbar, r, self.odd, h)
+                    .unwrap_or_else(|| cayley(h * wbar))
+            }
+        }
     }
 }
 
@@ -349,6 +409,10 @@ const REFACTOR_ABOVE: f64 = 0.3;
 /// See the `f32` constant: in `f64` every iteration is a Newton step.
 #[cfg(feature = "f64")]
 const REFACTOR_ABOVE: f64 = 0.0;
+
+/// The fraction of [`ImplicitSpringSolver::tolerance`] a group with a method's turn converges
+/// to (see `solve`).
+const METHOD_TURN_TOLERANCE: f64 = 1e-2;
 
 /// A chord step that shrinks the update by less than this factor is followed by a refactor.
 const CHORD_RATE: f64 = 0.25;
