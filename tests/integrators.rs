@@ -14,4 +14,5 @@ mod integrators {
     pub(crate) mod harness;
     pub(crate) mod stability;
     pub(crate) mod stages;
+    pub(crate) mod stiff_groups;
 }

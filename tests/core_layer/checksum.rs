@@ -180,13 +180,13 @@ fn pinned_checksums_of_the_reference_scene() {
 
 /// `f32` build (the default), with or without `enhanced-determinism`.
 const PINNED_F32: &[(&str, &str)] = &[
-    ("symplectic-euler", "6203f683c01c96497bc936bcf95576d5"),
+    ("symplectic-euler", "c5db2f2c262e149030185e223eb09a1a"),
     (
         "symplectic-euler-linear",
-        "426088e9a7039195e24fd304b33aa0d3",
+        "0ee71af065cc8ca38c1baed74d6a9a9f",
     ),
-    ("lclamp", "7f6fc4b6512ecac289177f6e1708e66f"),
-    ("implicit-gyroscopic", "81cba1b220337d5c24bea0728914a51e"),
+    ("lclamp", "adfeae92e481cfc7201e5b0ca55c269e"),
+    ("implicit-gyroscopic", "2027464a294602a86a4ccc7eca13d53b"),
     ("splitting", "eeb058f6046b0250a9c2196d0a8f8f6c"),
     ("splitting-xyz", "16c8135b2e93689eeb2b58f040adfe40"),
     ("yoshida4", "ea227359d32e9094363db7a11b72e5f9"),
@@ -196,13 +196,13 @@ const PINNED_F32: &[(&str, &str)] = &[
 ];
 /// `f64` build (with or without `enhanced-determinism`).
 const PINNED_F64: &[(&str, &str)] = &[
-    ("symplectic-euler", "5d51b24cd17df80ebd71491a54b6fff6"),
+    ("symplectic-euler", "67a41b4c0275998121de24a0f316ab63"),
     (
         "symplectic-euler-linear",
-        "8cd25156427d5ebc5a854fb51078f39e",
+        "06e0565da47460a7df34e836a6f8639d",
     ),
-    ("lclamp", "959f32e892a9619403e6c67af92a5a2d"),
-    ("implicit-gyroscopic", "da15a928ce3daaab0e31b6e0502057cc"),
+    ("lclamp", "6dd9d9998431ea87195246e5705f6cb2"),
+    ("implicit-gyroscopic", "1cccae935c7fced898391408014b2c2a"),
     ("splitting", "3ea9451fb452b3378549ed287c76ab76"),
     ("splitting-xyz", "86629318f710c3f9589280c0a6d92f18"),
     ("yoshida4", "7fe2f6c503ece11d652ab72ea66c6776"),

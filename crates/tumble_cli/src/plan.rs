@@ -70,10 +70,24 @@ fn methods_line(world: &mut World, names: &Names) -> String {
                     .map_or("exact", |m| m.name()),
                 names.of(body)
             )),
-            StabilityWarning::ImplicitGroups { body, bodies, .. } => out.push_str(&format!(
-                "; {bodies} {} in stiff spring groups, stepped by the implicit spring solve, \
+            StabilityWarning::ImplicitGroups {
+                body,
+                bodies,
+                midpoint,
+                ..
+            } => out.push_str(&format!(
+                "; {bodies} {} in stiff spring groups, stepped by the implicit spring solve \
+                 (rotation by `{}` for {}, by the implicit midpoint for {midpoint}), first {}",
+                if bodies == 1 { "body" } else { "bodies" },
+                settings.integrator,
+                bodies - midpoint,
+                names.of(body)
+            )),
+            StabilityWarning::CannotCombine { body, bodies, .. } => out.push_str(&format!(
+                "; {bodies} {} in stiff spring groups, which `{}` cannot step (refused), \
                  first {}",
                 if bodies == 1 { "body" } else { "bodies" },
+                settings.integrator,
                 names.of(body)
             )),
             _ => {}

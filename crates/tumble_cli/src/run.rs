@@ -426,8 +426,8 @@ pub(crate) fn stability_gate(
         return Err(Failure::new(
             exit::UNSTABLE,
             format!(
-                "{unstable} setting(s) outside the integrator's stable region (warnings above); \
-                 nothing was run; lower the time step or the stiffness, or pass \
+                "{unstable} setting(s) outside the integrator's stable region or that it \
+                 cannot run (warnings above); nothing was run; follow the warnings, or pass \
                  --allow-unstable to run anyway"
             ),
         ));

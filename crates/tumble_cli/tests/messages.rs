@@ -198,8 +198,10 @@ fn a_predicted_divergence_is_refused_with_exit_4_unless_allowed() {
 }
 
 /// By default the same chain at the same step takes the implicit spring step: no refusal, no
-/// quarantine, exit 0, and one warning that says the implicit solve steps its bodies, not the
-/// selected integrator.
+/// quarantine, exit 0, and one warning that says the implicit solve steps its bodies and how
+/// it turns them (by `splitting`: its springs hold the links at their centres, so they do not
+/// turn them); `--plan` says the same. A first-order method cannot be combined with the implicit step: refused
+/// (exit 4), naming the method and what to choose instead, nothing run.
 #[test]
 fn by_default_a_stiff_chain_runs_on_the_implicit_step() {
     let output = tumble_run(&["run", "spring_chain", "--dt", "0.2", "--steps", "200"]);
@@ -209,14 +211,39 @@ fn by_default_a_stiff_chain_runs_on_the_implicit_step() {
     assert_eq!(warnings.len(), 1, "{text}");
     assert!(
         warnings[0].contains("stepped by the implicit spring solve")
-            && warnings[0].contains("not by `splitting`"),
+            && warnings[0]
+                .contains("rotation by `splitting` for 3, by the implicit midpoint for 0"),
         "{text}"
     );
     let plan = tumble_run(&["run", "spring_chain", "--dt", "0.2", "--plan"]);
+    let plan = String::from_utf8_lossy(&plan.stdout);
     assert!(
-        String::from_utf8_lossy(&plan.stdout).contains("solve_implicit_springs"),
+        plan.contains("solve_implicit_springs")
+            && plan.contains("(rotation by `splitting` for 3, by the implicit midpoint for 0)"),
+        "{plan}"
+    );
+    let first_order = tumble_run(&[
+        "run",
+        "spring_chain",
+        "--dt",
+        "0.2",
+        "--integrator",
+        "symplectic-euler",
+        "--steps",
+        "5",
+    ]);
+    assert_eq!(
+        first_order.status.code(),
+        Some(4),
         "{}",
-        String::from_utf8_lossy(&plan.stdout)
+        stderr(&first_order)
+    );
+    let text = stderr(&first_order);
+    assert!(
+        text.contains("which `symplectic-euler` cannot step")
+            && text.contains("springs = `explicit`")
+            && text.contains("nothing was run"),
+        "{text}"
     );
 }
 

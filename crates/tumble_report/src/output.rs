@@ -322,8 +322,10 @@ pub fn markdown(results: &Results, plots: &[String]) -> String {
         "## Stability matrix\n\nEvery scene conserves its total energy (kinetic + spring + gravity) \
          physically. Verdict on it, checked after every step: **right** = finite, `||q| − 1| < \
          1e-5`, `E/E₀` within 1 ± 5 %; **dissipative** = never above 1.05 but more than 5 % lost; \
-         **bounded** = more than 5 % gained at some step but within [0.01, 100]; **unstable** = \
-         anything else (bold). \"warned\" = tumble's planning-time prediction of a divergence; \
+         **bounded** = more than 5 % gained at some step but within [0.01, 100]; **refused** = \
+         not run: a first-order method cannot step a stiff spring group (the implicit step \
+         needs a free rotation at constant momentum); **unstable** = anything else (bold). \
+         \"warned\" = tumble's planning-time prediction of a divergence or a refusal; \
          `springs` = the spring step (`auto` takes the implicit one for stiff groups). The same \
          verdicts as a heatmap: [stability.svg](stability.svg).\n"
     );

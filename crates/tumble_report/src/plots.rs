@@ -177,7 +177,7 @@ pub fn plot_stability(dir: &Path, cells: &[Cell]) -> Result<String, Box<dyn std:
     svg(dir, file, (width as u32, height as u32), |root| {
         let text = ("sans-serif", 11).into_font();
         root.draw(&Text::new(
-        "verdict on total energy: green right · yellow dissipative · blue bounded · red unstable · w = predicted",
+        "verdict on total energy: green right · yellow dissipative · blue bounded · grey refused · red unstable · w = predicted",
         (8, 8),
         text.clone(),
     ))?;
@@ -214,6 +214,7 @@ pub fn plot_stability(dir: &Path, cells: &[Cell]) -> Result<String, Box<dyn std:
                     "right" => RGBColor(76, 175, 80),
                     "dissipative" => RGBColor(255, 193, 7),
                     "bounded" => RGBColor(100, 160, 230),
+                    "refused" => RGBColor(150, 150, 150),
                     _ => RGBColor(220, 50, 47),
                 };
                 let x = left + cell_w * j as i32;

@@ -34,6 +34,9 @@ pub struct Cell {
     pub energy_range: [f64; 2],
     /// tumble's planning-time stability prediction warned.
     pub warned: bool,
+    /// The step refuses the setting (a first-order method on a stiff spring group, which it
+    /// cannot combine with the implicit spring step): not run.
+    pub refused: bool,
 }
 
 impl Cell {
@@ -54,10 +57,13 @@ impl Cell {
     ///   damping);
     /// - `bounded`: stable (a method near the edge of its stable region swings by up to ×100 and
     ///   comes back), but more than 5 % gained at some step;
-    /// - `unstable`: not [`stable`](Self::stable).
+    /// - `unstable`: not [`stable`](Self::stable);
+    /// - `refused`: the step refuses the setting (see [`Cell::refused`]).
     pub fn verdict(&self) -> &'static str {
         let [low, high] = self.energy_range;
-        if !self.stable() {
+        if self.refused {
+            "refused"
+        } else if !self.stable() {
             "unstable"
         } else if high <= 1.0 + ENERGY_BAND && low >= 1.0 - ENERGY_BAND {
             "right"
@@ -83,7 +89,11 @@ fn run(
     integrator: Integrator,
     setting: String,
 ) -> Cell {
-    let warned = check_stability(world).iter().any(|w| w.is_instability());
+    let warnings = check_stability(world);
+    let warned = warnings.iter().any(|w| w.is_instability());
+    let refused = warnings
+        .iter()
+        .any(|w| matches!(w, StabilityWarning::CannotCombine { .. }));
     let springs = if world.query::<&Spring>().iter(world).next().is_some() {
         world.resource::<PhysicsSettings>().springs.name()
     } else {
@@ -93,9 +103,9 @@ fn run(
     let e0 = total_energy(world, floor);
     let mut physics = PhysicsRunner::new(world);
     let mut max_q = 0.0_f64;
-    let mut finite = true;
+    let mut finite = !refused;
     let mut range = [1.0_f64, 1.0];
-    for _ in 0..steps {
+    for _ in 0..if refused { 0 } else { steps } {
         physics.step(world);
         world.clear_trackers();
         let mut q = world.query::<(&Pose, Option<&Rejected>)>();
@@ -120,6 +130,7 @@ fn run(
         energy_ratio: if finite { e1 / e0 } else { f64::NAN },
         energy_range: if finite { range } else { [f64::NAN; 2] },
         warned,
+        refused,
     }
 }
 

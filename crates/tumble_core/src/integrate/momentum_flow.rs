@@ -48,7 +48,7 @@ pub(crate) fn free_turn(
 mod tests {
     use super::*;
     use crate::mass::{Mass, MassProperties};
-    use crate::math::{Real, Vec3};
+    use crate::math::{Real, Vec3, Widen};
     use crate::state::{BodyState, Wrench};
 
     /// Each method's turn from the momentum is its own torque-free step: the same orientation
@@ -59,7 +59,7 @@ mod tests {
         let mass = MassProperties::new(Mass::new(2.0).unwrap(), inertia).unwrap();
         let omega = Vec3::new(0.7, -1.3, 2.1);
         let h: Real = 0.05;
-        let eps = f64::from(Real::EPSILON);
+        let eps = Real::EPSILON.widen();
         for &method in Integrator::ALL {
             let state = BodyState {
                 angular_velocity: omega,
@@ -67,17 +67,9 @@ mod tests {
             };
             let odd = mass.odd_axis();
             let frame = mass.principal_frame();
-            let m = {
-                let i = mass.principal_inertia();
-                let w = frame.inverse() * omega;
-                DVec3::new(
-                    f64::from(i.x * w.x),
-                    f64::from(i.y * w.y),
-                    f64::from(i.z * w.z),
-                )
-            };
-            let r = DVec3::ONE / crate::math::Widen::widen(mass.principal_inertia());
-            let turn = free_turn(method, m, r, odd, f64::from(h));
+            let m = (mass.principal_inertia() * (frame.inverse() * omega)).widen();
+            let r = DVec3::ONE / mass.principal_inertia().widen();
+            let turn = free_turn(method, m, r, odd, h.widen());
             assert_eq!(
                 turn.is_some(),
                 method.turns_at_constant_momentum(),
@@ -93,10 +85,10 @@ mod tests {
             };
             stage.whole_stage(&mut stepped, &mass, &Wrench::ZERO, h);
             let expected = stepped.rotation;
-            let f = crate::math::Widen::widen(frame);
+            let f = frame.widen();
             let got = f * turn * f.inverse();
             // The angle of `expected⁻¹ got` from its vector part (well conditioned near 0).
-            let apart = crate::math::Widen::widen(expected).inverse() * got;
+            let apart = expected.widen().inverse() * got;
             let angle = 2.0 * apart.xyz().length().min(1.0).asin();
             assert!(angle < 8.0 * eps, "{method}: {angle:e} rad apart");
         }

@@ -536,15 +536,14 @@ fn a_method_s_turn_costs_energy_at_second_order() {
         })
         .collect();
     eprintln!("energy errors at Δt/2, /4, /8 of 1/60: {errors:?}");
-    // Second order: a factor 4 per halving; at least 2.5 (first order would give 2), above
-    // the `f32` rounding floor of 10 s of steps.
-    let floor = 1200.0 * per_step_rounding();
-    for pair in errors.windows(2) {
-        assert!(
-            pair[1] <= floor || pair[0] / pair[1] >= 2.5,
-            "energy errors {errors:?} do not fall at second order"
-        );
-    }
+    // Second order over the two halvings (a factor 16; first order would give 4): measured
+    // ×20 in both precisions; at least ×10, an order of 1.66. (The first halving, from
+    // `ωΔt` 0.25, is not yet asymptotic: ×3 in `f64`, ×2.4 in `f32`.)
+    let ratio = errors[0] / errors[2];
+    assert!(
+        ratio >= 10.0,
+        "energy errors {errors:?} do not fall at second order (×{ratio:.1})"
+    );
 }
 
 /// Torque-free, a method's turn is that method's free flow exactly: a group whose springs are
@@ -613,5 +612,47 @@ fn a_first_order_method_is_refused() {
             );
             assert!(bodies.iter().zip(&before).all(|(b, s)| b.state == *s));
         }
+    }
+}
+
+/// `turning_compliance` is the largest eigenvalue of `M = Σ rᵢ uᵢuᵢᵀ` (module docs), found here
+/// by power iteration on the matrix built term by term, for boxes, a thin plate pulled along
+/// and across its thin axis, a rod, a locked axis and a body with a rotated principal frame.
+#[test]
+fn turning_compliance_is_the_largest_eigenvalue() {
+    let cases: [(Vec3, Vec3); 6] = [
+        (Vec3::new(1.0, 2.0, 2.5), Vec3::new(0.3, -0.2, 0.1)),
+        (Vec3::new(0.01, 1.0, 1.01), Vec3::new(0.5, 0.0, 0.0)),
+        (Vec3::new(0.01, 1.0, 1.01), Vec3::new(0.0, 0.5, 0.0)),
+        (Vec3::new(1e-4, 1.0, 1.0001), Vec3::new(0.2, 0.1, 0.0)),
+        (Vec3::new(0.0, 1.0, 1.0), Vec3::new(0.1, 0.2, 0.3)),
+        (Vec3::new(2.0, 2.0, 2.0), Vec3::new(0.0, 0.0, 0.0)),
+    ];
+    for (inertia, anchor) in cases {
+        let mass = MassProperties::new(Mass::new(1.0).unwrap(), inertia).unwrap();
+        let got = turning_compliance(&mass, anchor).widen();
+        let arm =
+            (mass.principal_frame().inverse() * (anchor - mass.local_center_of_mass())).widen();
+        let r = mass.inv_principal_inertia().widen();
+        let mut m = glam::DMat3::ZERO;
+        for (i, e) in [DVec3::X, DVec3::Y, DVec3::Z].into_iter().enumerate() {
+            let u = e.cross(arm);
+            m += glam::DMat3::from_cols(u * u.x, u * u.y, u * u.z) * r[i];
+        }
+        let mut v = DVec3::new(0.3, 0.7, -0.5);
+        let mut largest = 0.0;
+        for _ in 0..500 {
+            let w = m * v;
+            largest = w.length();
+            if largest == 0.0 {
+                break;
+            }
+            v = w / largest;
+        }
+        let tolerance = 1e-5 * largest.max(1e-30) + 1e-12;
+        assert!(
+            (got - largest).abs() <= tolerance,
+            "I {inertia}, anchor {anchor}: {got:e} against {largest:e}"
+        );
     }
 }

@@ -9,8 +9,9 @@
 //! `(ωΔt)²/4` of it and diverges at `ωΔt ≥ 2`. A group of bodies joined by springs (a connected
 //! component of the spring graph over dynamic bodies) that can vibrate at
 //! `ωΔt ≥` [`IMPLICIT_OMEGA_DT`](tumble_core::springs::IMPLICIT_OMEGA_DT) is stepped instead by the energy-conserving implicit step of
-//! [`tumble_core::springs::implicit`], as a whole: stable at any stiffness, with kinetic plus
-//! elastic energy conserved exactly and no numerical damping. `ω` is bounded above per body, over
+//! [`tumble_core::springs::implicit`], as a whole: stable at any stiffness, momenta kept
+//! exactly, no numerical damping, and kinetic plus elastic energy conserved exactly where the
+//! bodies turn by the implicit midpoint (below). `ω` is bounded above per body, over
 //! all of its springs and with the anchors' lever arms:
 //! `ω² ≤ max_bodies Σ_(its springs) k (ι_a + ι_b)`, `ι = 1/m + |r|² max I⁻¹` per end (a
 //! Gershgorin-style bound on the group's stiffness matrix, exact for the top mode of a uniform
@@ -29,6 +30,51 @@
 //! redone when the time step, the setting or the number of springs changes (a
 //! [`PhysicsRunner`](crate::schedule::PhysicsRunner) notices); after changing a spring's stiffness
 //! or a body's mass in place, re-insert the spring (or plan again) to re-classify.
+//!
+//! ### Which rotation the implicit step runs
+//!
+//! The implicit step solves each body's translation together with the springs (implicit
+//! midpoint, the springs' discrete gradient), and turns it one of two ways
+//! ([`GroupRotation`](tumble_core::springs::GroupRotation)):
+//!
+//! - **By the world's integrator** — its torque-free flow (`splitting`'s split, `exact`'s
+//!   elliptic functions, …) at the step's mean world momentum, with the springs' torques solved
+//!   with it. Torque-free this is that integrator's own step; with springs, momenta are kept
+//!   exactly and the energy to the method's accuracy, about `(ω_turn Δt)²/4` of the energy the
+//!   springs exchange with the body's rotation. `splitting`, `splitting-xyz` and `yoshida4`
+//!   switch a fast thin body to `exact`/`exact4` here as everywhere
+//!   ([`FreeFlow`](tumble_core::integrate::FreeFlow)). A body takes this turn where its
+//!   springs turn it slowly, `ω_turn <` [`METHOD_TURN_RATE`](tumble_core::springs::METHOD_TURN_RATE)
+//!   (1.8 rad/s: 0.03 rad in a step of 1/60 s, the energy they exchange with its rotation kept
+//!   to ≈ 2e-4 of it there): a wheel or a rotor on stiff springs at its axle, a light spinning
+//!   body hung by its centre. There the implicit midpoint would lag a spin's phase by
+//!   `(|ω|Δt)²/12` a step, 4e-2 rad over 10 s at 5 rad/s and 60 Hz. A rate, not an `ωΔt`, so
+//!   that refining `Δt` never changes the choice (a convergence study would mix two
+//!   discretisations); only steps over 1/6 s, where `ω_turn Δt` would reach
+//!   [`IMPLICIT_OMEGA_DT`](tumble_core::springs::IMPLICIT_OMEGA_DT), fall back to the midpoint.
+//! - **By the implicit midpoint** (Cayley rotation by the mean body rate, Euler's equations at
+//!   the midpoint) otherwise: kinetic plus elastic energy kept exactly at any stiffness. Where
+//!   springs turn a body stiffly, the method's free flow with stiff torques between its turns
+//!   is an explicit rotation under them, as unstable as the explicit spring step (measured: a
+//!   free net's energy grows eighteenfold in 300 steps at `ωΔt` 10), and its spin is mostly
+//!   theirs (a swinging chain link).
+//!
+//! `ω_turn² = Σ_(its spring ends) k c`, `c` the end's
+//! [`turning_compliance`](tumble_core::springs::turning_compliance) (the largest
+//! `(r × n)ᵀ I⁻¹ (r × n)` over directions, `r` the anchor's arm from the centre of mass), is
+//! fixed when the springs are classified, as the choice is: the same for every stage of a run
+//! (a composition stays symmetric), it changes only with the springs, the masses or the setting
+//! (and steps over 1/6 s), and `--plan` says it.
+//!
+//! The first-order methods (`symplectic-euler`, `symplectic-euler-linear`, `lclamp`,
+//! `implicit-gyroscopic`) have no torque-free flow at constant momentum to combine: an implicit
+//! group under them is refused — the planner warns
+//! ([`StabilityWarning::CannotCombine`](crate::stability::StabilityWarning::CannotCombine), which
+//! the CLI refuses to run) and the step records
+//! [`ImplicitSpringError::CannotCombine`](tumble_core::springs::ImplicitSpringError::CannotCombine)
+//! for each body of the group, which keeps its state. Use springs = `explicit` with a time step
+//! small enough for the springs, or a drift–kick–drift method. `tumble run --plan` and the
+//! run's warnings say which bodies turn which way.
 //!
 //! Bodies of an implicit group are marked [`ImplicitBody`](crate::components::ImplicitBody) and their springs [`ImplicitSpring`](crate::components::ImplicitSpring):
 //! the half drift and the explicit integrate systems skip them, `apply_springs` skips their

@@ -3,10 +3,11 @@
 use bevy_ecs::entity::EntityHashMap;
 use bevy_ecs::prelude::*;
 
+use tumble_core::integrate::ExactSwitch;
 use tumble_core::math::{Real, Vec3};
 use tumble_core::springs::{
     GroupBody, GroupRotation, GroupSpring, IMPLICIT_OMEGA_DT, ImplicitSpringSolver, LinkEnd,
-    inverse_effective_mass_bound, omega_dt_bound,
+    inverse_effective_mass_bound, omega_dt_bound, turning_compliance,
 };
 
 use crate::components::{
@@ -120,9 +121,21 @@ pub fn classify_springs(world: &mut World) {
         })
         .collect();
     let mut pull: Vec<Real> = vec![0.0; masses.len()];
+    // Per body, `Σ k c` over its spring ends, `c` the end's turning compliance: how stiffly
+    // its springs turn it (see the module docs).
+    let mut turn: Vec<Real> = vec![0.0; masses.len()];
     for ((_, spring), &(a, b, iota)) in springs.iter().zip(&ends) {
         for i in [a, b].into_iter().flatten() {
             pull[i] += spring.stiffness * (iota[0] + iota[1]);
+        }
+        let anchor_b = match spring.b {
+            SpringEnd::Body { anchor, .. } => anchor,
+            SpringEnd::World(_) => Vec3::ZERO,
+        };
+        for (end, anchor) in [(a, spring.anchor_a), (b, anchor_b)] {
+            if let Some(i) = end {
+                turn[i] += spring.stiffness * turning_compliance(&masses[i], anchor);
+            }
         }
     }
     for ((_, spring), &(a, b, iota)) in springs.iter().zip(&ends) {
@@ -163,10 +176,11 @@ pub fn classify_springs(world: &mut World) {
         });
         implicit_spring.push(stiff);
     }
-    let mut implicit_body = vec![false; masses.len()];
+    // Per dynamic body, `Some(ω_turn)` for a body of an implicit group.
+    let mut implicit_body = vec![None; masses.len()];
     for (i, flag) in implicit_body.iter_mut().enumerate() {
         let r = find(&mut parent, i);
-        *flag = stiff_group[r];
+        *flag = stiff_group[r].then(|| turn[i].sqrt());
     }
     mark_stiff(world, &springs, implicit_spring, &index, &implicit_body);
     let springs = spring_count(world);
@@ -178,14 +192,14 @@ pub fn classify_springs(world: &mut World) {
 }
 
 /// Puts [`ImplicitSpring`] on the springs and [`ImplicitBody`] on the bodies the classification
-/// found stiff (`implicit_spring` per spring, `implicit_body` per dynamic body of `index`), and
-/// takes them off the others.
+/// found stiff (`implicit_spring` per spring, `implicit_body` per dynamic body of `index`: its
+/// turning rate if stiff), and takes them off the others.
 fn mark_stiff(
     world: &mut World,
     springs: &[(Entity, Spring)],
     implicit_spring: Vec<bool>,
     index: &EntityHashMap<usize>,
-    implicit_body: &[bool],
+    implicit_body: &[Option<Real>],
 ) {
     for ((entity, _), stiff) in springs.iter().zip(implicit_spring) {
         let has = world.get::<ImplicitSpring>(*entity).is_some();
@@ -200,12 +214,22 @@ fn mark_stiff(
         .iter(world)
         .collect();
     for entity in bodies {
-        let stiff = index.get(&entity).is_some_and(|&i| implicit_body[i]);
-        let has = world.get::<ImplicitBody>(entity).is_some();
-        if stiff && !has {
-            world.entity_mut(entity).insert(ImplicitBody::default());
-        } else if !stiff && has {
-            world.entity_mut(entity).remove::<ImplicitBody>();
+        let stiff = index.get(&entity).and_then(|&i| implicit_body[i]);
+        match (stiff, world.get_mut::<ImplicitBody>(entity)) {
+            (Some(turn), Some(mut body)) => {
+                if body.turn_rate() != turn {
+                    body.set_turn_rate(turn);
+                }
+            }
+            (Some(turn), None) => {
+                world
+                    .entity_mut(entity)
+                    .insert(ImplicitBody::turned_at(turn));
+            }
+            (None, Some(_)) => {
+                world.entity_mut(entity).remove::<ImplicitBody>();
+            }
+            (None, None) => {}
         }
     }
 }
@@ -262,6 +286,7 @@ pub fn solve_implicit_springs(
     let span = cursor.span(&settings);
     let dt = span.h;
     let half_substep = 0.5 * span.substep;
+    let switch = ExactSwitch::new(settings.integrator, settings.free_flow, span.substep);
     for ((entity, t, mut v, m, mut acc, damping), mut implicit) in &mut bodies {
         // `Damping` is a flow of its own, half a substep before the substep and half after (see
         // `tumble_core::damping`), as on the explicit path.
@@ -274,12 +299,14 @@ pub fn solve_implicit_springs(
         s.index.insert(entity, s.entities.len());
         s.parent.push(s.entities.len());
         s.entities.push(entity);
+        let state = body_state(&t, &v, m);
+        let rotation = group_rotation(&settings, switch.as_ref(), &implicit, &state, &m.0);
         s.all.push(GroupBody {
-            state: body_state(&t, &v, m),
+            state,
             mass: m.0,
             load: acc.take(),
             load_moment: implicit.take_load_moment(),
-            rotation: GroupRotation::Midpoint,
+            rotation,
         });
     }
     let groups = s.group_bodies(&springs);
@@ -325,6 +352,29 @@ pub fn solve_implicit_springs(
                 }
             }
         }
+    }
+}
+
+/// How the implicit solve turns a body of a stiff group (see the module docs): by the world's
+/// integrator (its exact counterpart where `switch` gives the body the exact free flow this
+/// stage) where its springs turn it softly, by the implicit midpoint otherwise. A method that
+/// cannot be combined is passed on as it is, for the solve to refuse.
+fn group_rotation(
+    settings: &PhysicsSettings,
+    switch: Option<&ExactSwitch>,
+    implicit: &ImplicitBody,
+    state: &tumble_core::BodyState,
+    mass: &tumble_core::MassProperties,
+) -> GroupRotation {
+    let method = settings.integrator;
+    if method.turns_at_constant_momentum()
+        && implicit.turns_by_midpoint(classification_span(settings))
+    {
+        return GroupRotation::Midpoint;
+    }
+    match switch {
+        Some(switch) if switch.applies(state, mass) => GroupRotation::Method(switch.exact()),
+        _ => GroupRotation::Method(method),
     }
 }
 

@@ -23,10 +23,13 @@
 //!   (≈ 32/(Ω²Δt)): I = (1, 2, 3) at 20 rad/s and 60 Hz gives 4.8 s (measured: 3.5 s). A warning
 //!   is raised when `t*` is shorter than [`EXPLICIT_GYROSCOPIC_HORIZON`].
 //!
-//! Bodies in stiff spring groups are stepped by the implicit spring solve ([`crate::springs`]),
-//! not by the selected method: none of the method's checks below applies to them (the predictor
-//! never refuses a method for a body it would not step), and one
-//! [`StabilityWarning::ImplicitGroups`] says which method they get instead.
+//! Bodies in stiff spring groups are stepped by the implicit spring solve ([`crate::springs`]):
+//! translation and springs implicit, rotation by the selected method or by the implicit
+//! midpoint. None of the method's stability checks below applies to them (the predictor never
+//! refuses a method for a body it would not step); one [`StabilityWarning::ImplicitGroups`]
+//! says how many there are and how many turn by the midpoint now, and a first-order method,
+//! which cannot be combined with the implicit solve, gets one
+//! [`StabilityWarning::CannotCombine`] instead: a refusal.
 //!
 //! One limit of the default method's accuracy (not its stability), which the step itself
 //! takes care of by default:
@@ -409,22 +412,42 @@ fn check_explicit_gyroscopic(
     }
 }
 
-/// The bodies the implicit spring solve steps instead of the selected method (the checks of
-/// the method leave them out), named once.
+/// The bodies of stiff spring groups, which the implicit spring solve steps (see
+/// [`crate::springs`]): named once, with how many of them it turns by the implicit midpoint
+/// rather than by the selected method; or, for a method that cannot be combined with the
+/// implicit solve (the first-order ones), refused.
 fn note_implicit_groups(
     world: &mut World,
     settings: &PhysicsSettings,
     warnings: &mut Vec<StabilityWarning>,
 ) {
-    // The implicit solve steps these bodies, not the selected method: the checks of the method
-    // above leave them out, and this says so.
-    let mut implicit = world.query_filtered::<Entity, With<ImplicitBody>>();
-    let mut bodies = implicit.iter(world);
-    if let Some(body) = bodies.next() {
-        warnings.push(StabilityWarning::ImplicitGroups {
-            body,
-            bodies: 1 + bodies.count(),
-            integrator: settings.integrator,
-        });
+    let span = settings.stages().accuracy_span(settings.dt());
+    let mut implicit = world.query::<(Entity, &ImplicitBody)>();
+    let mut first = None;
+    let (mut bodies, mut midpoint) = (0, 0);
+    for (body, turn) in implicit.iter(world) {
+        first.get_or_insert(body);
+        bodies += 1;
+        if turn.turns_by_midpoint(span) {
+            midpoint += 1;
+        }
     }
+    let Some(body) = first else {
+        return;
+    };
+    let integrator = settings.integrator;
+    warnings.push(if integrator.turns_at_constant_momentum() {
+        StabilityWarning::ImplicitGroups {
+            body,
+            bodies,
+            integrator,
+            midpoint,
+        }
+    } else {
+        StabilityWarning::CannotCombine {
+            body,
+            bodies,
+            integrator,
+        }
+    });
 }

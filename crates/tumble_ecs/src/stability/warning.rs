@@ -67,15 +67,31 @@ pub enum StabilityWarning {
         measure: Real,
     },
     /// Bodies in stiff spring groups (see [`crate::springs`]), which the implicit spring solve
-    /// steps — translation and rotation, by the implicit midpoint rule — instead of the selected
-    /// integrator (not an instability: stable at any stiffness, but not the method asked for).
-    /// One warning for the world, naming the first such body.
+    /// steps: translation with the springs, rotation by the selected integrator's free flow or,
+    /// for a body its springs turn stiffly, by the implicit midpoint (not an instability: what
+    /// the planner chose, said so that it is never silent). One warning for the world, naming
+    /// the first such body.
     ImplicitGroups {
         /// The first body of an implicit group.
         body: Entity,
         /// Bodies in implicit groups.
         bodies: usize,
-        /// The integrator they do not run.
+        /// The selected integrator.
+        integrator: Integrator,
+        /// How many of them turn by the implicit midpoint (see
+        /// [`ImplicitBody::turns_by_midpoint`](crate::components::ImplicitBody::turns_by_midpoint)).
+        midpoint: usize,
+    },
+    /// Bodies in stiff spring groups under a first-order integrator, which has no free rotation
+    /// at constant momentum to run inside the implicit spring solve: the step refuses the groups
+    /// ([`ImplicitSpringError::CannotCombine`](tumble_core::springs::ImplicitSpringError::CannotCombine)),
+    /// so the world cannot run as set. One warning for the world, naming the first such body.
+    CannotCombine {
+        /// The first body of an implicit group.
+        body: Entity,
+        /// Bodies in implicit groups.
+        bodies: usize,
+        /// The integrator.
         integrator: Integrator,
     },
     /// A spin whose gyroscopic term a first-order method (`lclamp`, `implicit-gyroscopic`)
@@ -122,6 +138,7 @@ impl StabilityWarning {
             StabilityWarning::ExplicitGyroscopic { body, .. }
             | StabilityWarning::FirstOrderGyroscopic { body, .. }
             | StabilityWarning::ImplicitGroups { body, .. }
+            | StabilityWarning::CannotCombine { body, .. }
             | StabilityWarning::ExactFreeFlow { body, .. }
             | StabilityWarning::InexactFreeRotation { body, .. }
             | StabilityWarning::StiffRk4Rotation { body, .. }
@@ -131,7 +148,8 @@ impl StabilityWarning {
     }
 
     /// True for settings that make the integration diverge (stiff springs, explicit gyroscopic
-    /// blow-ups); false for a limit of accuracy or precision.
+    /// blow-ups) or that the step refuses (a method that cannot step a stiff spring group);
+    /// false for a limit of accuracy or precision.
     pub fn is_instability(&self) -> bool {
         !matches!(
             self,
@@ -191,11 +209,30 @@ impl std::fmt::Display for StabilityWarning {
                 body,
                 bodies,
                 integrator,
+                midpoint,
             } => write!(
                 f,
                 "rigid body {body}: {} in stiff spring groups, stepped by the implicit spring \
-                 solve (implicit midpoint, translation and rotation), not by `{integrator}`; \
-                 springs = `explicit` steps them with `{integrator}` at a time step small \
+                 solve: translation with the springs; rotation by `{integrator}` for {}, by the \
+                 implicit midpoint for {midpoint} (their springs turn them stiffly: energy kept \
+                 exactly)",
+                if bodies == 1 {
+                    "alone".to_owned()
+                } else {
+                    format!("and {} more bodies", bodies - 1)
+                },
+                bodies - midpoint
+            ),
+            StabilityWarning::CannotCombine {
+                body,
+                bodies,
+                integrator,
+            } => write!(
+                f,
+                "rigid body {body}: {} in stiff spring groups, which `{integrator}` cannot step: \
+                 a first-order method has no free rotation at constant momentum to run inside \
+                 the implicit spring solve; choose `splitting`, `splitting-xyz`, `yoshida4`, \
+                 `rk4`, `exact` or `exact4`, or springs = `explicit` with a time step small \
                  enough for their stiffness",
                 if bodies == 1 {
                     "alone".to_owned()

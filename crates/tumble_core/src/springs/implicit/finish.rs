@@ -118,6 +118,8 @@ impl ImplicitSpringSolver {
     /// group's centre of mass are scaled by `s = √(1 + ΔE/T_rel)` to give it back (`T_rel` the
     /// kinetic energy relative to the centre of mass): linear momentum is kept, and only a
     /// correction rounding can explain (within four times [`Self::rounding_bound`]) is made.
+    /// Bodies turned by a method's free flow are left out (the group's centre and `T_rel` are
+    /// those of the others).
     pub(super) fn keep_energy_through_rounding(
         &self,
         exact: &[Pose],
@@ -136,11 +138,23 @@ impl ImplicitSpringSolver {
             .collect();
         let target = self.energy(exact);
         let missing = target - self.energy(&rounded);
-        let mass: f64 = self.starts.iter().map(|s| s.mass).sum();
+        // Only the bodies the midpoint turns are scaled: a method's turn keeps the energy to the
+        // method's accuracy, not exactly, and scaling its spin would shift its phase.
+        let midpoint = |s: &Start| s.method.is_none();
+        let mass: f64 = self
+            .starts
+            .iter()
+            .filter(|s| midpoint(s))
+            .map(|s| s.mass)
+            .sum();
+        if mass <= 0.0 {
+            return;
+        }
         let centre = self
             .starts
             .iter()
             .zip(&rounded)
+            .filter(|(s, _)| midpoint(s))
             .map(|(s, p)| s.mass * p.v)
             .sum::<DVec3>()
             / mass;
@@ -148,6 +162,7 @@ impl ImplicitSpringSolver {
             .starts
             .iter()
             .zip(&rounded)
+            .filter(|(s, _)| midpoint(s))
             .map(|(s, p)| {
                 let w = p.body_rate(s);
                 0.5 * s.mass * (p.v - centre).length_squared()
@@ -162,7 +177,12 @@ impl ImplicitSpringSolver {
             return;
         }
         let s = (1.0 + missing / relative).sqrt();
-        for (state, p) in out.iter_mut().zip(&rounded) {
+        for ((state, p), _) in out
+            .iter_mut()
+            .zip(&rounded)
+            .zip(&self.starts)
+            .filter(|(_, start)| midpoint(start))
+        {
             let corrected = BodyState {
                 linear_velocity: (centre + s * (p.v - centre)).narrow(),
                 angular_velocity: (s * p.w).narrow(),

@@ -62,6 +62,32 @@
 //! Torque-free, it is the implicit midpoint rule on Euler's equations with a Cayley attitude
 //! update, which conserves `|Π|`, the kinetic energy and the world angular momentum `Q Π`.
 //!
+//! # A method's turn
+//!
+//! [`GroupRotation::Method`] turns a body by a drift–kick–drift method's torque-free flow
+//! instead of the Cayley rotation (see [`crate::integrate`]): with `Π̄ = I Ω̄` the step's mean
+//! body momentum in the start frame (so `L̄ = Q₀ Π̄` is its mean world momentum),
+//!
+//! ```text
+//! Q₁ = Q₀ C,   C = the method's free flow over h from body momentum Π̄ (Q₁ = Q₀ C)
+//! I Ω̄ − Π₀ = ½ h (T_ext + Σ b × Q₀ᵀF̄),   b = (a + C a)/2,   Π₁ = Cᵀ (2 I Ω̄ − Π₀)
+//! ```
+//!
+//! with no gyroscopic term and no turning factor: the flow keeps `L` by itself. The world
+//! momentum changes by `Q₀(2IΩ̄ − 2Π₀) = h Σ (Q₀ b) × F̄`, the torque of `F̄` at the arm
+//! `(Q₀a + Q₁a)/2`, so with the translation's `h x̄ × F̄` each end adds `h p̄ × F̄` again and a
+//! spring's two ends cancel: linear and angular momentum are kept exactly, as under the
+//! midpoint. Torque-free, `Π̄ = Π₀` and the step is the method's own free flow. The energy is
+//! not kept exactly: only the Cayley rotation makes the anchors' displacement `h Ω̄ × b` of the
+//! rate whose kinetic energy changes (`cay(w) a − a = w × b`); a flow turns them by its own
+//! map, and the balance closes to the method's accuracy (second order, measured). Where springs
+//! turn a body stiffly that error is that of an explicit rotation under stiff torques, and
+//! unstable: the caller gives such bodies [`GroupRotation::Midpoint`] (the ECS layer does, by
+//! [`turning_compliance`](super::turning_compliance)). The Newton matrix keeps the Cayley
+//! rotation's derivative for the turn, an approximation: the iteration converges linearly
+//! there, and a group with a method's turn converges a hundred times past the tolerance, so
+//! that the momenta stay at round-off.
+//!
 //! # The solve
 //!
 //! The unknowns `(v̄, Ω̄)` of all bodies of the group solve a nonlinear system by Newton's method
