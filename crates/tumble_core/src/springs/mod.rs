@@ -27,6 +27,16 @@ use crate::math::{Narrow, Real, Vec3, Widen};
 /// step keeps the energy exact.
 pub const IMPLICIT_OMEGA_DT: Real = 0.3;
 
+/// The coarsest step `auto` judges a spring group's stiffness at (s): `Δt`, or 1/60 s where `Δt`
+/// is finer. `auto` steps a group implicitly where `ωΔt ≥` [`IMPLICIT_OMEGA_DT`]; judged at the
+/// world's own `Δt`, a group stiff at 1/60 s would turn explicit at 1/240 s, and a `Δt` sweep
+/// under the defaults would mix two discretisations (the implicit midpoint's phase error has the
+/// opposite sign of position Verlet's, twice as large), so the order measured across it would
+/// mean nothing. Judged at `max(Δt, 1/60 s)`, refining the step below a game's 60 Hz never
+/// changes the spring step; coarser steps are judged as they are (stability needs it), and
+/// `--plan` says which groups are implicit at every step.
+pub const AUTO_REFERENCE_DT: Real = 1.0 / 60.0;
+
 /// `ω_turn` (rad/s) below which a body of an implicit group is turned by the world's integrator
 /// rather than the implicit midpoint (see [`GroupRotation`]): springs that turn it by less than
 /// 0.03 rad in a game's step of 1/60 s. Then the energy they exchange with its rotation is kept

@@ -17,7 +17,10 @@
 //! Gershgorin-style bound on the group's stiffness matrix, exact for the top mode of a uniform
 //! chain; one spring's own `k (ι_a + ι_b)` misses that a body pulled by several springs vibrates
 //! faster, by up to √degree). So a group is never stiffer than the classification assumed. Soft
-//! groups pay nothing: their bodies stay on the explicit path. `Δt` here is the span of the plain
+//! groups pay nothing: their bodies stay on the explicit path. `Δt` here is the world's step, or
+//! [`AUTO_REFERENCE_DT`](tumble_core::springs::AUTO_REFERENCE_DT) (1/60 s) where that is finer,
+//! so that refining the step never switches a group from implicit to explicit (a `Δt` sweep
+//! under the defaults keeps one discretisation below 1/60 s), as the span of the plain
 //! step whose explicit spring step is as accurate as one substep (`Stages::accuracy_span`:
 //! `Δt/N` with `N` substeps; `0.44 Δt/N` with `yoshida4`'s composition, whose explicit step
 //! swings a spring's energy by 2.3 % only at `ωh = 0.68`, and is stable up to 1.57); in a step
@@ -115,6 +118,8 @@ pub use damping::{damp_springs_end, damp_springs_start};
 pub use stiff::{
     SpringClassification, classification_is_stale, classify_springs, solve_implicit_springs,
 };
+
+pub(crate) use stiff::classification_span;
 
 pub(crate) use damping::is_damped;
 

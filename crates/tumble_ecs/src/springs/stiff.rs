@@ -6,8 +6,9 @@ use bevy_ecs::prelude::*;
 use tumble_core::integrate::ExactSwitch;
 use tumble_core::math::{Real, Vec3};
 use tumble_core::springs::{
-    GroupBody, GroupRotation, GroupSpring, IMPLICIT_OMEGA_DT, ImplicitSpringSolver, LinkEnd,
-    inverse_effective_mass_bound, omega_dt_bound, turning_compliance,
+    AUTO_REFERENCE_DT, GroupBody, GroupRotation, GroupSpring, IMPLICIT_OMEGA_DT,
+    ImplicitSpringSolver, LinkEnd, inverse_effective_mass_bound, omega_dt_bound,
+    turning_compliance,
 };
 
 use crate::components::{
@@ -27,9 +28,13 @@ pub struct SpringClassification {
 
 /// The span the explicit spring step's accuracy is judged on, as if it were one plain step
 /// (`Δt` without substeps, `Δt/N` with `N`, `0.44 Δt/N` for `yoshida4`'s composition: see
-/// [`Stages::accuracy_span`](tumble_core::integrate::Stages::accuracy_span)).
-fn classification_span(settings: &PhysicsSettings) -> Real {
-    settings.stages().accuracy_span(settings.dt())
+/// [`Stages::accuracy_span`](tumble_core::integrate::Stages::accuracy_span)), with `Δt` no finer
+/// than [`AUTO_REFERENCE_DT`] (see there: refining the step does not change the
+/// classification).
+pub(crate) fn classification_span(settings: &PhysicsSettings) -> Real {
+    settings
+        .stages()
+        .accuracy_span(settings.dt().max(AUTO_REFERENCE_DT))
 }
 
 /// Number of spring entities, from the archetypes (no query state needed).

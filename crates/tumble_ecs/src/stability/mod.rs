@@ -421,7 +421,7 @@ fn note_implicit_groups(
     settings: &PhysicsSettings,
     warnings: &mut Vec<StabilityWarning>,
 ) {
-    let span = settings.stages().accuracy_span(settings.dt());
+    let span = crate::springs::classification_span(settings);
     let mut implicit = world.query::<(Entity, &ImplicitBody)>();
     let mut first = None;
     let (mut bodies, mut midpoint) = (0, 0);
