@@ -9,6 +9,7 @@ mod stages;
 use bevy_ecs::prelude::*;
 use tumble_core::math::{Quat, Real, Vec3, to_f64};
 use tumble_core::{Mass, MassProperties};
+use tumble_ecs::components::SpringTurn;
 use tumble_ecs::forces::kinetic_and_elastic_energy as energy;
 use tumble_ecs::prelude::*;
 
@@ -276,4 +277,71 @@ fn a_stiff_cloth_falls_without_making_energy() {
         }
     }
     assert!(lowest < -0.1, "the cloth fell: lowest y {lowest}");
+}
+
+/// The classification puts on each body how fast its springs can turn it,
+/// `ω_turn = √(Σ k c)` with `c` each end's turning compliance, and nothing on a body held at its
+/// centre of mass; the rate follows a spring added later.
+#[test]
+fn each_body_carries_how_fast_its_springs_turn_it() {
+    let mut world = World::new();
+    world.insert_resource(PhysicsSettings::new(DT, Integrator::Splitting).unwrap());
+    let inertia = Vec3::new(0.02, 0.03, 0.04);
+    let off = body(
+        &mut world,
+        Vec3::ZERO,
+        Quat::IDENTITY,
+        inertia,
+        Vec3::ZERO,
+        Vec3::ZERO,
+    );
+    let centred = body(
+        &mut world,
+        Vec3::new(1.0, 0.0, 0.0),
+        Quat::IDENTITY,
+        inertia,
+        Vec3::ZERO,
+        Vec3::ZERO,
+    );
+    let arm = Vec3::new(0.1, 0.05, 0.0);
+    let k = 200.0;
+    world.spawn(Spring::new(
+        off,
+        arm,
+        SpringEnd::World(Vec3::new(-0.5, 0.0, 0.0)),
+        k,
+        0.0,
+    ));
+    world.spawn(Spring::new(
+        centred,
+        Vec3::ZERO,
+        SpringEnd::World(Vec3::new(2.0, 0.0, 0.0)),
+        k,
+        0.0,
+    ));
+    let mut physics = PhysicsRunner::new(&mut world);
+    physics.step(&mut world);
+    let mass = world.get::<MassProps>(off).unwrap().0;
+    let expected = (k * tumble_core::springs::turning_compliance(&mass, arm)).sqrt();
+    let rate = world.get::<SpringTurn>(off).unwrap().rate();
+    assert!(
+        (rate - expected).abs() <= 1e-5 * expected,
+        "{rate} against {expected}"
+    );
+    assert!(world.get::<SpringTurn>(centred).is_none());
+    // A second spring on the same body: the rates add in quadrature.
+    let other = Vec3::new(-0.1, 0.0, 0.05);
+    world.spawn(Spring::new(
+        off,
+        other,
+        SpringEnd::World(Vec3::new(0.5, 0.0, 0.0)),
+        k,
+        0.0,
+    ));
+    physics.step(&mut world);
+    let both = (k * tumble_core::springs::turning_compliance(&mass, arm)
+        + k * tumble_core::springs::turning_compliance(&mass, other))
+    .sqrt();
+    let rate = world.get::<SpringTurn>(off).unwrap().rate();
+    assert!((rate - both).abs() <= 1e-5 * both, "{rate} against {both}");
 }

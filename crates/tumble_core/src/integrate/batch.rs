@@ -97,6 +97,15 @@ pub trait BodyBatch {
     /// Body `i`'s step did not give a valid state (non-finite, or a non-unit rotation); it keeps
     /// its old one.
     fn diverged(&mut self, i: usize);
+    /// How fast body `i`'s springs can turn it (rad/s; 0 for a body without springs): where
+    /// they turn it fast enough that their own error outweighs the split free rotation's, the
+    /// exact switch leaves the body on the method's flow (see
+    /// [`ExactSwitch::applies_turned`]). Default: 0.
+    #[inline(always)]
+    fn spring_turn_rate(&self, i: usize) -> Real {
+        let _ = i;
+        0.0
+    }
     /// A hint: body `i` (possibly beyond the last) will be read soon; fetch its memory with
     /// [`prefetch`](crate::prefetch::prefetch). The batch loops call it a few dozen bodies
     /// ahead, far enough for the memory to arrive before the body is read. Default: nothing.
@@ -212,7 +221,7 @@ impl PendingRotations {
 /// The methods without a batched kernel: every body steps alone with `single`.
 fn each_alone(
     bodies: &mut impl BodyBatch,
-    mut single: impl FnMut(&mut BodyState, &MassProperties, &Wrench),
+    mut single: impl FnMut(&mut BodyState, &MassProperties, &Wrench, Real),
 ) {
     let mut next = BodyState::ZEROED;
     for i in 0..bodies.len() {
@@ -220,7 +229,12 @@ fn each_alone(
         let Some(wrench) = bodies.read(i, &mut next) else {
             continue;
         };
-        single(&mut next, bodies.mass(i), &wrench);
+        single(
+            &mut next,
+            bodies.mass(i),
+            &wrench,
+            bodies.spring_turn_rate(i),
+        );
         commit(bodies, i, &next);
     }
 }
@@ -236,7 +250,7 @@ fn batched(
     bodies: &mut impl BodyBatch,
     dt: Real,
     switch: Option<ExactSwitch>,
-    mut alone: impl FnMut(&mut BodyState, &MassProperties, &Wrench),
+    mut alone: impl FnMut(&mut BodyState, &MassProperties, &Wrench, Real),
 ) {
     let h = free_rotation_span(phase, dt);
     let kicks = phase == StepPhase::Finish;
@@ -248,8 +262,9 @@ fn batched(
             continue;
         };
         let mass = bodies.mass(i);
+        let turn = bodies.spring_turn_rate(i);
         if let Some(switch) = switch
-            && switch.applies(&next, mass)
+            && switch.applies_turned(&next, mass, turn)
         {
             let mut single = next;
             switch.exact().stage(phase, &mut single, mass, &wrench, dt);
@@ -271,7 +286,7 @@ fn batched(
                 // A copy, so that `next` never escapes into the (not inlined) scalar step and
                 // stays in registers on the hot path.
                 let mut single = next;
-                alone(&mut single, mass, &wrench);
+                alone(&mut single, mass, &wrench, turn);
                 commit(bodies, i, &single);
             }
         }
@@ -288,7 +303,7 @@ fn paired(
     phase: StepPhase,
     bodies: &mut impl BodyBatch,
     dt: Real,
-    mut alone: impl FnMut(&mut BodyState, &MassProperties, &Wrench),
+    mut alone: impl FnMut(&mut BodyState, &MassProperties, &Wrench, Real),
 ) {
     let h = free_rotation_span(phase, dt);
     let mut next = BodyState::ZEROED;
@@ -303,7 +318,7 @@ fn paired(
         if mass.is_spherical() || !drift_kick_drift_translation(phase, &mut next, mass, &wrench, dt)
         {
             let mut single = next;
-            alone(&mut single, mass, &wrench);
+            alone(&mut single, mass, &wrench, bodies.spring_turn_rate(i));
             commit(bodies, i, &single);
             continue;
         }
@@ -438,8 +453,10 @@ impl Integrator {
         h: Real,
         switch: Option<ExactSwitch>,
     ) {
-        let alone = |s: &mut BodyState, m: &MassProperties, w: &Wrench| match switch {
-            Some(switch) if switch.applies(s, m) => switch.exact().stage(phase, s, m, w, h),
+        let alone = |s: &mut BodyState, m: &MassProperties, w: &Wrench, turn: Real| match switch {
+            Some(switch) if switch.applies_turned(s, m, turn) => {
+                switch.exact().stage(phase, s, m, w, h)
+            }
             _ => self.stage(phase, s, m, w, h),
         };
         if self.is_exact_torque_free() {
@@ -480,8 +497,8 @@ impl Integrator {
         if let [c] = self.composition() {
             return self.stage_batch_switched(StepPhase::Whole, bodies, c * dt, switch);
         }
-        let alone = |s: &mut BodyState, m: &MassProperties, w: &Wrench| match switch {
-            Some(switch) if switch.applies(s, m) => switch.exact().step(s, m, w, dt),
+        let alone = |s: &mut BodyState, m: &MassProperties, w: &Wrench, turn: Real| match switch {
+            Some(switch) if switch.applies_turned(s, m, turn) => switch.exact().step(s, m, w, dt),
             _ => self.step(s, m, w, dt),
         };
         if self == Integrator::Exact4 {

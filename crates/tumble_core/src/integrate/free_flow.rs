@@ -40,7 +40,9 @@
 //! ([`Integrator::exact_counterpart`]: `exact`): the same drift–kick–drift step, forces sampled
 //! at the same points, only the free rotation exact. `yoshida4` cancels the split's error to
 //! fourth order while `e` is small, so it switches to `exact4` where `e_orbit` of its largest
-//! stage (`|c₀| h ≈ 1.70 h`) exceeds [`COMPOSED_SPLIT_ERROR_LIMIT`]. A body that spins slowly never
+//! stage (`|c₀| h ≈ 1.70 h`) exceeds [`COMPOSED_SPLIT_ERROR_LIMIT`]. A body on springs that turn
+//! it at `ω_turn` keeps the split where their own error per step, `(ω_turn h)³/24`, outweighs the
+//! split's, `e_orbit |ω| h` ([`ExactSwitch::applies_turned`]). A body that spins slowly never
 //! pays for the check beyond `|ω|²` (`e_orbit ≤ 0.75 h² |ω|²` and `ω_E ≤ √2 |ω|`, so
 //! `D ≤ 2.2 h² |ω|³ T`: `|I_b − I_c| ≤ I_a`, `I_max ≤ √2 √(I_b I_c)` and `I_max ≤ 2 I_mid`
 //! follow from the triangle inequality every [`MassProperties`] satisfies). The choice
@@ -280,6 +282,38 @@ impl ExactSwitch {
         // of registers on the hot path. A NaN rate compares false here too: the method's own
         // step takes it and reports it.
         self.exceeds(*state, mass)
+    }
+
+    /// [`applies`](Self::applies) for a body its springs can turn at up to `turn_rate` (rad/s;
+    /// 0 without springs): the switch is also left off where the springs' own error outweighs
+    /// the split's. Drift–kick–drift errs on a spring turning the body at `ω_turn` by about
+    /// `(ω_turn h)³/24` rad per step (position Verlet's phase error), the split free rotation by
+    /// `e_orbit |ω| h` (its relative rate error on the orbit, times the turn of a step): where
+    /// `e_orbit |ω| ≤ ω_turn³ h²/24` on the largest stage `h`, the exact flow would cost a
+    /// sevenfold step and change nothing the springs do not swamp (a chain link swinging on
+    /// its springs). A pure function of the state, like the rest of the switch.
+    #[inline(always)]
+    pub fn applies_turned(
+        &self,
+        state: &BodyState,
+        mass: &MassProperties,
+        turn_rate: Real,
+    ) -> bool {
+        self.applies(state, mass)
+            && (turn_rate == 0.0 || !self.springs_dominate(*state, mass, turn_rate))
+    }
+
+    /// True when the springs' error outweighs the split's (see
+    /// [`applies_turned`](Self::applies_turned)), out of line.
+    #[cold]
+    #[inline(never)]
+    fn springs_dominate(&self, state: BodyState, mass: &MassProperties, turn_rate: Real) -> bool {
+        let principal = principal_orientation(&state, mass).widen();
+        let omega = rotate64(principal.conjugate(), state.angular_velocity.widen());
+        let inertia = mass.principal_inertia().widen();
+        let split = split_orbit_error(inertia, omega, self.span) * omega.length();
+        let turn = turn_rate.widen();
+        split <= turn * turn * turn * self.span * self.span / 24.0
     }
 
     /// `measure > limit`, out of line.

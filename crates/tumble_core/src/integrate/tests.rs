@@ -116,6 +116,8 @@ struct Bodies {
     states: Vec<BodyState>,
     masses: Vec<MassProperties>,
     wrenches: Vec<Wrench>,
+    /// How fast each body's springs turn it (rad/s; see [`BodyBatch::spring_turn_rate`]).
+    turns: Vec<Real>,
     diverged: Vec<usize>,
 }
 
@@ -129,6 +131,9 @@ impl BodyBatch for Bodies {
     }
     fn mass(&self, i: usize) -> &MassProperties {
         &self.masses[i]
+    }
+    fn spring_turn_rate(&self, i: usize) -> Real {
+        self.turns[i]
     }
     fn write(&mut self, i: usize, state: &BodyState) {
         self.states[i] = *state;
@@ -146,6 +151,7 @@ fn population() -> Bodies {
         states: Vec::new(),
         masses: Vec::new(),
         wrenches: Vec::new(),
+        turns: Vec::new(),
         diverged: Vec::new(),
     };
     for i in 0..n {
@@ -163,6 +169,7 @@ fn population() -> Bodies {
             .with_principal_frame(Quat::from_rotation_z(f))
             .unwrap();
         bodies.masses.push(mass);
+        bodies.turns.push(0.0);
         bodies.states.push(BodyState {
             position: Vec3::new(f, -f, 2.0 * f),
             rotation: Quat::from_rotation_y(7.0 * f) * Quat::from_rotation_x(f),
@@ -259,6 +266,23 @@ fn exact_batches_give_the_same_bits_as_the_scalar_step() {
 /// occur.
 #[test]
 fn the_free_flow_switch_steps_each_body_as_its_choice_on_every_kernel_path() {
+    // Without springs, and with every other body turned by springs at 200 rad/s (which leaves
+    // some of them on the split flow: the batch asks each body's rate).
+    for turn in [0.0, 200.0] {
+        switch_steps_each_body_as_its_choice(turn);
+    }
+}
+
+fn with_turns(mut bodies: Bodies, turn: Real) -> Bodies {
+    for (i, t) in bodies.turns.iter_mut().enumerate() {
+        if i % 2 == 0 {
+            *t = turn;
+        }
+    }
+    bodies
+}
+
+fn switch_steps_each_body_as_its_choice(turn: Real) {
     let dt = 1.0 / 60.0;
     for integrator in [
         Integrator::Splitting,
@@ -266,19 +290,23 @@ fn the_free_flow_switch_steps_each_body_as_its_choice_on_every_kernel_path() {
         Integrator::Yoshida4,
     ] {
         let switch = ExactSwitch::new(integrator, FreeFlow::Auto, dt).unwrap();
-        let mut scalar = population();
-        let (mut exact, mut split) = (0, 0);
+        let mut scalar = with_turns(population(), turn);
+        let (mut exact, mut split, mut kept) = (0, 0, 0);
         for _ in 0..20 {
             for (i, state) in scalar.states.iter_mut().enumerate() {
                 let (mass, wrench) = (&scalar.masses[i], &scalar.wrenches[i]);
+                let rate = scalar.turns[i];
                 let stage = |s: &BodyState| {
-                    if switch.applies(s, mass) {
+                    if switch.applies_turned(s, mass, rate) {
                         switch.exact()
                     } else {
                         integrator
                     }
                 };
                 let chosen = stage(state);
+                if switch.applies(state, mass) && chosen == integrator {
+                    kept += 1;
+                }
                 if chosen == integrator {
                     split += 1;
                 } else {
@@ -295,11 +323,11 @@ fn the_free_flow_switch_steps_each_body_as_its_choice_on_every_kernel_path() {
             }
         }
         assert!(
-            exact > 0 && split > 0,
-            "{integrator}: {exact} exact, {split} split"
+            exact > 0 && split > 0 && (turn == 0.0) == (kept == 0),
+            "{integrator}: {exact} exact, {split} split, {kept} kept on the split by springs"
         );
         for kernel in Kernel::available() {
-            let mut batch = population();
+            let mut batch = with_turns(population(), turn);
             for _ in 0..20 {
                 integrator.step_batch_switched(&mut batch, dt, Some(switch));
                 if let [c] = integrator.composition() {
@@ -339,4 +367,39 @@ fn the_free_flow_switch_is_none_where_nothing_would_switch() {
             assert!(exact.is_exact_torque_free());
         }
     }
+}
+
+/// A body under springs keeps the split flow where the springs' error per step,
+/// `(ω_turn h)³/24`, outweighs the split's, `e_orbit |ω| h`: the switch leaves it exactly above
+/// the rate where they are equal, and takes it below, for every body the switch applies to.
+#[test]
+fn springs_that_outweigh_the_split_keep_the_split_flow() {
+    let dt: Real = 1.0 / 60.0;
+    let bodies = population();
+    let mut checked = 0;
+    for integrator in [Integrator::Splitting, Integrator::Yoshida4] {
+        let switch = ExactSwitch::new(integrator, FreeFlow::Auto, dt).unwrap();
+        let largest = integrator
+            .composition()
+            .iter()
+            .fold(0.0, |m: Real, c| m.max(c.abs()))
+            .widen()
+            * dt.widen();
+        for (state, mass) in bodies.states.iter().zip(&bodies.masses) {
+            if !switch.applies(state, mass) {
+                assert!(!switch.applies_turned(state, mass, 1e3));
+                continue;
+            }
+            assert!(switch.applies_turned(state, mass, 0.0));
+            let principal = (state.rotation * mass.principal_frame()).widen();
+            let omega = principal.conjugate() * state.angular_velocity.widen();
+            let split = split_orbit_error(mass.principal_inertia().widen(), omega, largest)
+                * omega.length();
+            let even = (24.0 * split / (largest * largest)).cbrt();
+            assert!(switch.applies_turned(state, mass, (0.99 * even) as Real));
+            assert!(!switch.applies_turned(state, mass, (1.01 * even) as Real));
+            checked += 1;
+        }
+    }
+    assert!(checked > 0);
 }

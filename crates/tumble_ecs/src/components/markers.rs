@@ -20,10 +20,6 @@ pub struct ImplicitBody {
     /// force): their forces are in the accumulator, their torque is taken at mid-step inside the
     /// implicit solve (see [`GroupBody::load_moment`]), which consumes it.
     load_moment: DMat3,
-    /// `ω_turn` (rad/s), how fast the body's springs can turn it (see [`crate::springs`]): the
-    /// implicit solve turns it by the world's integrator where that is slow for the step, by the
-    /// implicit midpoint otherwise.
-    turn_rate: Real,
 }
 
 impl Default for ImplicitBody {
@@ -31,7 +27,6 @@ impl Default for ImplicitBody {
     fn default() -> Self {
         Self {
             load_moment: DMat3::ZERO,
-            turn_rate: 0.0,
         }
     }
 }
@@ -40,35 +35,6 @@ impl ImplicitBody {
     /// Records a force `force` (world) at the arm `arm` (body frame, from the centre of mass).
     pub(crate) fn add_point_force(&mut self, arm: Vec3, force: Vec3) {
         self.load_moment += outer(arm.widen(), force.widen());
-    }
-
-    /// A body whose springs turn it at up to `turn_rate` (rad/s; see the field).
-    pub(crate) fn turned_at(turn_rate: Real) -> Self {
-        Self {
-            turn_rate,
-            ..Self::default()
-        }
-    }
-
-    /// Sets the turning rate (see the field), keeping the recorded point forces.
-    pub(crate) fn set_turn_rate(&mut self, turn_rate: Real) {
-        self.turn_rate = turn_rate;
-    }
-
-    /// `ω_turn` (rad/s): how fast the body's springs can turn it, `√(Σ k c)` over its spring
-    /// ends with `c` the end's [`turning_compliance`](tumble_core::springs::turning_compliance).
-    pub fn turn_rate(&self) -> Real {
-        self.turn_rate
-    }
-
-    /// True when the implicit solve turns the body by the implicit midpoint rather than by the
-    /// world's integrator (see [`crate::springs`]): its springs turn it at `ω_turn ≥`
-    /// [`METHOD_TURN_RATE`](tumble_core::springs::METHOD_TURN_RATE), or at `ω_turn Δt ≥`
-    /// [`IMPLICIT_OMEGA_DT`](tumble_core::springs::IMPLICIT_OMEGA_DT) (`Δt` the span the spring
-    /// classification judges, [`Stages::accuracy_span`](tumble_core::integrate::Stages::accuracy_span)).
-    pub fn turns_by_midpoint(&self, span: Real) -> bool {
-        use tumble_core::springs::{IMPLICIT_OMEGA_DT, METHOD_TURN_RATE};
-        !(self.turn_rate < METHOD_TURN_RATE && self.turn_rate * span < IMPLICIT_OMEGA_DT)
     }
 
     /// The recorded moment `P`, leaving none recorded (the implicit solve consumes it).
@@ -80,6 +46,41 @@ impl ImplicitBody {
     pub(crate) fn point_torque(&self, rotation: tumble_core::math::Quat) -> Vec3 {
         tumble_core::math::axial_vector(DMat3::from_quat(rotation.widen()) * self.load_moment)
             .narrow()
+    }
+}
+
+/// How fast a body's springs can turn it: `ω_turn = √(Σ k c)` over its spring ends (rad/s), `c`
+/// the end's [`turning_compliance`](tumble_core::springs::turning_compliance). Put on every
+/// dynamic body with springs whose anchors can turn it when the springs are classified (see
+/// [`crate::springs`]); a body without one has `ω_turn = 0`. It decides how the implicit
+/// spring step turns a body of a stiff group, and leaves a split method's exact switch off a
+/// body whose springs' error outweighs the split's
+/// ([`ExactSwitch::applies_turned`](tumble_core::integrate::ExactSwitch::applies_turned)).
+#[derive(Component, Debug, Clone, Copy, PartialEq, Default)]
+pub struct SpringTurn {
+    rate: Real,
+}
+
+impl SpringTurn {
+    /// A body its springs turn at up to `rate` (rad/s).
+    pub(crate) fn new(rate: Real) -> Self {
+        Self { rate }
+    }
+
+    /// `ω_turn` (rad/s).
+    pub fn rate(&self) -> Real {
+        self.rate
+    }
+
+    /// True when the implicit solve turns the body (of a stiff group) by the implicit midpoint
+    /// rather than by the world's integrator (see [`crate::springs`]): its springs turn it at
+    /// `ω_turn ≥` [`METHOD_TURN_RATE`](tumble_core::springs::METHOD_TURN_RATE), or at
+    /// `ω_turn Δt ≥` [`IMPLICIT_OMEGA_DT`](tumble_core::springs::IMPLICIT_OMEGA_DT) (`Δt` the
+    /// span the spring classification judges,
+    /// [`Stages::accuracy_span`](tumble_core::integrate::Stages::accuracy_span)).
+    pub fn turns_by_midpoint(&self, span: Real) -> bool {
+        use tumble_core::springs::{IMPLICIT_OMEGA_DT, METHOD_TURN_RATE};
+        !(self.rate < METHOD_TURN_RATE && self.rate * span < IMPLICIT_OMEGA_DT)
     }
 }
 
@@ -106,6 +107,7 @@ pub(crate) type Stepped<L> = (
     &'static MassProps,
     L,
     Option<&'static Damping>,
+    Option<&'static SpringTurn>,
 );
 
 /// The physics queries hold only table components and archetype filters, so they are always

@@ -51,7 +51,7 @@ pub use errors::{
     RejectedGenerator,
 };
 pub use generators::{ConstantForce, ConstantLocalForce, ConstantTorque, Spring, SpringEnd};
-pub use markers::{Dynamic, ImplicitBody, ImplicitSpring};
+pub use markers::{Dynamic, ImplicitBody, ImplicitSpring, SpringTurn};
 pub use settings::{Gravity, PhysicsSettings, SpringSolver};
 
 pub(crate) use body::{RemovedBodies, reject};

@@ -23,7 +23,7 @@ macro_rules! step_each_table {
     ($bodies:ident, $stage:ident, $parallelism:ident, $commands:ident, |$load:pat_param| $loads:expr) => {{
         let parallelism = $parallelism.map_or_else(Parallelism::default, |p| *p);
         let mut errors = Vec::new();
-        for (entities, mut t, mut v, masses, $load, dampings) in
+        for (entities, mut t, mut v, masses, $load, dampings, turns) in
             dense($bodies.contiguous_iter_mut())
         {
             let bodies = Bodies {
@@ -32,6 +32,7 @@ macro_rules! step_each_table {
                 velocities: &mut v,
                 masses,
                 dampings,
+                turns,
                 loads: $loads,
             };
             step_table(&$stage, &parallelism, bodies, &mut errors);

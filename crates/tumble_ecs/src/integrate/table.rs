@@ -17,8 +17,8 @@ use tumble_core::{BodyBatch, BodyState, Integrator, MassProperties, StepPhase, W
 
 use crate::components::{BodyError, BodyErrorKind, check_accumulator, check_body};
 use crate::components::{
-    Damping, ForceAccumulator, GravityScale, MassProps, PhysicsSettings, Pose, Velocity,
-    body_state, write_body_state,
+    Damping, ForceAccumulator, GravityScale, MassProps, PhysicsSettings, Pose, SpringTurn,
+    Velocity, body_state, write_body_state,
 };
 use crate::integrate::StageCursor;
 use crate::parallel::Parallelism;
@@ -85,6 +85,8 @@ pub(crate) struct Bodies<'a> {
     pub(crate) velocities: &'a mut [Velocity],
     pub(crate) masses: &'a [MassProps],
     pub(crate) dampings: Option<&'a [Damping]>,
+    /// How fast each body's springs can turn it (see [`SpringTurn`]), where the table has them.
+    pub(crate) turns: Option<&'a [SpringTurn]>,
     pub(crate) loads: Loads<'a>,
 }
 
@@ -103,6 +105,10 @@ impl<'a> Bodies<'a> {
             let (a, b) = d.split_at(mid);
             (Some(a), Some(b))
         });
+        let (s0, s1) = self.turns.map_or((None, None), |s| {
+            let (a, b) = s.split_at(mid);
+            (Some(a), Some(b))
+        });
         let (l0, l1) = self.loads.split_at(mid);
         (
             Bodies {
@@ -111,6 +117,7 @@ impl<'a> Bodies<'a> {
                 velocities: v0,
                 masses: m0,
                 dampings: d0,
+                turns: s0,
                 loads: l0,
             },
             Bodies {
@@ -119,6 +126,7 @@ impl<'a> Bodies<'a> {
                 velocities: v1,
                 masses: m1,
                 dampings: d1,
+                turns: s1,
                 loads: l1,
             },
         )
@@ -237,6 +245,11 @@ impl BodyBatch for TableBatch<'_, '_> {
     #[inline(always)]
     fn mass(&self, i: usize) -> &MassProperties {
         &self.bodies.masses[i].0
+    }
+
+    #[inline(always)]
+    fn spring_turn_rate(&self, i: usize) -> Real {
+        self.bodies.turns.map_or(0.0, |turns| turns[i].rate())
     }
 
     #[inline(always)]

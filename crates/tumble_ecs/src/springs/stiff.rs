@@ -13,8 +13,8 @@ use tumble_core::springs::{
 
 use crate::components::{
     BodyError, BodyErrorKind, Dynamic, ForceAccumulator, ImplicitBody, ImplicitSpring, MassProps,
-    PhysicsSettings, Pose, RigidBody, Spring, SpringEnd, SpringSolver, Stepped, body_state, reject,
-    write_body_state,
+    PhysicsSettings, Pose, RigidBody, Spring, SpringEnd, SpringSolver, SpringTurn, Stepped,
+    body_state, reject, write_body_state,
 };
 use crate::integrate::damp;
 
@@ -181,13 +181,14 @@ pub fn classify_springs(world: &mut World) {
         });
         implicit_spring.push(stiff);
     }
-    // Per dynamic body, `Some(ω_turn)` for a body of an implicit group.
-    let mut implicit_body = vec![None; masses.len()];
+    let mut implicit_body = vec![false; masses.len()];
     for (i, flag) in implicit_body.iter_mut().enumerate() {
         let r = find(&mut parent, i);
-        *flag = stiff_group[r].then(|| turn[i].sqrt());
+        *flag = stiff_group[r];
     }
     mark_stiff(world, &springs, implicit_spring, &index, &implicit_body);
+    let rates: Vec<Real> = turn.iter().map(|t| t.sqrt()).collect();
+    mark_turn_rates(world, &index, &rates);
     let springs = spring_count(world);
     world.insert_resource(SpringClassification {
         dt,
@@ -197,14 +198,14 @@ pub fn classify_springs(world: &mut World) {
 }
 
 /// Puts [`ImplicitSpring`] on the springs and [`ImplicitBody`] on the bodies the classification
-/// found stiff (`implicit_spring` per spring, `implicit_body` per dynamic body of `index`: its
-/// turning rate if stiff), and takes them off the others.
+/// found stiff (`implicit_spring` per spring, `implicit_body` per dynamic body of `index`), and
+/// takes them off the others.
 fn mark_stiff(
     world: &mut World,
     springs: &[(Entity, Spring)],
     implicit_spring: Vec<bool>,
     index: &EntityHashMap<usize>,
-    implicit_body: &[Option<Real>],
+    implicit_body: &[bool],
 ) {
     for ((entity, _), stiff) in springs.iter().zip(implicit_spring) {
         let has = world.get::<ImplicitSpring>(*entity).is_some();
@@ -219,22 +220,34 @@ fn mark_stiff(
         .iter(world)
         .collect();
     for entity in bodies {
-        let stiff = index.get(&entity).and_then(|&i| implicit_body[i]);
-        match (stiff, world.get_mut::<ImplicitBody>(entity)) {
-            (Some(turn), Some(mut body)) => {
-                if body.turn_rate() != turn {
-                    body.set_turn_rate(turn);
-                }
+        let stiff = index.get(&entity).is_some_and(|&i| implicit_body[i]);
+        let has = world.get::<ImplicitBody>(entity).is_some();
+        if stiff && !has {
+            world.entity_mut(entity).insert(ImplicitBody::default());
+        } else if !stiff && has {
+            world.entity_mut(entity).remove::<ImplicitBody>();
+        }
+    }
+}
+
+/// Puts a [`SpringTurn`] with its rate on every dynamic body of `index` whose springs can turn
+/// it (`rates` per body, 0 for none), and takes it off the others.
+fn mark_turn_rates(world: &mut World, index: &EntityHashMap<usize>, rates: &[Real]) {
+    let bodies: Vec<Entity> = world
+        .query_filtered::<Entity, With<RigidBody>>()
+        .iter(world)
+        .collect();
+    for entity in bodies {
+        let rate = index.get(&entity).map_or(0.0, |&i| rates[i]);
+        match (rate > 0.0, world.get::<SpringTurn>(entity).copied()) {
+            (true, Some(turn)) if turn.rate() == rate => {}
+            (true, _) => {
+                world.entity_mut(entity).insert(SpringTurn::new(rate));
             }
-            (Some(turn), None) => {
-                world
-                    .entity_mut(entity)
-                    .insert(ImplicitBody::turned_at(turn));
+            (false, Some(_)) => {
+                world.entity_mut(entity).remove::<SpringTurn>();
             }
-            (None, Some(_)) => {
-                world.entity_mut(entity).remove::<ImplicitBody>();
-            }
-            (None, None) => {}
+            (false, None) => {}
         }
     }
 }
@@ -292,7 +305,7 @@ pub fn solve_implicit_springs(
     let dt = span.h;
     let half_substep = 0.5 * span.substep;
     let switch = ExactSwitch::new(settings.integrator, settings.free_flow, span.substep);
-    for ((entity, t, mut v, m, mut acc, damping), mut implicit) in &mut bodies {
+    for ((entity, t, mut v, m, mut acc, damping, turn), mut implicit) in &mut bodies {
         // `Damping` is a flow of its own, half a substep before the substep and half after (see
         // `tumble_core::damping`), as on the explicit path.
         if let Some(d) = damping
@@ -305,7 +318,8 @@ pub fn solve_implicit_springs(
         s.parent.push(s.entities.len());
         s.entities.push(entity);
         let state = body_state(&t, &v, m);
-        let rotation = group_rotation(&settings, switch.as_ref(), &implicit, &state, &m.0);
+        let turn = turn.copied().unwrap_or_default();
+        let rotation = group_rotation(&settings, switch.as_ref(), turn, &state, &m.0);
         s.all.push(GroupBody {
             state,
             mass: m.0,
@@ -333,7 +347,8 @@ pub fn solve_implicit_springs(
                     "implicit spring group stepped"
                 );
                 for (k, &i) in s.members[members].iter().enumerate() {
-                    if let Ok(((_, mut t, mut v, m, _, damping), _)) = bodies.get_mut(s.entities[i])
+                    if let Ok(((_, mut t, mut v, m, _, damping, _), _)) =
+                        bodies.get_mut(s.entities[i])
                     {
                         write_body_state(&s.bodies[k].state, m, &mut t, &mut v);
                         if let Some(d) = damping
@@ -367,18 +382,19 @@ pub fn solve_implicit_springs(
 fn group_rotation(
     settings: &PhysicsSettings,
     switch: Option<&ExactSwitch>,
-    implicit: &ImplicitBody,
+    turn: SpringTurn,
     state: &tumble_core::BodyState,
     mass: &tumble_core::MassProperties,
 ) -> GroupRotation {
     let method = settings.integrator;
-    if method.turns_at_constant_momentum()
-        && implicit.turns_by_midpoint(classification_span(settings))
+    if method.turns_at_constant_momentum() && turn.turns_by_midpoint(classification_span(settings))
     {
         return GroupRotation::Midpoint;
     }
     match switch {
-        Some(switch) if switch.applies(state, mass) => GroupRotation::Method(switch.exact()),
+        Some(switch) if switch.applies_turned(state, mass, turn.rate()) => {
+            GroupRotation::Method(switch.exact())
+        }
         _ => GroupRotation::Method(method),
     }
 }

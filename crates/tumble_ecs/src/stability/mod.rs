@@ -77,11 +77,11 @@ use tumble_core::Integrator;
 use tumble_core::integrate::{ExactSwitch, FreeFlow};
 use tumble_core::math::{Real, Vec3, Widen};
 
-use crate::components::ImplicitBody;
 use crate::components::{
     Gravity, GravityScale, Kinematic, MassProps, PhysicsSettings, Pose, RigidBody, Static,
     Velocity, body_state,
 };
+use crate::components::{ImplicitBody, SpringTurn};
 use crate::components::{Spring, SpringEnd};
 
 /// `ω Δt` above which the symplectic position update of a spring diverges.
@@ -256,20 +256,22 @@ fn check_free_rotation(
     // (`ExactSwitch`) and gives the exact flow to those it would integrate badly: one notice
     // names the bodies that take it now. Under `method` each body whose split errs by more
     // than the limit a stage is warned of.
-    let mut spins = world.query_filtered::<(Entity, &MassProps, &Pose, &Velocity), (
-        With<RigidBody>,
-        Without<ImplicitBody>,
-        Without<Static>,
-        Without<Kinematic>,
-    )>();
+    let mut spins = world
+        .query_filtered::<(Entity, &MassProps, &Pose, &Velocity, Option<&SpringTurn>), (
+            With<RigidBody>,
+            Without<ImplicitBody>,
+            Without<Static>,
+            Without<Kinematic>,
+        )>();
     match settings.free_flow {
         FreeFlow::Auto => {
             if let Some(switch) = ExactSwitch::new(settings.integrator, FreeFlow::Auto, substep) {
                 let mut first: Option<(Entity, Real)> = None;
                 let mut count = 0;
-                for (body, mass, transform, velocity) in spins.iter(world) {
+                for (body, mass, transform, velocity, turn) in spins.iter(world) {
                     let state = body_state(transform, velocity, mass);
-                    if switch.applies(&state, mass) {
+                    let rate = turn.map_or(0.0, SpringTurn::rate);
+                    if switch.applies_turned(&state, mass, rate) {
                         count += 1;
                         first.get_or_insert((body, switch.measure(&state, mass) as Real));
                     }
@@ -298,7 +300,7 @@ fn check_free_rotation(
                     .iter()
                     .fold(0.0, |m: Real, w| m.max(w.abs()));
                 let h = largest * substep;
-                for (body, mass, transform, velocity) in spins.iter(world) {
+                for (body, mass, transform, velocity, _) in spins.iter(world) {
                     let principal = transform.rotation * mass.principal_frame();
                     let omega = tumble_core::integrate::rotate_inv(principal, velocity.angular);
                     let error_per_step = split_rotation_error(
@@ -422,13 +424,13 @@ fn note_implicit_groups(
     warnings: &mut Vec<StabilityWarning>,
 ) {
     let span = crate::springs::classification_span(settings);
-    let mut implicit = world.query::<(Entity, &ImplicitBody)>();
+    let mut implicit = world.query_filtered::<(Entity, Option<&SpringTurn>), With<ImplicitBody>>();
     let mut first = None;
     let (mut bodies, mut midpoint) = (0, 0);
     for (body, turn) in implicit.iter(world) {
         first.get_or_insert(body);
         bodies += 1;
-        if turn.turns_by_midpoint(span) {
+        if turn.copied().unwrap_or_default().turns_by_midpoint(span) {
             midpoint += 1;
         }
     }

@@ -79,7 +79,7 @@ pub enum StabilityWarning {
         /// The selected integrator.
         integrator: Integrator,
         /// How many of them turn by the implicit midpoint (see
-        /// [`ImplicitBody::turns_by_midpoint`](crate::components::ImplicitBody::turns_by_midpoint)).
+        /// [`SpringTurn::turns_by_midpoint`](crate::components::SpringTurn::turns_by_midpoint)).
         midpoint: usize,
     },
     /// Bodies in stiff spring groups under a first-order integrator, which has no free rotation
