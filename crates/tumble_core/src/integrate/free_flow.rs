@@ -163,6 +163,17 @@ pub fn split_rotation_error(inertia: DVec3, omega: DVec3, h: f64) -> f64 {
 /// for a body with principal moments `inertia` turning at principal rates `omega`, steps of
 /// `h` (module docs). Zero for a body with a locked axis.
 pub fn split_rotation_drift(inertia: DVec3, omega: DVec3, h: f64, horizon: f64) -> f64 {
+    drift_of_orbit_error(
+        inertia,
+        omega,
+        split_orbit_error(inertia, omega, h),
+        horizon,
+    )
+}
+
+/// `D` over `horizon` from the body's `e_orbit` ([`split_orbit_error`]), see
+/// [`split_rotation_drift`].
+fn drift_of_orbit_error(inertia: DVec3, omega: DVec3, e_orbit: f64, horizon: f64) -> f64 {
     let mut sorted = inertia.to_array();
     if split_axes(sorted).is_none() {
         return 0.0;
@@ -171,7 +182,6 @@ pub fn split_rotation_drift(inertia: DVec3, omega: DVec3, h: f64, horizon: f64) 
     let elongation = 1.0 - sorted[0] / sorted[1];
     let energy = 0.5 * (inertia * omega * omega).element_sum();
     let rate = (2.0 * energy / sorted[1]).sqrt();
-    let e_orbit = split_orbit_error(inertia, omega, h);
     DRIFT_FACTOR * elongation * elongation * e_orbit * rate * horizon
 }
 
@@ -299,21 +309,31 @@ impl ExactSwitch {
         mass: &MassProperties,
         turn_rate: Real,
     ) -> bool {
-        self.applies(state, mass)
-            && (turn_rate == 0.0 || !self.springs_dominate(*state, mass, turn_rate))
+        if turn_rate == 0.0 {
+            return self.applies(state, mass);
+        }
+        let w = state.angular_velocity;
+        // The same order of operations as `applies`: the same bits on every path.
+        let w2 = w.x * w.x + w.y * w.y + w.z * w.z;
+        w2 > self.quick && self.exceeds_turned(*state, mass, turn_rate)
     }
 
-    /// True when the springs' error outweighs the split's (see
-    /// [`applies_turned`](Self::applies_turned)), out of line.
+    /// The split costs more than the limit and more than the springs' error (see
+    /// [`applies_turned`](Self::applies_turned)), from one `e_orbit`, out of line.
     #[cold]
     #[inline(never)]
-    fn springs_dominate(&self, state: BodyState, mass: &MassProperties, turn_rate: Real) -> bool {
+    fn exceeds_turned(&self, state: BodyState, mass: &MassProperties, turn_rate: Real) -> bool {
         let principal = principal_orientation(&state, mass).widen();
         let omega = rotate64(principal.conjugate(), state.angular_velocity.widen());
         let inertia = mass.principal_inertia().widen();
-        let split = split_orbit_error(inertia, omega, self.span) * omega.length();
+        let e_orbit = split_orbit_error(inertia, omega, self.span);
+        let measure = match self.rule {
+            Rule::Drift => drift_of_orbit_error(inertia, omega, e_orbit, ACCURACY_HORIZON.widen()),
+            Rule::StageError => e_orbit,
+        };
         let turn = turn_rate.widen();
-        split <= turn * turn * turn * self.span * self.span / 24.0
+        measure > self.limit
+            && e_orbit * omega.length() > turn * turn * turn * self.span * self.span / 24.0
     }
 
     /// `measure > limit`, out of line.
