@@ -10,6 +10,7 @@
 #![warn(missing_docs)]
 
 pub mod bandwidth;
+pub mod budget;
 pub mod csv;
 pub mod engines;
 pub mod exact;
@@ -441,37 +442,28 @@ pub fn run_and_write(options: &BenchOptions) -> Result<(), Box<dyn std::error::E
         None => Vec::new(),
     };
     if let Some(readme) = &options.readme {
-        with_sections(readme, &[(&name, ""), (machines::SUMMARY_NAME, "")])?;
+        with_sections(readme, &[(budget::SECTION, "")])?;
         OutputSet::check(readme)?;
     }
     let results = run_bench(options, |line| eprintln!("… {line}"));
     let table = output::markdown(&results);
     let mut files = OutputSet::new();
-    let summary = match &options.out {
-        Some(dir) => {
-            files.add(&dir.join(format!("{name}.md")), table.as_bytes())?;
-            files.add(
-                &dir.join(format!("{name}.json")),
-                (serde_json::to_string_pretty(&results)? + "\n").as_bytes(),
-            )?;
-            let runs = machines::with_run(kept_runs, &name, RunSummary::from(&results));
-            let summary = machines::targets_by_run(&runs);
-            let summary_file = dir.join(format!("{}.md", machines::SUMMARY_NAME));
-            files.add(&summary_file, summary.as_bytes())?;
-            summary
-        }
-        // Without an output directory there are no kept runs: the summary holds this one.
-        None => machines::targets_by_run(&[RunSummary::from(&results)]),
-    };
+    if let Some(dir) = &options.out {
+        files.add(&dir.join(format!("{name}.md")), table.as_bytes())?;
+        files.add(
+            &dir.join(format!("{name}.json")),
+            (serde_json::to_string_pretty(&results)? + "\n").as_bytes(),
+        )?;
+        let runs = machines::with_run(kept_runs, &name, RunSummary::from(&results));
+        let summary_file = dir.join(format!("{}.md", machines::SUMMARY_NAME));
+        files.add(&summary_file, machines::targets_by_run(&runs).as_bytes())?;
+    }
     if let Some(readme) = &options.readme {
-        let section = output::readme_section(&results);
+        // The README gets the frame budget; the full tables and the targets stay in `--out`.
+        let section = budget::frame_budget(&results);
         files.add(
             readme,
-            with_sections(
-                readme,
-                &[(&name, &section), (machines::SUMMARY_NAME, &summary)],
-            )?
-            .as_bytes(),
+            with_sections(readme, &[(budget::SECTION, &section)])?.as_bytes(),
         )?;
     }
     files.commit()?;

@@ -73,18 +73,44 @@ fn small_run_measures_every_engine_and_writes_json() {
     assert!(table.contains(&format!("free rotation is {} flops per body-step", f.total)));
     assert!(json["kernel_flops"]["total"].as_u64() == Some(f.total));
     assert!(table.contains("**trajectory CSV**") && table.contains("rapier SpringJoint"));
+    // The frame budget: the largest world of each kind, as bodies per 60 Hz frame, from the
+    // same rows (100 free bodies here: 1/60 s over its ns per body-step).
+    let budget = tumble_bench::budget::frame_budget(&results);
+    let free = results
+        .rows
+        .iter()
+        .filter(|r| r.integrator == "splitting")
+        .max_by_key(|r| r.bodies)
+        .unwrap();
+    assert!(budget.contains(&format!("| free bodies under gravity | {} |", free.bodies)));
+    assert!(budget.contains("spring chains, explicit (ωΔt 0.5)"));
+    assert!(budget.contains("spring chains, implicit (ωΔt 10)"));
+    assert!(budget.contains(&results.kernel_path));
+    let row = budget
+        .lines()
+        .find(|l| l.starts_with("| free bodies"))
+        .unwrap();
+    let one: f64 = row
+        .split('|')
+        .nth(3)
+        .unwrap()
+        .trim()
+        .replace('\u{2009}', "")
+        .parse()
+        .unwrap();
+    let expected = 1e9 / 60.0 / free.ecs_1t;
+    assert!((one / expected - 1.0).abs() < 0.01, "{row}: {expected}");
 }
 
 #[test]
-fn readme_section_replaces_only_between_markers() {
-    // The section a run on an AVX2-only CPU writes.
-    let name = tumble_bench::machines::run_name("avx2", "avx2");
-    let replace = |text, section| replace_between_markers(text, &name, section);
-    let text = "intro\n<!-- bench-avx2:begin -->\nold\n<!-- bench-avx2:end -->\noutro\n";
+fn the_frame_budget_replaces_only_between_its_markers() {
+    let name = tumble_bench::budget::SECTION;
+    let replace = |text, section| replace_between_markers(text, name, section);
+    let text = "intro\n<!-- frame-budget:begin -->\nold\n<!-- frame-budget:end -->\noutro\n";
     let new = replace(text, "new\n").unwrap();
     assert_eq!(
         new,
-        "intro\n<!-- bench-avx2:begin -->\nnew\n<!-- bench-avx2:end -->\noutro\n"
+        "intro\n<!-- frame-budget:begin -->\nnew\n<!-- frame-budget:end -->\noutro\n"
     );
     assert!(replace("no markers", "x").is_none());
 }
