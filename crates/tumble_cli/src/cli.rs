@@ -8,7 +8,8 @@ use clap::{ArgAction, Parser, Subcommand};
 /// tumble: rigid-body dynamics for headless game loops.
 ///
 /// Exit status: 0 success, 1 error (bad input or I/O), 2 usage, 3 a body was rejected or
-/// diverged, 4 predicted unstable (refused unless --allow-unstable), 130 interrupted.
+/// diverged, 4 predicted unstable or a method that cannot step the scene (refused unless
+/// --allow-unstable), 130 interrupted.
 #[derive(Parser, Debug)]
 #[command(version)]
 pub(crate) struct Cli {

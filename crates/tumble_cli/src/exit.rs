@@ -13,7 +13,8 @@ pub(crate) const ERROR: u8 = 1;
 pub(crate) const USAGE: u8 = 2;
 /// The run finished, but a body was rejected (quarantined) or diverged.
 pub(crate) const REJECTED: u8 = 3;
-/// tumble predicts the step unstable for the scene: refused unless `--allow-unstable`.
+/// tumble predicts the step unstable for the scene, or its method cannot step it (a first-order
+/// integrator on a stiff spring group): refused unless `--allow-unstable`.
 pub(crate) const UNSTABLE: u8 = 4;
 /// Interrupted by a signal that ends the process (SIGINT, SIGTERM, SIGHUP, SIGUSR1, …: see
 /// `interrupt`; 128 + SIGINT, as shells report it); nothing was written.
