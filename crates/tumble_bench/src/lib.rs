@@ -53,9 +53,9 @@ pub struct BenchOptions {
     /// forced another).
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// Also replace this run's section of this markdown file (between `<!-- <name>:begin -->`
-    /// and `<!-- <name>:end -->`) and the table of every run's targets (`bench-targets`),
-    /// e.g. `docs/performance.md`.
+    /// Also replace the frame budget in this markdown file (between
+    /// `<!-- frame-budget:begin -->` and `<!-- frame-budget:end -->`): bodies per 60 Hz frame
+    /// from this run, e.g. `README.md`.
     #[arg(long)]
     pub readme: Option<PathBuf>,
 }

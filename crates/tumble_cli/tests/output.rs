@@ -568,7 +568,7 @@ fn report_and_bench_refuse_an_unwritable_destination_before_working() {
         (
             "bench",
             vec!["--readme".into(), readme.clone().into()],
-            format!("error: {}: no <!-- bench-", readme.display()),
+            format!("error: {}: no <!-- frame-budget:begin", readme.display()),
         ),
     ];
     for (command, args, expected) in cases {

@@ -262,9 +262,11 @@ fn batched(
             continue;
         };
         let mass = bodies.mass(i);
-        let turn = bodies.spring_turn_rate(i);
+        // A body below the switch's quick bound never reads its spring rate: the hot path of
+        // slow bodies is one `|ω|²`, as without springs.
         if let Some(switch) = switch
-            && switch.applies_turned(&next, mass, turn)
+            && switch.spins_past_quick_bound(&next)
+            && switch.applies_turned(&next, mass, bodies.spring_turn_rate(i))
         {
             let mut single = next;
             switch.exact().stage(phase, &mut single, mass, &wrench, dt);
@@ -286,7 +288,7 @@ fn batched(
                 // A copy, so that `next` never escapes into the (not inlined) scalar step and
                 // stays in registers on the hot path.
                 let mut single = next;
-                alone(&mut single, mass, &wrench, turn);
+                alone(&mut single, mass, &wrench, bodies.spring_turn_rate(i));
                 commit(bodies, i, &single);
             }
         }

@@ -336,6 +336,18 @@ impl ExactSwitch {
             && e_orbit * omega.length() > turn * turn * turn * self.span * self.span / 24.0
     }
 
+    /// False when the body spins too slowly for the switch to apply to it whatever its inertia
+    /// and springs: the first, cheap test of [`applies`](Self::applies) and
+    /// [`applies_turned`](Self::applies_turned) (one `|ω|²`), for a caller that would otherwise
+    /// fetch more of the body first.
+    #[inline(always)]
+    pub fn spins_past_quick_bound(&self, state: &BodyState) -> bool {
+        let w = state.angular_velocity;
+        // The same order of operations as `applies`.
+        let w2 = w.x * w.x + w.y * w.y + w.z * w.z;
+        w2 > self.quick
+    }
+
     /// `measure > limit`, out of line.
     #[cold]
     #[inline(never)]
