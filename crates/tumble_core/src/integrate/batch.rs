@@ -262,10 +262,7 @@ fn batched(
             continue;
         };
         let mass = bodies.mass(i);
-        // A body below the switch's quick bound never reads its spring rate: the hot path of
-        // slow bodies is one `|ω|²`, as without springs.
         if let Some(switch) = switch
-            && switch.spins_past_quick_bound(&next)
             && switch.applies_turned(&next, mass, bodies.spring_turn_rate(i))
         {
             let mut single = next;

@@ -282,16 +282,10 @@ impl ExactSwitch {
     /// state and mass. Cheap unless it spins fast: one `|ω|²`.
     #[inline(always)]
     pub fn applies(&self, state: &BodyState, mass: &MassProperties) -> bool {
-        let w = state.angular_velocity;
-        // A fixed order of operations: the same bits on every path.
-        let w2 = w.x * w.x + w.y * w.y + w.z * w.z;
-        if w2 <= self.quick {
-            return false;
-        }
         // A copy: a reference would escape into the cold call and keep the caller's state out
-        // of registers on the hot path. A NaN rate compares false here too: the method's own
-        // step takes it and reports it.
-        self.exceeds(*state, mass)
+        // of registers on the hot path. A NaN rate fails the quick bound: the method's own step
+        // takes it and reports it.
+        self.spins_past_quick_bound(state) && self.exceeds(*state, mass)
     }
 
     /// [`applies`](Self::applies) for a body its springs can turn at up to `turn_rate` (rad/s;
@@ -312,10 +306,7 @@ impl ExactSwitch {
         if turn_rate == 0.0 {
             return self.applies(state, mass);
         }
-        let w = state.angular_velocity;
-        // The same order of operations as `applies`: the same bits on every path.
-        let w2 = w.x * w.x + w.y * w.y + w.z * w.z;
-        w2 > self.quick && self.exceeds_turned(*state, mass, turn_rate)
+        self.spins_past_quick_bound(state) && self.exceeds_turned(*state, mass, turn_rate)
     }
 
     /// The split costs more than the limit and more than the springs' error (see
@@ -323,14 +314,7 @@ impl ExactSwitch {
     #[cold]
     #[inline(never)]
     fn exceeds_turned(&self, state: BodyState, mass: &MassProperties, turn_rate: Real) -> bool {
-        let principal = principal_orientation(&state, mass).widen();
-        let omega = rotate64(principal.conjugate(), state.angular_velocity.widen());
-        let inertia = mass.principal_inertia().widen();
-        let e_orbit = split_orbit_error(inertia, omega, self.span);
-        let measure = match self.rule {
-            Rule::Drift => drift_of_orbit_error(inertia, omega, e_orbit, ACCURACY_HORIZON.widen()),
-            Rule::StageError => e_orbit,
-        };
+        let (measure, e_orbit, omega) = self.judge(&state, mass);
         let turn = turn_rate.widen();
         measure > self.limit
             && e_orbit * omega.length() > turn * turn * turn * self.span * self.span / 24.0
@@ -338,12 +322,11 @@ impl ExactSwitch {
 
     /// False when the body spins too slowly for the switch to apply to it whatever its inertia
     /// and springs: the first, cheap test of [`applies`](Self::applies) and
-    /// [`applies_turned`](Self::applies_turned) (one `|ω|²`), for a caller that would otherwise
-    /// fetch more of the body first.
+    /// [`applies_turned`](Self::applies_turned), one `|ω|²`.
     #[inline(always)]
-    pub fn spins_past_quick_bound(&self, state: &BodyState) -> bool {
+    fn spins_past_quick_bound(&self, state: &BodyState) -> bool {
         let w = state.angular_velocity;
-        // The same order of operations as `applies`.
+        // A fixed order of operations: the same bits on every path.
         let w2 = w.x * w.x + w.y * w.y + w.z * w.z;
         w2 > self.quick
     }
@@ -359,14 +342,20 @@ impl ExactSwitch {
     /// [`ACCURACY_HORIZON`]) or the largest stage's `e_orbit` (module docs).
     #[cold]
     pub fn measure(&self, state: &BodyState, mass: &MassProperties) -> f64 {
+        self.judge(state, mass).0
+    }
+
+    /// [`measure`](Self::measure), with the `e_orbit` it was formed from and the principal
+    /// rates `ω`.
+    fn judge(&self, state: &BodyState, mass: &MassProperties) -> (f64, f64, DVec3) {
         let principal = principal_orientation(state, mass).widen();
         let omega = rotate64(principal.conjugate(), state.angular_velocity.widen());
         let inertia = mass.principal_inertia().widen();
-        match self.rule {
-            Rule::Drift => {
-                split_rotation_drift(inertia, omega, self.span, ACCURACY_HORIZON.widen())
-            }
-            Rule::StageError => split_orbit_error(inertia, omega, self.span),
-        }
+        let e_orbit = split_orbit_error(inertia, omega, self.span);
+        let measure = match self.rule {
+            Rule::Drift => drift_of_orbit_error(inertia, omega, e_orbit, ACCURACY_HORIZON.widen()),
+            Rule::StageError => e_orbit,
+        };
+        (measure, e_orbit, omega)
     }
 }

@@ -187,6 +187,8 @@ pub fn classify_springs(world: &mut World) {
         *flag = stiff_group[r];
     }
     mark_stiff(world, &springs, implicit_spring, &index, &implicit_body);
+    // After the implicit markers, in a pass of its own: the order components are added in
+    // decides the tables' order, and with it the order an implicit group's solve sums in.
     let rates: Vec<Real> = turn.iter().map(|t| t.sqrt()).collect();
     mark_turn_rates(world, &index, &rates);
     let springs = spring_count(world);
@@ -215,11 +217,7 @@ fn mark_stiff(
             world.entity_mut(*entity).remove::<ImplicitSpring>();
         }
     }
-    let bodies: Vec<Entity> = world
-        .query_filtered::<Entity, With<RigidBody>>()
-        .iter(world)
-        .collect();
-    for entity in bodies {
+    for entity in rigid_bodies(world) {
         let stiff = index.get(&entity).is_some_and(|&i| implicit_body[i]);
         let has = world.get::<ImplicitBody>(entity).is_some();
         if stiff && !has {
@@ -233,11 +231,7 @@ fn mark_stiff(
 /// Puts a [`SpringTurn`] with its rate on every dynamic body of `index` whose springs can turn
 /// it (`rates` per body, 0 for none), and takes it off the others.
 fn mark_turn_rates(world: &mut World, index: &EntityHashMap<usize>, rates: &[Real]) {
-    let bodies: Vec<Entity> = world
-        .query_filtered::<Entity, With<RigidBody>>()
-        .iter(world)
-        .collect();
-    for entity in bodies {
+    for entity in rigid_bodies(world) {
         let rate = index.get(&entity).map_or(0.0, |&i| rates[i]);
         match (rate > 0.0, world.get::<SpringTurn>(entity).copied()) {
             (true, Some(turn)) if turn.rate() == rate => {}
@@ -250,6 +244,14 @@ fn mark_turn_rates(world: &mut World, index: &EntityHashMap<usize>, rates: &[Rea
             (false, None) => {}
         }
     }
+}
+
+/// Every rigid body, in query order (as the world's tables stand now).
+fn rigid_bodies(world: &mut World) -> Vec<Entity> {
+    world
+        .query_filtered::<Entity, With<RigidBody>>()
+        .iter(world)
+        .collect()
 }
 
 /// Scratch memory of [`solve_implicit_springs`], kept between steps.
@@ -305,6 +307,7 @@ pub fn solve_implicit_springs(
     let dt = span.h;
     let half_substep = 0.5 * span.substep;
     let switch = ExactSwitch::new(settings.integrator, settings.free_flow, span.substep);
+    let judged = classification_span(&settings);
     for ((entity, t, mut v, m, mut acc, damping, turn), mut implicit) in &mut bodies {
         // `Damping` is a flow of its own, half a substep before the substep and half after (see
         // `tumble_core::damping`), as on the explicit path.
@@ -319,7 +322,7 @@ pub fn solve_implicit_springs(
         s.entities.push(entity);
         let state = body_state(&t, &v, m);
         let turn = turn.copied().unwrap_or_default();
-        let rotation = group_rotation(&settings, switch.as_ref(), turn, &state, &m.0);
+        let rotation = group_rotation(&settings, switch.as_ref(), judged, turn, &state, &m.0);
         s.all.push(GroupBody {
             state,
             mass: m.0,
@@ -377,18 +380,19 @@ pub fn solve_implicit_springs(
 
 /// How the implicit solve turns a body of a stiff group (see the module docs): by the world's
 /// integrator (its exact counterpart where `switch` gives the body the exact free flow this
-/// stage) where its springs turn it softly, by the implicit midpoint otherwise. A method that
-/// cannot be combined is passed on as it is, for the solve to refuse.
+/// stage) where its springs turn it softly, by the implicit midpoint otherwise (`judged` the
+/// span the classification judges, [`classification_span`]). A method that cannot be combined
+/// is passed on as it is, for the solve to refuse.
 fn group_rotation(
     settings: &PhysicsSettings,
     switch: Option<&ExactSwitch>,
+    judged: Real,
     turn: SpringTurn,
     state: &tumble_core::BodyState,
     mass: &tumble_core::MassProperties,
 ) -> GroupRotation {
     let method = settings.integrator;
-    if method.turns_at_constant_momentum() && turn.turns_by_midpoint(classification_span(settings))
-    {
+    if method.turns_at_constant_momentum() && turn.turns_by_midpoint(judged) {
         return GroupRotation::Midpoint;
     }
     match switch {
