@@ -146,19 +146,19 @@ fn random_scene_checksums_are_the_same_in_every_build() {
 const PINNED_F32: &[(&str, &str)] = &[
     (
         "symplectic-euler",
-        "09ee1e977e6e86ffb2d15be51af62f02 e31689f0b68d431eeef7d4801eaf196e a56d79aafe87091f334590910d16f791",
+        "edb59256137afdc0e924c820e164e8fb beac8f4be7624bc43f3245f1f8b4795f 5c93d92f03ea01e21301cfe29c09c086",
     ),
     (
         "symplectic-euler-linear",
-        "9f28705014683690a29b990fe293287f 15fb789bfb0196cd297134cc9c4064e6 9c3928c1733bee8ab1cabfd44bc6380f",
+        "675125aac4721bb4976815f340b8f278 b1a827186324ac7712a486d6d3db3ea2 b27ea581421fa9823f847f67b927664d",
     ),
     (
         "lclamp",
-        "6ca0491cfa4c35ac373227f4ceec4ad7 35ecc3f62d06caa6a0dd3ce1a93e96ae 84c138c8799e69a8affa6b38f6fb5041",
+        "3cc4d5b364826d9f30e45f362f34d461 2ecd7b7ac85b0128e38b249032790c25 5e0358ca9dcca5e3cc85917cdcce2b67",
     ),
     (
         "implicit-gyroscopic",
-        "180cbe55a0885bbcbe7d41e808e1a1d2 d7e6fb678a78029e476f2ec20e2710aa 2d6689ea266c7eb314acede9da2e51f9",
+        "e6e53ede24b272e10d76d3ba97af33fe ca2c7d64503d477764bb4925c1282055 20897df6d029b7a30598606e6f21488e",
     ),
     (
         "splitting",
@@ -166,7 +166,7 @@ const PINNED_F32: &[(&str, &str)] = &[
     ),
     (
         "splitting-xyz",
-        "8014c0d258c2db0bf0ec18ce029b81de 200f4188448f36f0b7e004a640267c47 dd8876b49d7c603644476130b8aa92ec",
+        "0cc939640e70838bcda68288208c1a1b 84674756e4bcbdc0aa743731b94d8b5a d03dcae7aea9d44fc7931e655b3fd22f",
     ),
     (
         "yoshida4",
@@ -174,7 +174,7 @@ const PINNED_F32: &[(&str, &str)] = &[
     ),
     (
         "rk4",
-        "03d78b4753febff7679d4f0fd5415c9a 6a649604b5eda1775b23a085eba7ff7c 8caa460d5b377dbb1d3aa635d3aee008",
+        "050bc3ac879f19b867115c528d53a68a 9bb4ac74f4a6ed5881d5bcc048f12e33 7192971284bf8a6e364f9484f9f7e359",
     ),
     (
         "exact",
@@ -189,19 +189,19 @@ const PINNED_F32: &[(&str, &str)] = &[
 const PINNED_F64: &[(&str, &str)] = &[
     (
         "symplectic-euler",
-        "e1fe6458cb116749c7912ab504bac7fa eb6f33020c827f4cdc2c289aa7acdc7c e85859e9cea4c5ac023004e8dd02a04c",
+        "431ca4fdb7b839f7955e3e466c26b6d4 ef5c726f1fa615a4f7074b3d47940c0f b40634c48b13568fceb23c9c6dcb0244",
     ),
     (
         "symplectic-euler-linear",
-        "9b4cd19bb1154e7d1cfba0db5eaf5a39 827b26d2088698bad36cb60c8002ff9a 888e2e5c4c1d444e3c3822b0cee4a55b",
+        "2369c3c04dfbfee036bfa04bc3f8dc8d 077dfa9df1ca3c0e926261872121163c db11bf7728f5b1324cbf52d512348a1f",
     ),
     (
         "lclamp",
-        "fc4a1e9c3379ce958d02f965b09b24ed fab1f281817a4c120cdec5a78b1689c8 d884e97a9f156cf074344d0a93c1bf38",
+        "05d1846826261d5fec9282d131161104 dc28eff1a176144916dad9fe31966f56 084fc9f415396e647dfba50aa10f14d7",
     ),
     (
         "implicit-gyroscopic",
-        "13b02c20f7c41e8c0eb7642b9dc07fb9 a084fdf3d82d1e393e450b94b4f78f5f 060fba8106b5f6bac77c64bb7dd71668",
+        "bd696f785cf3eb8920b9cbe82e411bb8 2ebd4abf87b8bcb4187c9bf58710fa18 9d03a983a5a85de3a7f62c03ae41447b",
     ),
     (
         "splitting",
@@ -209,7 +209,7 @@ const PINNED_F64: &[(&str, &str)] = &[
     ),
     (
         "splitting-xyz",
-        "e30414cc787b6fad76727aff4155dae1 e6ca56697bd65fe6732502bd0a981a32 57aa7f6cb3aa60d0ae27f8e2937f50b7",
+        "e30414cc787b6fad76727aff4155dae1 78cc34d8a64cd3df24dbb729a52fe2fc 57aa7f6cb3aa60d0ae27f8e2937f50b7",
     ),
     (
         "yoshida4",
@@ -217,7 +217,7 @@ const PINNED_F64: &[(&str, &str)] = &[
     ),
     (
         "rk4",
-        "0418e291081333fc6b1e31066ab41ae5 2161ce759fc740def0ff4a3e7e7d60b7 06fa8c4a9a1e4c4c6b13528fc53ef5a2",
+        "5b78d5d3517ef9055a7b7c938af74528 925d66a75dce930abf2f18edbb5e177f 078480bc4b35fc880f76bfde4c621088",
     ),
     (
         "exact",

@@ -13,9 +13,9 @@ pub mod bandwidth;
 pub mod budget;
 pub mod csv;
 pub mod engines;
-pub mod exact;
 pub mod machines;
 pub mod measure;
+pub mod methods;
 pub mod output;
 pub mod population;
 pub mod rollback;
@@ -158,8 +158,8 @@ pub struct BenchResults {
     pub runner_check: Option<RunnerCheckCost>,
     /// Spring chains: the cost of stiffness and spring throughput.
     pub springs: springs::SpringResults,
-    /// The exact free flow against the default, ECS, one thread.
-    pub exact: Vec<exact::ExactRow>,
+    /// Every integrator against the default, ECS, one thread.
+    pub methods: Vec<methods::MethodRow>,
     /// Rollback snapshots: bytes per body, capture and restore time.
     pub rollback: Vec<rollback::RollbackRow>,
     /// Trajectory CSV writing throughput.
@@ -266,12 +266,12 @@ pub fn run_bench(options: &BenchOptions, mut progress: impl FnMut(&str)) -> Benc
     ));
     let runner_check = Some(runner_check(check_bodies, &effort));
     let springs = springs::run(options.quick, &mut progress);
-    let exact_sizes: &[usize] = if options.quick {
+    let method_sizes: &[usize] = if options.quick {
         &[1_000]
     } else {
         &[1_000, 100_000]
     };
-    let exact = exact::run(exact_sizes, &effort, &mut progress);
+    let methods = methods::run(method_sizes, &effort, &mut progress);
     let rollback_sizes: &[usize] = if options.quick {
         &[1_000]
     } else {
@@ -289,7 +289,7 @@ pub fn run_bench(options: &BenchOptions, mut progress: impl FnMut(&str)) -> Benc
         .into_iter()
         .collect();
     let mut results = BenchResults {
-        schema: 3,
+        schema: 4,
         pool_threads: pool_threads(),
         kernel_path: tumble_core::kernel_path().to_string(),
         widest_kernel_path: widest_kernel_path(),
@@ -304,7 +304,7 @@ pub fn run_bench(options: &BenchOptions, mut progress: impl FnMut(&str)) -> Benc
         unused_feature,
         runner_check,
         springs,
-        exact,
+        methods,
         rollback,
         csv,
         targets: Vec::new(),

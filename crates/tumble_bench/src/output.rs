@@ -3,7 +3,9 @@
 
 use std::fmt::Write;
 
+use crate::methods::{METHOD_BOUNDS, MethodRow};
 use crate::{BenchResults, Row, Target};
+use tumble_core::Integrator;
 
 /// The default integrator's name (the targets are stated for it).
 const DEFAULT: &str = "splitting";
@@ -214,15 +216,21 @@ fn fixed_costs_targets(results: &BenchResults, out: &mut Vec<Target>) {
     }
 }
 
-/// `exact` against `splitting`, and the implicit spring step against the explicit one.
+/// Every integrator against its bound ([`METHOD_BOUNDS`]), and the implicit spring step
+/// against the explicit one.
 fn exact_and_implicit_targets(results: &BenchResults, out: &mut Vec<Target>) {
-    for row in &results.exact {
-        out.push(target(
-            &format!("exact / splitting, ECS 1 thread, {} bodies", row.bodies),
-            row.ratio(),
-            "<=",
-            10.0,
-        ));
+    for row in &results.methods {
+        for b in &METHOD_BOUNDS {
+            out.push(target(
+                &format!(
+                    "{} / {}, ECS 1 thread, {} bodies",
+                    b.integrator, b.relative_to, row.bodies
+                ),
+                row.ratio(b.integrator, b.relative_to),
+                "<=",
+                b.bound,
+            ));
+        }
     }
     if let Some(explicit) = results.springs.explicit_reference() {
         for row in results
@@ -399,7 +407,7 @@ pub fn markdown(results: &BenchResults) -> String {
     }
     let _ = writeln!(s, "{}\n", flops_line(results));
     s.push_str(&springs_markdown(results));
-    s.push_str(&exact_markdown(&results.exact));
+    s.push_str(&methods_markdown(&results.methods));
     s.push_str(&rollback_markdown(&results.rollback));
     s.push_str(&csv_markdown(&results.csv));
     s.push_str(&targets_table(&results.targets));
@@ -451,23 +459,29 @@ pub fn rollback_markdown(rows: &[crate::rollback::RollbackRow]) -> String {
     )
 }
 
-/// The exact free flow's cost against the default.
-pub fn exact_markdown(rows: &[crate::exact::ExactRow]) -> String {
-    table_if_any(
-        "**exact** free rotation against `splitting` — ns per body-step, ECS, 1 thread",
-        "| bodies | splitting | exact | exact / splitting |",
-        "|---:|---:|---:|---:|",
-        rows,
-        |r| {
-            format!(
-                "| {} | {} | {} | {:.1}× |",
-                r.bodies,
-                fmt_ns(r.splitting_ns),
-                fmt_ns(r.exact_ns),
-                r.ratio()
-            )
-        },
-    )
+/// Every integrator's cost against the default.
+pub fn methods_markdown(rows: &[MethodRow]) -> String {
+    let mut s = String::new();
+    for row in rows {
+        s.push_str(&table_if_any(
+            &format!(
+                "**Every integrator**, {} free bodies — ns per body-step, ECS, 1 thread, and \
+                 relative to `splitting`",
+                row.bodies
+            ),
+            "| integrator | ns/body-step | × splitting |",
+            "|---|---:|---:|",
+            &row.ns,
+            |&(integrator, ns)| {
+                format!(
+                    "| `{integrator}` | {} | {:.2} |",
+                    fmt_ns(ns),
+                    ns / row.ns_of(Integrator::Splitting)
+                )
+            },
+        ));
+    }
+    s
 }
 
 /// The spring tables: one chain at each stiffness, then spring throughput (next to the free

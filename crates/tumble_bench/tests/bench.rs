@@ -38,7 +38,13 @@ fn small_run_measures_every_engine_and_writes_json() {
     );
     assert!(!results.targets.iter().any(|t| t.name.contains("1e5")));
     let json: serde_json::Value = serde_json::to_value(&results).unwrap();
-    assert_eq!(json["schema"], 3);
+    assert_eq!(json["schema"], 4);
+    // Every integrator timed against the default, in one interleaved run.
+    for row in &results.methods {
+        assert_eq!(row.ns.len(), tumble_core::Integrator::ALL.len());
+        assert!(row.ns.iter().all(|(_, ns)| ns.is_finite() && *ns > 0.0));
+    }
+    assert!(!results.methods.is_empty());
     assert!(
         (0.5..=2.2).contains(&results.two_copy_ceiling),
         "{}",

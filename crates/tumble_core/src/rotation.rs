@@ -31,14 +31,6 @@ pub(crate) fn rotate_exact(q: Quat, omega: Vec3, dt: Real) -> Quat {
     quat_normalize(quat_mul(exp_rotation(omega * dt), q))
 }
 
-/// The linearized update `q ← normalize(q + ½ Δt (ω, 0) q)`: first-order, its error grows with
-/// `|ω|Δt` (kept to show that error, see the `symplectic-euler-linear` integrator).
-#[inline]
-pub(crate) fn rotate_linearized(q: Quat, omega: Vec3, dt: Real) -> Quat {
-    let w = Quat::from_xyzw(omega.x, omega.y, omega.z, 0.0);
-    quat_normalize(q + quat_mul(w, q) * (0.5 * dt))
-}
-
 /// Rotation angle between two orientations, in radians (0..π): the angle of `a* b`, computed as
 /// `2 atan2(|v|, |w|)` in f64, which stays accurate for tiny angles where `2 acos |⟨a, b⟩|` loses
 /// every digit (and returns 0 once round-off pushes the dot product past 1).

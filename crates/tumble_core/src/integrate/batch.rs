@@ -2,24 +2,30 @@
 //! share.
 //!
 //! A batch reads each body from a [`BodyBatch`] (plain arrays, or an ECS table without an
-//! intermediate copy), steps it and writes it back. For `splitting` (the default) the free
-//! rotations of up to eight non-spherical bodies are computed together in SIMD lanes by the
-//! kernel of `symmetric_kernel`, on the [`kernel_path`](super::kernel_path) (and so for each
-//! stage of `yoshida4`, a composition of `splitting` steps); the translation,
-//! the kicks and spherical bodies stay scalar. `exact` and `exact4` rotate two bodies at a time,
-//! in scalar code run stage by stage so that their long dependency chains overlap. Every other
-//! method steps body by body. Either way each body's result is bit-identical
-//! to [`Integrator::try_step`] and the stage functions on that body alone, whatever the batch, its order or
-//! the thread that runs it.
+//! intermediate copy), steps it and writes it back. For the drift–kick–drift methods
+//! `splitting` (the default), `splitting-xyz` and `rk4` the free rotations of up to eight
+//! non-spherical bodies are computed together in SIMD lanes by the kernel of `symmetric_kernel`,
+//! on the [`kernel_path`](super::kernel_path), and so are the three stages' flows of a torque-free
+//! `yoshida4` step; the translation, the kicks and spherical bodies stay scalar. The four
+//! kick–drift methods rotate eight bodies at a time on their own kernel (`kick_drift_kernel`),
+//! spherical ones included. `exact` and `exact4` rotate two bodies at a time, in scalar code run
+//! stage by stage so that their long dependency chains overlap. Either way each body's result is
+//! bit-identical to [`Integrator::try_step`] and the stage functions on that body alone,
+//! whatever the batch, its order, the kernel path or the thread that runs it.
 
 use crate::math::{Quat, Real, Vec3};
 use std::borrow::Borrow;
 
 use super::exact_flow::{rotate_exactly, rotate_exactly_pair};
+use super::kick_drift_kernel::{
+    KickDrift, KickDriftLanes, kick_drift_lanes, kick_drift_one, kick_drift_translation,
+};
 use super::splitting::{
     drift_kick_drift_linear, drift_kick_drift_translation, free_rotation_span, kick_angular,
 };
-use super::symmetric_kernel::{LaneInputs, rotate_symmetric_lanes, rotate_symmetric_one};
+use super::symmetric_kernel::{
+    LaneFlow, LaneInputs, RotatedLanes, rotate_symmetric_lanes, rotate_symmetric_one,
+};
 use super::{ExactSwitch, Integrator};
 use crate::mass::MassProperties;
 use crate::prefetch::prefetch;
@@ -130,68 +136,139 @@ fn commit(bodies: &mut impl BodyBatch, i: usize, next: &BodyState) {
     }
 }
 
-/// Bodies waiting for their free rotation over the same `h`, flushed [`LANES`] at a time: each
+/// A lane kernel's inputs for [`LANES`] bodies, as a batch queues them: the rotation each of
+/// them is waiting for.
+trait QueuedLanes {
+    /// Puts the body `state` (already translated) into lane `lane`, under `load`: the angular
+    /// impulse of its kick for `splitting`, its torque for a kick–drift method.
+    fn set(&mut self, lane: usize, state: &BodyState, mass: &MassProperties, load: Vec3);
+    /// Copies lane 0 into lanes `from..LANES` (the filler of a partial batch; lanes are
+    /// independent, so any valid input will do).
+    fn fill_from_first(&mut self, from: usize);
+    /// Lane `lane` rotated alone, through the kernel on `f64`: its new `(q, ω)`.
+    fn one(&self, lane: usize, h: Real) -> (Quat, Vec3);
+    /// Every lane rotated at once on `kernel`'s instruction set (the same bits as [`one`](Self::one)).
+    fn all(&self, kernel: Kernel, h: [Real; LANES]) -> RotatedLanes;
+}
+
+/// The symmetric-top flows of `splitting` (after their kicks) or of a composed step.
+struct SymmetricQueue {
+    inputs: LaneInputs,
+    flow: LaneFlow,
+}
+
+impl QueuedLanes for SymmetricQueue {
+    #[inline(always)]
+    fn set(&mut self, lane: usize, state: &BodyState, mass: &MassProperties, load: Vec3) {
+        let relabels = self.flow.relabels();
+        self.inputs.set(
+            lane,
+            state.rotation,
+            state.angular_velocity,
+            mass,
+            load,
+            relabels,
+        );
+    }
+    #[inline(always)]
+    fn fill_from_first(&mut self, from: usize) {
+        self.inputs.fill_from_first(from);
+    }
+    #[inline(always)]
+    fn one(&self, lane: usize, h: Real) -> (Quat, Vec3) {
+        rotate_symmetric_one(&self.inputs.get(lane), h, self.flow)
+    }
+    #[inline(always)]
+    fn all(&self, kernel: Kernel, h: [Real; LANES]) -> RotatedLanes {
+        rotate_symmetric_lanes(kernel, &self.inputs, h, self.flow)
+    }
+}
+
+/// The rotations of a kick–drift method.
+struct KickDriftQueue {
+    inputs: KickDriftLanes,
+    method: KickDrift,
+}
+
+impl QueuedLanes for KickDriftQueue {
+    #[inline(always)]
+    fn set(&mut self, lane: usize, state: &BodyState, mass: &MassProperties, load: Vec3) {
+        self.inputs
+            .set(lane, state.rotation, state.angular_velocity, mass, load);
+    }
+    #[inline(always)]
+    fn fill_from_first(&mut self, from: usize) {
+        self.inputs.fill_from_first(from);
+    }
+    #[inline(always)]
+    fn one(&self, lane: usize, h: Real) -> (Quat, Vec3) {
+        kick_drift_one(&self.inputs.get(lane), h, self.method)
+    }
+    #[inline(always)]
+    fn all(&self, kernel: Kernel, h: [Real; LANES]) -> RotatedLanes {
+        kick_drift_lanes(kernel, &self.inputs, h, self.method)
+    }
+}
+
+/// Bodies waiting for their rotation over the same `h`, flushed [`LANES`] at a time: each
 /// body's translated position and velocity, and its kernel inputs component by component so
 /// that the kernel loads them as vectors. (`h` is written once, not per body: scalar stores
 /// read back at once by a vector load stall store forwarding.)
-struct PendingRotations {
+struct PendingRotations<L> {
     index: [usize; LANES],
     /// Each queued body's `(position, linear_velocity)`: the rest of its state is the kernel's.
     translated: [(Vec3, Vec3); LANES],
-    input: LaneInputs,
+    lanes: L,
     h: [Real; LANES],
     len: usize,
     kernel: Kernel,
 }
 
-impl PendingRotations {
+impl<L: QueuedLanes> PendingRotations<L> {
     /// No bodies yet; all of them will rotate over `h`, `LANES` at a time on `kernel`.
-    fn new(h: Real, kernel: Kernel) -> Self {
+    fn new(h: Real, kernel: Kernel, lanes: L) -> Self {
         Self {
             index: [0; LANES],
             translated: [(Vec3::ZERO, Vec3::ZERO); LANES],
-            input: LaneInputs::default(),
+            lanes,
             h: [h; LANES],
             len: 0,
             kernel,
         }
     }
 
-    /// Queues body `index` (already translated, as `state`, and not spherical) for its free
-    /// rotation after the kick of angular impulse `impulse`; returns true when the batch is full
-    /// and must be flushed.
+    /// Queues body `index` (already translated, as `state`) for its rotation under `load` (see
+    /// [`QueuedLanes::set`]); returns true when the batch is full and must be flushed.
     #[inline(always)]
     fn queue(
         &mut self,
         index: usize,
         state: &BodyState,
         mass: &MassProperties,
-        impulse: Vec3,
+        load: Vec3,
     ) -> bool {
         let lane = self.len;
-        self.input
-            .set(lane, state.rotation, state.angular_velocity, mass, impulse);
+        self.lanes.set(lane, state, mass, load);
         self.index[lane] = index;
         self.translated[lane] = (state.position, state.linear_velocity);
         self.len = lane + 1;
         self.len == LANES
     }
 
-    /// Rotates the queued bodies (after their kicks when `kicks`) and commits each result. A
-    /// batch of one goes through the scalar kernel; a partial batch fills its empty lanes with
-    /// copies of its first body (lanes are independent, so the results are the same bits either
-    /// way).
+    /// Rotates the queued bodies and commits each result. A batch of one goes through the
+    /// scalar kernel; a partial batch fills its empty lanes with copies of its first body
+    /// (lanes are independent, so the results are the same bits either way).
     #[inline(always)]
-    fn flush(&mut self, bodies: &mut impl BodyBatch, kicks: bool) {
+    fn flush(&mut self, bodies: &mut impl BodyBatch) {
         match self.len {
             0 => {}
             1 => {
-                let (rotation, omega) = rotate_symmetric_one(&self.input.get(0), self.h[0], kicks);
+                let (rotation, omega) = self.lanes.one(0, self.h[0]);
                 self.finish(0, rotation, omega, bodies);
             }
             len => {
-                self.input.fill_from_first(len);
-                let rotated = rotate_symmetric_lanes(self.kernel, &self.input, self.h, kicks);
+                self.lanes.fill_from_first(len);
+                let rotated = self.lanes.all(self.kernel, self.h);
                 for lane in 0..len {
                     let (rotation, omega) = rotated.lane(lane);
                     self.finish(lane, rotation, omega, bodies);
@@ -246,6 +323,7 @@ fn each_alone(
 #[inline(always)]
 fn batched(
     kernel: Kernel,
+    flow: LaneFlow,
     phase: StepPhase,
     bodies: &mut impl BodyBatch,
     dt: Real,
@@ -253,8 +331,9 @@ fn batched(
     mut alone: impl FnMut(&mut BodyState, &MassProperties, &Wrench, Real),
 ) {
     let h = free_rotation_span(phase, dt);
-    let kicks = phase == StepPhase::Finish;
-    let mut pending = PendingRotations::new(h, kernel);
+    let flow = flow.with_kick(phase == StepPhase::Finish);
+    let inputs = LaneInputs::default();
+    let mut pending = PendingRotations::new(h, kernel, SymmetricQueue { inputs, flow });
     let mut next = BodyState::ZEROED;
     for i in 0..bodies.len() {
         bodies.prefetch(i + PREFETCH_AHEAD);
@@ -278,7 +357,7 @@ fn batched(
             }
             Some(impulse) => {
                 if pending.queue(i, &next, mass, impulse) {
-                    pending.flush(bodies, kicks);
+                    pending.flush(bodies);
                 }
             }
             None => {
@@ -290,7 +369,86 @@ fn batched(
             }
         }
     }
-    pending.flush(bodies, kicks);
+    pending.flush(bodies);
+}
+
+/// The batch of whole composed steps (`yoshida4`): a body without torque takes the exact
+/// translation over `dt` and its stages' free rotations in sequence, queued for the SIMD kernel
+/// (as [`Integrator::step`] does alone); a spherical body turns exactly; a body under a torque
+/// is stepped whole by `alone`, stage by stage.
+#[inline(always)]
+fn composed(
+    kernel: Kernel,
+    weights: &'static [Real],
+    bodies: &mut impl BodyBatch,
+    dt: Real,
+    switch: Option<ExactSwitch>,
+    mut alone: impl FnMut(&mut BodyState, &MassProperties, &Wrench, Real),
+) {
+    let flow = LaneFlow::Composed(weights);
+    let inputs = LaneInputs::default();
+    let mut pending = PendingRotations::new(dt, kernel, SymmetricQueue { inputs, flow });
+    let mut next = BodyState::ZEROED;
+    for i in 0..bodies.len() {
+        bodies.prefetch(i + PREFETCH_AHEAD);
+        let Some(wrench) = bodies.read(i, &mut next) else {
+            continue;
+        };
+        let mass = bodies.mass(i);
+        let turn = bodies.spring_turn_rate(i);
+        if wrench.torque != Vec3::ZERO
+            || switch.is_some_and(|switch| switch.applies_turned(&next, mass, turn))
+        {
+            let mut single = next;
+            alone(&mut single, mass, &wrench, turn);
+            commit(bodies, i, &single);
+            continue;
+        }
+        drift_kick_drift_translation(StepPhase::Whole, &mut next, mass, &wrench, dt);
+        if mass.is_spherical() {
+            next.rotation = rotate_exact(next.rotation, next.angular_velocity, dt);
+            commit(bodies, i, &next);
+        } else if pending.queue(i, &next, mass, Vec3::ZERO) {
+            pending.flush(bodies);
+        }
+    }
+    pending.flush(bodies);
+}
+
+/// The kick–drift batch (`symplectic-euler*`, `lclamp`, `implicit-gyroscopic`): each body's
+/// translation, then its rotation under its torque, queued for the SIMD kernel
+/// ([`PendingRotations`]).
+#[inline(always)]
+fn kick_drifted(
+    kernel: Kernel,
+    method: KickDrift,
+    bodies: &mut impl BodyBatch,
+    h: Real,
+    switch: Option<ExactSwitch>,
+    mut alone: impl FnMut(&mut BodyState, &MassProperties, &Wrench, Real),
+) {
+    let inputs = KickDriftLanes::default();
+    let mut pending = PendingRotations::new(h, kernel, KickDriftQueue { inputs, method });
+    let mut next = BodyState::ZEROED;
+    for i in 0..bodies.len() {
+        bodies.prefetch(i + PREFETCH_AHEAD);
+        let Some(wrench) = bodies.read(i, &mut next) else {
+            continue;
+        };
+        let mass = bodies.mass(i);
+        let turn = bodies.spring_turn_rate(i);
+        if switch.is_some_and(|switch| switch.applies_turned(&next, mass, turn)) {
+            let mut single = next;
+            alone(&mut single, mass, &wrench, turn);
+            commit(bodies, i, &single);
+            continue;
+        }
+        kick_drift_translation(&mut next, mass, wrench.force, h);
+        if pending.queue(i, &next, mass, wrench.torque) {
+            pending.flush(bodies);
+        }
+    }
+    pending.flush(bodies);
 }
 
 /// The `exact` batch: each body's drift–kick–drift translation, then its free rotation, two
@@ -412,12 +570,12 @@ impl Integrator {
     /// valid ([`BodyState::is_valid`]) keeps its state and is reported to
     /// [`BodyBatch::diverged`]; no other body is affected. Does not allocate.
     ///
-    /// `splitting` and `yoshida4` rotate their bodies in SIMD lanes on the
+    /// Every method but `exact` and `exact4` rotates its bodies in SIMD lanes on the
     /// [`kernel_path`](super::kernel_path) (every path gives the same bits).
     ///
     /// # Panics
     ///
-    /// For `splitting` and `yoshida4`, when the environment variable
+    /// For those methods, when the environment variable
     /// [`KERNEL_ENV`](super::KERNEL_ENV) names a kernel path this CPU cannot run (see
     /// [`KernelPath::selected`](super::KernelPath::selected)).
     pub fn stage_batch(self, phase: StepPhase, bodies: &mut impl BodyBatch, h: Real) {
@@ -434,7 +592,7 @@ impl Integrator {
         h: Real,
         switch: Option<ExactSwitch>,
     ) {
-        let kernel = if self.rotates_on_symmetric_kernel() {
+        let kernel = if self.batches_in_lanes() {
             Kernel::selected()
         } else {
             Kernel::Portable
@@ -465,14 +623,21 @@ impl Integrator {
                 StepPhase::Finish => paired(StepPhase::Finish, bodies, h, alone),
             };
         }
-        if !self.rotates_on_symmetric_kernel() {
-            return each_alone(bodies, alone);
+        if let Some(method) = KickDrift::of(self) {
+            // The kick–drift methods do nothing before the forces (see `begin_stage`).
+            return match phase {
+                StepPhase::Begin => each_alone(bodies, alone),
+                _ => kick_drifted(kernel, method, bodies, h, switch, alone),
+            };
         }
         // One loop per phase, each with its phase a constant, as if written out three times.
+        let Some(flow) = self.lane_flow() else {
+            return each_alone(bodies, alone);
+        };
         match phase {
-            StepPhase::Whole => batched(kernel, StepPhase::Whole, bodies, h, switch, alone),
-            StepPhase::Begin => batched(kernel, StepPhase::Begin, bodies, h, switch, alone),
-            StepPhase::Finish => batched(kernel, StepPhase::Finish, bodies, h, switch, alone),
+            StepPhase::Whole => batched(kernel, flow, StepPhase::Whole, bodies, h, switch, alone),
+            StepPhase::Begin => batched(kernel, flow, StepPhase::Begin, bodies, h, switch, alone),
+            StepPhase::Finish => batched(kernel, flow, StepPhase::Finish, bodies, h, switch, alone),
         }
     }
 
@@ -493,8 +658,24 @@ impl Integrator {
         dt: Real,
         switch: Option<ExactSwitch>,
     ) {
+        let kernel = if self.batches_in_lanes() {
+            Kernel::selected()
+        } else {
+            Kernel::Portable
+        };
+        self.step_batch_on(kernel, bodies, dt, switch);
+    }
+
+    /// [`step_batch_switched`](Self::step_batch_switched) with the SIMD lanes on `kernel`.
+    pub(crate) fn step_batch_on(
+        self,
+        kernel: Kernel,
+        bodies: &mut impl BodyBatch,
+        dt: Real,
+        switch: Option<ExactSwitch>,
+    ) {
         if let [c] = self.composition() {
-            return self.stage_batch_switched(StepPhase::Whole, bodies, c * dt, switch);
+            return self.stage_batch_on(kernel, StepPhase::Whole, bodies, c * dt, switch);
         }
         let alone = |s: &mut BodyState, m: &MassProperties, w: &Wrench, turn: Real| match switch {
             Some(switch) if switch.applies_turned(s, m, turn) => switch.exact().step(s, m, w, dt),
@@ -504,6 +685,9 @@ impl Integrator {
             // Without torque its composed step is the translation of a whole stage over `dt`
             // and one exact rotation over `dt` (see `Integrator::step`): a whole stage's work.
             return paired(StepPhase::Whole, bodies, dt, alone);
+        }
+        if self.rotates_on_symmetric_kernel() {
+            return composed(kernel, self.composition(), bodies, dt, switch, alone);
         }
         each_alone(bodies, alone);
     }

@@ -54,17 +54,3 @@ pub fn rotate_inv(q: Quat, v: Vec3) -> Vec3 {
 pub(super) fn principal_orientation(state: &BodyState, mass: &MassProperties) -> Quat {
     crate::math::quat_mul(state.rotation, mass.principal_frame())
 }
-
-/// Removes the angular velocity about locked principal axes (zero moment ⇒ no rotation about
-/// that axis), for methods that update `ω` directly rather than through `L`.
-#[inline]
-pub(super) fn clear_locked_axes(state: &mut BodyState, mass: &MassProperties) {
-    if !mass.has_locked_axis() {
-        return;
-    }
-    let q_principal = principal_orientation(state, mass);
-    let unlocked = mass.inv_principal_inertia().cmpgt(Vec3::ZERO);
-    let body = rotate_inv(q_principal, state.angular_velocity);
-    let kept = Vec3::select(unlocked, body, Vec3::ZERO);
-    state.angular_velocity = rotate(q_principal, kept);
-}

@@ -9,31 +9,41 @@
 //!
 //! It never blows up, but the direction error of the explicit step is kept: a stable spin about
 //! the largest axis drifts toward the middle axis and gains energy. First order; kept as the
-//! reference point of what other engines do.
+//! reference point of what other engines do. The rotation runs on the kick–drift kernel
+//! (`kick_drift_kernel`).
 
-use super::frame::{clear_locked_axes, principal_orientation, rotate, rotate_inv};
-use crate::mass::MassProperties;
-use crate::math::Real;
-use crate::rotation::rotate_exact;
-use crate::state::{BodyState, Wrench};
+use super::kick_drift_kernel::PrincipalBody;
+use super::lanes::{Vec3L, cross};
+use crate::simd::Lane;
 
-/// One step of the `lclamp` method.
-#[inline]
-pub(super) fn lclamp(state: &mut BodyState, mass: &MassProperties, wrench: &Wrench, dt: Real) {
-    state.linear_velocity += (dt * mass.inv_mass()) * wrench.force;
-    state.position += dt * state.linear_velocity;
-    let q = principal_orientation(state, mass);
-    let inertia = mass.principal_inertia();
-    let omega = rotate_inv(q, state.angular_velocity);
-    let torque = rotate_inv(q, wrench.torque);
-    let momentum = inertia * omega;
-    let target = (momentum + dt * torque).length();
-    let mut next = omega + dt * mass.inv_principal_inertia() * (torque - omega.cross(momentum));
-    let length = (inertia * next).length();
-    if length > 0.0 && target.is_finite() {
-        next *= target / length;
-    }
-    state.angular_velocity = rotate(q, next);
-    clear_locked_axes(state, mass);
-    state.rotation = rotate_exact(state.rotation, state.angular_velocity, dt);
+/// The `lclamp` kick of the body rates: the explicit kick `n = b + h r ⊙ (t − b × I b)`,
+/// rescaled so that `|I n| = |I b + h t|` (unless `|I n| = 0` or the target is not finite);
+/// returns `n − b`.
+#[inline(always)]
+pub(super) fn clamped_kick<T: Lane>(body: &PrincipalBody<T>, h: T) -> Vec3L<T> {
+    let (b, i, r, t) = (body.omega, body.inertia, body.r, body.torque);
+    let cpu = h.cpu();
+    let (zero, one) = (T::splat(cpu, 0.0), T::splat(cpu, 1.0));
+    let momentum = [i[0] * b[0], i[1] * b[1], i[2] * b[2]];
+    let kicked = [
+        momentum[0] + h * t[0],
+        momentum[1] + h * t[1],
+        momentum[2] + h * t[2],
+    ];
+    let target = (kicked[0] * kicked[0] + kicked[1] * kicked[1] + kicked[2] * kicked[2]).sqrt();
+    let gyro = cross(b, momentum);
+    let next = [
+        b[0] + h * r[0] * (t[0] - gyro[0]),
+        b[1] + h * r[1] * (t[1] - gyro[1]),
+        b[2] + h * r[2] * (t[2] - gyro[2]),
+    ];
+    let l = [i[0] * next[0], i[1] * next[1], i[2] * next[2]];
+    let length = (l[0] * l[0] + l[1] * l[1] + l[2] * l[2]).sqrt();
+    let scale = T::select(length.gt(zero), target / length, one);
+    let scale = T::select(target.beyond(f64::MAX), one, scale);
+    [
+        next[0] * scale - b[0],
+        next[1] * scale - b[1],
+        next[2] * scale - b[2],
+    ]
 }

@@ -39,6 +39,8 @@ pub use free_flow::{
     SPLIT_ERROR_LIMIT, split_orbit_error, split_rotation_drift, split_rotation_error,
 };
 mod implicit_gyroscopic;
+mod kick_drift_kernel;
+mod lanes;
 mod lclamp;
 mod momentum_flow;
 pub(crate) use momentum_flow::free_turn;
@@ -66,15 +68,13 @@ use crate::state::{BodyState, Wrench};
 pub use crate::simd::{KERNEL_ENV, KernelError, KernelPath, OpCounts, kernel_path};
 use exact_flow::rotate_exactly;
 pub use frame::{rotate, rotate_inv};
-use implicit_gyroscopic::implicit_gyroscopic;
-use lclamp::lclamp;
-use rk4::rk4_free_flow;
+use kick_drift_kernel::{KickDrift, kick_drift_step};
 use splitting::{
-    Rotation, drift_kick_drift, drift_kick_drift_translation, kick_angular, rotate_freely,
-    rotate_symmetric_kicked, strang_free_flow,
+    Rotation, drift_kick_drift, drift_kick_drift_translation, kick_angular,
+    rotate_kicked_on_kernel, rotate_symmetric_kicked,
 };
+use symmetric_kernel::LaneFlow;
 pub use symmetric_kernel::symmetric_rotation_flops;
-use symplectic_euler::{symplectic_euler, symplectic_euler_linear};
 
 /// A time-integration method, selectable per world.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
@@ -225,7 +225,27 @@ impl Integrator {
     /// True when the method's free rotation is `splitting`'s symmetric-top flow, which the
     /// batched step runs in SIMD lanes (`splitting`, and `yoshida4`, a composition of it).
     fn rotates_on_symmetric_kernel(self) -> bool {
-        matches!(self, Integrator::Splitting | Integrator::Yoshida4)
+        self.lane_flow().is_some()
+    }
+
+    /// The free flow the lane kernel of `symmetric_kernel` runs for this method, without its
+    /// kick (`yoshida4`'s stages are `splitting`'s flow).
+    fn lane_flow(self) -> Option<LaneFlow> {
+        match self {
+            Integrator::Splitting | Integrator::Yoshida4 => {
+                Some(LaneFlow::Symmetric { kicks: false })
+            }
+            Integrator::SplittingXyz => Some(LaneFlow::Xyz { kicks: false }),
+            Integrator::Rk4 => Some(LaneFlow::Rk4 { kicks: false }),
+            _ => None,
+        }
+    }
+
+    /// True when the batched step rotates the method's bodies in SIMD lanes on the
+    /// [`kernel_path`]: `splitting` and `yoshida4` (the symmetric-top kernel) and the four
+    /// kick–drift methods (their own kernel).
+    fn batches_in_lanes(self) -> bool {
+        self.rotates_on_symmetric_kernel() || kick_drift_kernel::KickDrift::of(self).is_some()
     }
 
     /// The free rotation of a drift–kick–drift method, after the kick's angular impulse:
@@ -233,16 +253,14 @@ impl Integrator {
     fn free_rotation(self) -> Rotation {
         match self {
             Integrator::Rk4 => |s, m, h, j| {
-                kick_angular(s, m, j);
-                rotate_freely(s, m, h, rk4_free_flow);
+                rotate_kicked_on_kernel(s, m, h, j, LaneFlow::Rk4 { kicks: true });
             },
             Integrator::Exact | Integrator::Exact4 => |s, m, h, j| {
                 kick_angular(s, m, j);
                 rotate_exactly(s, m, h);
             },
             Integrator::SplittingXyz => |s, m, h, j| {
-                kick_angular(s, m, j);
-                rotate_freely(s, m, h, strang_free_flow);
+                rotate_kicked_on_kernel(s, m, h, j, LaneFlow::Xyz { kicks: true });
             },
             _ => rotate_symmetric_kicked,
         }
@@ -270,10 +288,16 @@ impl Integrator {
         h: Real,
     ) {
         match self {
-            Integrator::SymplecticEuler => symplectic_euler(state, mass, wrench, h),
-            Integrator::SymplecticEulerLinear => symplectic_euler_linear(state, mass, wrench, h),
-            Integrator::Lclamp => lclamp(state, mass, wrench, h),
-            Integrator::ImplicitGyroscopic => implicit_gyroscopic(state, mass, wrench, h),
+            Integrator::SymplecticEuler => {
+                kick_drift_step(state, mass, wrench, h, KickDrift::Explicit);
+            }
+            Integrator::SymplecticEulerLinear => {
+                kick_drift_step(state, mass, wrench, h, KickDrift::ExplicitLinear);
+            }
+            Integrator::Lclamp => kick_drift_step(state, mass, wrench, h, KickDrift::Clamped),
+            Integrator::ImplicitGyroscopic => {
+                kick_drift_step(state, mass, wrench, h, KickDrift::Implicit);
+            }
             Integrator::Splitting
             | Integrator::SplittingXyz
             | Integrator::Yoshida4

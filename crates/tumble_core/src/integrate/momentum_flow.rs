@@ -12,8 +12,8 @@ use glam::{DQuat, DVec3};
 
 use super::Integrator;
 use super::exact_flow::exact_free_flow;
-use super::rk4::rk4_free_flow;
-use super::splitting::{FreeBody, strang_free_flow, symmetric_free_flow};
+use super::splitting::{FreeBody, symmetric_free_flow};
+use super::symmetric_kernel::{LaneFlow, turn_from_momentum};
 
 /// The turn `C` of `integrator`'s torque-free rotation over `h` (`Q₁ = Q₀ C`, in the principal
 /// frame) of a body with body momentum `m`, reciprocal principal moments `r` (0 on a locked
@@ -33,8 +33,14 @@ pub(crate) fn free_turn(
     };
     match integrator {
         Integrator::Splitting | Integrator::Yoshida4 => symmetric_free_flow(&mut body, r, odd, h),
-        Integrator::SplittingXyz => strang_free_flow(&mut body, r, h),
-        Integrator::Rk4 => rk4_free_flow(&mut body, r, h),
+        Integrator::SplittingXyz | Integrator::Rk4 => {
+            let flow = match integrator {
+                Integrator::Rk4 => LaneFlow::Rk4 { kicks: false },
+                _ => LaneFlow::Xyz { kicks: false },
+            };
+            let [x, y, z, w] = turn_from_momentum(flow, m.to_array(), r.to_array(), h);
+            body.q = DQuat::from_xyzw(x, y, z, w);
+        }
         Integrator::Exact | Integrator::Exact4 => exact_free_flow(&mut body, r, h),
         Integrator::SymplecticEuler
         | Integrator::SymplecticEulerLinear

@@ -39,8 +39,8 @@
 //!
 //! **Where the code is.** The `splitting` flow is written once, lane-generic, in
 //! `symmetric_kernel` (`Flowing::symmetric_flow`): one body runs it in `f64`, a batch in SIMD
-//! lanes (`yoshida4` is a composition of whole `splitting` steps, see `stages`). The one-axis flows of `splitting-xyz` (and
-//! `rk4`'s free flow) advance a [`FreeBody`] here. The drift–kick–drift phases are
+//! lanes (`yoshida4` is a composition of whole `splitting` steps, see `stages`). `splitting-xyz`'s
+//! axis-by-axis flow and `rk4`'s run on the same lanes; `exact`'s advances a [`FreeBody`]. The drift–kick–drift phases are
 //! [`drift_kick_drift_translation`] plus the method's free rotation, on both the scalar and the
 //! batched paths.
 //!
@@ -55,7 +55,7 @@ use glam::{DQuat, DVec3};
 
 use super::StepPhase;
 use super::frame::{reciprocal, rotate64};
-use super::symmetric_kernel::{SymmetricInput, rotate_symmetric_one};
+use super::symmetric_kernel::{LaneFlow, SymmetricInput, rotate_symmetric_one};
 use crate::mass::MassProperties;
 use crate::rotation::rotate_exact;
 use crate::state::{BodyState, Wrench};
@@ -109,37 +109,63 @@ impl FreeBody {
 /// (0 on locked axes).
 pub(super) type FreeFlow = fn(&mut FreeBody, DVec3, f64);
 
-/// Strang splitting 1-2-3-2-1 of the free flow over `h` (`splitting-xyz`).
-#[inline]
-pub(super) fn strang_free_flow(body: &mut FreeBody, r: DVec3, h: f64) {
-    let half = 0.5 * h;
-    body.axis_flow(0, r.x, half);
-    body.axis_flow(1, r.y, half);
-    body.axis_flow(2, r.z, h);
-    body.axis_flow(1, r.y, half);
-    body.axis_flow(0, r.x, half);
-}
-
 /// The rotational part of a drift over `h` at constant world `L`, after the kick `L += J` of the
 /// angular impulse `J` (world frame; zero in a phase without a kick): a method's free rotation.
 pub(super) type Rotation = fn(&mut BodyState, &MassProperties, Real, Vec3);
 
-/// The free rotation of the `splitting` method over `h`: spherical bodies exactly about `ω`
-/// (`ω ∥ L` for them), the others through the lane kernel of the module `symmetric_kernel` —
-/// the same code the batched step runs, so one body gets the same bits alone or in a batch.
+/// The free rotation `flow` over `h` on the lane kernel of the module `symmetric_kernel` (the
+/// same code the batched step runs, so one body gets the same bits alone or in a batch);
+/// spherical bodies turn exactly about `ω` (`ω ∥ L` for them).
 #[inline]
-pub(super) fn rotate_symmetric(state: &mut BodyState, mass: &MassProperties, h: Real) {
+pub(super) fn rotate_on_kernel(
+    state: &mut BodyState,
+    mass: &MassProperties,
+    h: Real,
+    flow: LaneFlow,
+) {
     if mass.is_spherical() {
         state.rotation = rotate_exact(state.rotation, state.angular_velocity, h);
         return;
     }
-    let input = SymmetricInput::new(state.rotation, state.angular_velocity, mass);
-    (state.rotation, state.angular_velocity) = rotate_symmetric_one(&input, h, false);
+    let flow = flow.with_kick(false);
+    let input = SymmetricInput::for_flow(
+        state.rotation,
+        state.angular_velocity,
+        mass,
+        flow.relabels(),
+    );
+    (state.rotation, state.angular_velocity) = rotate_symmetric_one(&input, h, flow);
 }
 
-/// [`rotate_symmetric`] after the kick `L += J` of the angular impulse `impulse` (world frame):
+/// [`rotate_on_kernel`] after the kick `L += J` of the angular impulse `impulse` (world frame):
 /// the kernel folds `J` into the body momentum (see `symmetric_kernel`); a spherical body takes
 /// it as `ω += I⁻¹ J` first, as every other method does.
+#[inline]
+pub(super) fn rotate_kicked_on_kernel(
+    state: &mut BodyState,
+    mass: &MassProperties,
+    h: Real,
+    impulse: Vec3,
+    flow: LaneFlow,
+) {
+    if mass.is_spherical() || impulse == Vec3::ZERO {
+        // No impulse: the kernel's kicked flow would give the unkicked bits anyway.
+        kick_angular(state, mass, impulse);
+        rotate_on_kernel(state, mass, h, flow);
+        return;
+    }
+    let flow = flow.with_kick(true);
+    let input = SymmetricInput::for_flow(
+        state.rotation,
+        state.angular_velocity,
+        mass,
+        flow.relabels(),
+    )
+    .with_impulse(impulse);
+    (state.rotation, state.angular_velocity) = rotate_symmetric_one(&input, h, flow);
+}
+
+/// `splitting`'s free rotation after the kick of `impulse` ([`rotate_kicked_on_kernel`]).
 #[inline]
 pub(super) fn rotate_symmetric_kicked(
     state: &mut BodyState,
@@ -147,15 +173,7 @@ pub(super) fn rotate_symmetric_kicked(
     h: Real,
     impulse: Vec3,
 ) {
-    if mass.is_spherical() || impulse == Vec3::ZERO {
-        // No impulse: the kernel's kicked flow would give the unkicked bits anyway.
-        kick_angular(state, mass, impulse);
-        rotate_symmetric(state, mass, h);
-        return;
-    }
-    let input =
-        SymmetricInput::new(state.rotation, state.angular_velocity, mass).with_impulse(impulse);
-    (state.rotation, state.angular_velocity) = rotate_symmetric_one(&input, h, true);
+    rotate_kicked_on_kernel(state, mass, h, impulse, LaneFlow::Symmetric { kicks: true });
 }
 
 /// The rotational part of a drift: the free flow over `h` at constant world `L`.

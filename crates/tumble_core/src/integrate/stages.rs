@@ -26,9 +26,9 @@
 use std::num::NonZeroU32;
 
 use super::Integrator;
-use super::symmetric_kernel::{Flowing, SymmetricInput, to_real};
+use super::symmetric_kernel::{LaneFlow, SymmetricInput, rotate_symmetric_one};
 use crate::mass::MassProperties;
-use crate::math::{Real, Widen};
+use crate::math::Real;
 use crate::rotation::rotate_exact;
 use crate::state::BodyState;
 
@@ -53,7 +53,7 @@ pub(super) const SINGLE: [Real; 1] = [1.0];
 pub(super) fn rotate_composed(
     state: &mut BodyState,
     mass: &MassProperties,
-    weights: &[Real],
+    weights: &'static [Real],
     h: Real,
 ) {
     if mass.is_spherical() {
@@ -61,12 +61,8 @@ pub(super) fn rotate_composed(
         return;
     }
     let input = SymmetricInput::new(state.rotation, state.angular_velocity, mass);
-    let mut flowing = Flowing::<f64>::start(&input, false);
-    for &c in weights {
-        flowing.symmetric_flow(c.widen() * h.widen());
-    }
-    let (q, w) = flowing.finish();
-    (state.rotation, state.angular_velocity) = to_real(q, w);
+    (state.rotation, state.angular_velocity) =
+        rotate_symmetric_one(&input, h, LaneFlow::Composed(weights));
 }
 
 /// One stage of a step (see the module docs).
@@ -190,7 +186,7 @@ pub const TRIPLE_JUMP_LIMIT: Real = 1.5734;
 mod tests {
     use super::*;
     use crate::mass::{Mass, MassProperties};
-    use crate::math::Vec3;
+    use crate::math::{Vec3, Widen};
     use crate::state::{BodyState, Wrench};
 
     /// Largest `|x|` over `steps` steps of `yoshida4` on `ẍ = −x` from `x = 1` at `ωh = h`.

@@ -22,6 +22,8 @@
 //! (`r = 0`) and symmetric bodies need no branches.
 
 use super::frame::reciprocal;
+use super::lanes::{Quat4, Rotor, Vec3L, conjugate, mul, rotate};
+use super::rk4::rk4_flow;
 use crate::mass::MassProperties;
 use crate::math::{Narrow, Quat, Real, Vec3, Widen};
 #[cfg(target_arch = "x86_64")]
@@ -29,80 +31,6 @@ use crate::simd::{Avx2, Avx4, Avx8, Avx512};
 use crate::simd::{
     Counted, F64x4, Kernel, LANES, Lane, OpCounts, Pair, Portable, counted, sin_cos,
 };
-
-/// A quaternion `(x, y, z, w)` in lanes.
-pub(super) type Quat4<T> = [T; 4];
-/// A vector in lanes.
-pub(super) type Vec3L<T> = [T; 3];
-
-/// Hamilton product `a b`.
-#[inline(always)]
-fn mul<T: Lane>(a: Quat4<T>, b: Quat4<T>) -> Quat4<T> {
-    let [ax, ay, az, aw] = a;
-    let [bx, by, bz, bw] = b;
-    [
-        aw * bx + ax * bw + (ay * bz - az * by),
-        aw * by + ay * bw + (az * bx - ax * bz),
-        aw * bz + az * bw + (ax * by - ay * bx),
-        aw * bw - (ax * bx + ay * by + az * bz),
-    ]
-}
-
-/// The rotation `v ↦ q v q* / |q|²` (a rotation even for a slightly non-unit `q`), with the
-/// parts that depend on `q` alone computed once for any number of vectors.
-struct Rotor<T> {
-    q: Quat4<T>,
-    /// `1/|q|²`.
-    inv: T,
-    /// `w² − |b|²`.
-    ww: T,
-    /// `2w`.
-    w2: T,
-}
-
-impl<T: Lane> Rotor<T> {
-    #[inline(always)]
-    fn new(q: Quat4<T>) -> Self {
-        let [x, y, z, w] = q;
-        let cpu = w.cpu();
-        let b2 = x * x + y * y + z * z;
-        Self {
-            q,
-            inv: T::splat(cpu, 1.0) / (w * w + b2),
-            ww: w * w - b2,
-            w2: T::splat(cpu, 2.0) * w,
-        }
-    }
-
-    /// `q v q* / |q|²`.
-    #[inline(always)]
-    fn apply(&self, v: Vec3L<T>) -> Vec3L<T> {
-        let [x, y, z, _] = self.q;
-        let (inv, ww, w2) = (self.inv, self.ww, self.w2);
-        let bv2 = T::splat(x.cpu(), 2.0) * (x * v[0] + y * v[1] + z * v[2]);
-        let cross = [
-            y * v[2] - z * v[1],
-            z * v[0] - x * v[2],
-            x * v[1] - y * v[0],
-        ];
-        [
-            (ww * v[0] + bv2 * x + w2 * cross[0]) * inv,
-            (ww * v[1] + bv2 * y + w2 * cross[1]) * inv,
-            (ww * v[2] + bv2 * z + w2 * cross[2]) * inv,
-        ]
-    }
-}
-
-/// `q v q* / |q|²`: a rotation even for a slightly non-unit `q`.
-#[inline(always)]
-fn rotate<T: Lane>(q: Quat4<T>, v: Vec3L<T>) -> Vec3L<T> {
-    Rotor::new(q).apply(v)
-}
-
-#[inline(always)]
-fn conjugate<T: Lane>(q: Quat4<T>) -> Quat4<T> {
-    [-q[0], -q[1], -q[2], q[3]]
-}
 
 /// `(sin θ/2, cos θ/2)` of `angle` θ, and `(cos θ, sin θ)` from them by the double-angle
 /// formulas.
@@ -128,6 +56,16 @@ impl<T: Lane> Free<T> {
         self.q = [c * x + w * s, c * y + z * s, c * z - y * s, c * w - x * s];
         let [m0, m1, m2] = self.m;
         self.m = [m0, cos * m1 + sin * m2, cos * m2 - sin * m1];
+    }
+
+    /// `Q ← Q exp(θ e_y)`, `m ← exp(−θ e_y) m`.
+    #[inline(always)]
+    fn rotate_y(&mut self, angle: T) {
+        let ((s, c), (cos, sin)) = half_and_whole(angle);
+        let [x, y, z, w] = self.q;
+        self.q = [c * x - z * s, c * y + w * s, c * z + x * s, c * w - y * s];
+        let [m0, m1, m2] = self.m;
+        self.m = [cos * m0 - sin * m2, m1, cos * m2 + sin * m0];
     }
 
     /// `Q ← Q exp(θ e_z)`, `m ← exp(−θ e_z) m`.
@@ -178,6 +116,17 @@ const RELABEL: [[Real; 4]; 3] = [
     [-0.5, -0.5, -0.5, 0.5],
 ];
 
+/// The relabelling `P` and the moments in its frame: [`relabelled_inertia`] with its `P` when
+/// `relabel`, else the identity and the moments as they are.
+#[inline(always)]
+fn relabelling(mass: &MassProperties, relabel: bool) -> ([Real; 4], [Real; 3]) {
+    if relabel {
+        (RELABEL[mass.odd_axis()], relabelled_inertia(mass))
+    } else {
+        (RELABEL[0], mass.principal_inertia().to_array())
+    }
+}
+
 /// A body's principal moments relabelled `(a, a+1, a+2) → (x, y, z)` for its odd axis `a`
 /// ([`MassProperties::odd_axis`]: the pair of axes with the closest reciprocal moments is the
 /// symmetric pair).
@@ -196,14 +145,27 @@ impl SymmetricInput {
     /// documentation).
     #[inline]
     pub(super) fn new(rotation: Quat, omega: Vec3, mass: &MassProperties) -> Self {
+        Self::for_flow(rotation, omega, mass, true)
+    }
+
+    /// Builds the inputs for one body, relabelled so that its odd axis is `x` when `relabel`
+    /// (see [`LaneFlow::relabels`]), else in its principal frame as it is.
+    #[inline]
+    pub(super) fn for_flow(
+        rotation: Quat,
+        omega: Vec3,
+        mass: &MassProperties,
+        relabel: bool,
+    ) -> Self {
         let f = mass.principal_frame().widen();
         let (q, w) = (rotation.widen(), omega.widen());
+        let (relabel, inertia) = relabelling(mass, relabel);
         Self {
             rotation: [q.x, q.y, q.z, q.w],
             omega: [w.x, w.y, w.z],
             frame: [f.x, f.y, f.z, f.w],
-            relabel: RELABEL[mass.odd_axis()].map(Widen::widen),
-            inertia: relabelled_inertia(mass).map(Widen::widen),
+            relabel: relabel.map(Widen::widen),
+            inertia: inertia.map(Widen::widen),
             impulse: [0.0; 3],
         }
     }
@@ -236,10 +198,10 @@ impl LaneInputs {
         omega: Vec3,
         mass: &MassProperties,
         impulse: Vec3,
+        relabel: bool,
     ) {
-        let inertia = relabelled_inertia(mass);
+        let (relabel, inertia) = relabelling(mass, relabel);
         let frame = mass.principal_frame();
-        let relabel = RELABEL[mass.odd_axis()];
         for (k, (q, (f, p))) in [rotation.x, rotation.y, rotation.z, rotation.w]
             .into_iter()
             .zip(
@@ -365,6 +327,38 @@ impl<T: Lane> Flowing<T> {
         free.rotate_z(half * residual * free.m[2]);
     }
 
+    /// Strang 1-2-3-2-1 over `h`: the exact flows of `½ r_x m_x²` for `h/2`, of `½ r_y m_y²` for
+    /// `h/2`, of `½ r_z m_z²` for `h`, then back (`splitting-xyz`, see [`super::splitting`]).
+    #[inline(always)]
+    pub(super) fn xyz_flow(&mut self, h: T) {
+        let (free, r) = (&mut self.free, self.r);
+        let half = T::splat(h.cpu(), 0.5) * h;
+        free.rotate_x(half * r[0] * free.m[0]);
+        free.rotate_y(half * r[1] * free.m[1]);
+        free.rotate_z(h * r[2] * free.m[2]);
+        free.rotate_y(half * r[1] * free.m[1]);
+        free.rotate_x(half * r[0] * free.m[0]);
+    }
+
+    /// `flow` over `h` (its kick, if any, is [`start`](Self::start)'s).
+    #[inline(always)]
+    pub(super) fn flow(&mut self, h: T, flow: LaneFlow) {
+        match flow {
+            LaneFlow::Symmetric { .. } => self.symmetric_flow(h),
+            LaneFlow::Composed(weights) => {
+                // Indexed, not iterated: inside a `#[target_feature]` function every helper
+                // must inline.
+                let mut k = 0;
+                while k < weights.len() {
+                    self.symmetric_flow(T::splat(h.cpu(), weights[k].widen()) * h);
+                    k += 1;
+                }
+            }
+            LaneFlow::Xyz { .. } => self.xyz_flow(h),
+            LaneFlow::Rk4 { .. } => rk4_flow(&mut self.free.q, &mut self.free.m, self.r, h),
+        }
+    }
+
     /// The new orientation (unit, f64) and world angular velocity: `ω' = Q (r ⊙ m)`,
     /// `q' = normalize(Q F'ᵀ)`.
     #[inline(always)]
@@ -377,17 +371,75 @@ impl<T: Lane> Flowing<T> {
     }
 }
 
-/// The free rotation over `h` of the `splitting` method, in lanes, after the kick of the
-/// inputs' angular impulse when `kicks`: returns the new orientation (unit, f64) and world
-/// angular velocity. See the module documentation for the sequence.
+/// Which free flow a kernel call runs: `splitting`'s symmetric-top flow (alone, or composed as
+/// in `yoshida4`), `splitting-xyz`'s axis-by-axis flow, or `rk4`'s.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) enum LaneFlow {
+    /// One symmetric-top flow over `h` (`splitting`), after the kick of the inputs' angular
+    /// impulse when `kicks`.
+    Symmetric {
+        /// Fold the impulse into the momentum first.
+        kicks: bool,
+    },
+    /// The symmetric-top flows over `c h` for each weight `c` in turn, without a kick: the free
+    /// rotation of a whole composed step without torque (`yoshida4`'s triple jump, see
+    /// `stages`).
+    Composed(&'static [Real]),
+    /// The Strang splitting 1-2-3-2-1 over `h` (`splitting-xyz`, see `splitting`), after the
+    /// kick when `kicks`.
+    Xyz {
+        /// Fold the impulse into the momentum first.
+        kicks: bool,
+    },
+    /// One RK4 step of the rotation at constant momentum over `h` (`rk4`, see `rk4`), after
+    /// the kick when `kicks`.
+    Rk4 {
+        /// Fold the impulse into the momentum first.
+        kicks: bool,
+    },
+}
+
+impl LaneFlow {
+    /// True when the flow folds the inputs' angular impulse into the momentum first.
+    #[inline(always)]
+    pub(super) fn kicks(self) -> bool {
+        matches!(
+            self,
+            LaneFlow::Symmetric { kicks: true }
+                | LaneFlow::Xyz { kicks: true }
+                | LaneFlow::Rk4 { kicks: true }
+        )
+    }
+
+    /// True when the flow runs in the relabelled frame whose odd axis is `x` (the symmetric-top
+    /// flows); the others run in the principal frame as it is.
+    #[inline(always)]
+    pub(super) fn relabels(self) -> bool {
+        matches!(self, LaneFlow::Symmetric { .. } | LaneFlow::Composed(_))
+    }
+
+    /// The same flow with or without the kick.
+    #[inline(always)]
+    pub(super) fn with_kick(self, kicks: bool) -> Self {
+        match self {
+            LaneFlow::Symmetric { .. } => LaneFlow::Symmetric { kicks },
+            LaneFlow::Xyz { .. } => LaneFlow::Xyz { kicks },
+            LaneFlow::Rk4 { .. } => LaneFlow::Rk4 { kicks },
+            composed => composed,
+        }
+    }
+}
+
+/// The free rotation of `flow` over `h`, in lanes: returns the new orientation (unit, f64) and
+/// world angular velocity. See the module documentation for the sequence.
 #[inline(always)]
 pub(super) fn symmetric_rotation<T: Lane>(
     input: &SymmetricInput<T>,
     h: T,
-    kicks: bool,
+    flow: LaneFlow,
 ) -> (Quat4<T>, Vec3L<T>) {
-    let mut flowing = Flowing::start(input, kicks);
-    flowing.symmetric_flow(h);
+    let mut flowing = Flowing::start(input, flow.kicks());
+    flowing.flow(h, flow);
     flowing.finish()
 }
 
@@ -414,7 +466,25 @@ pub fn symmetric_rotation_flops(kicks: bool) -> OpCounts {
         inertia: input.inertia.map(Counted),
         impulse: input.impulse.map(Counted),
     };
-    counted(|| symmetric_rotation(&lanes, Counted(1.0 / 60.0), kicks)).1
+    counted(|| symmetric_rotation(&lanes, Counted(1.0 / 60.0), LaneFlow::Symmetric { kicks })).1
+}
+
+/// The turn `C` of `flow` over `h` from the identity (`Q₁ = Q₀ C`, unnormalized) of a body with
+/// body momentum `m` and reciprocal moments `r` in its (unrelabelled) principal frame, in `f64`:
+/// the flows multiply `Q` on the right, so the turn depends on `m` and `h` alone (see
+/// `momentum_flow`). For the flows that do not relabel.
+pub(super) fn turn_from_momentum(flow: LaneFlow, m: [f64; 3], r: [f64; 3], h: f64) -> [f64; 4] {
+    debug_assert!(!flow.relabels());
+    let mut flowing = Flowing {
+        free: Free {
+            q: [0.0, 0.0, 0.0, 1.0],
+            m,
+        },
+        r,
+        frame: [0.0, 0.0, 0.0, 1.0],
+    };
+    flowing.flow(h, flow.with_kick(false));
+    flowing.free.q
 }
 
 /// Rounds a kernel result to the engine's precision.
@@ -426,11 +496,15 @@ pub(super) fn to_real(q: [f64; 4], w: [f64; 3]) -> (Quat, Vec3) {
     )
 }
 
-/// One body through the kernel (`f64` lanes), after the kick of its impulse when `kicks`: the
-/// new `(q, ω)`, rounded to the engine precision once.
+/// One body through the kernel (`f64` lanes): the new `(q, ω)` after `flow`, rounded to the
+/// engine precision once.
 #[inline]
-pub(super) fn rotate_symmetric_one(input: &SymmetricInput, h: Real, kicks: bool) -> (Quat, Vec3) {
-    let (q, w) = symmetric_rotation::<f64>(input, h.widen(), kicks);
+pub(super) fn rotate_symmetric_one(
+    input: &SymmetricInput,
+    h: Real,
+    flow: LaneFlow,
+) -> (Quat, Vec3) {
+    let (q, w) = symmetric_rotation::<f64>(input, h.widen(), flow);
     to_real(q, w)
 }
 
@@ -460,8 +534,8 @@ impl RotatedLanes {
 }
 
 /// [`LANES`] bodies through the kernel at once (SIMD lanes), each over its own `h` (after the
-/// kick of its impulse when `kicks`), on the `kernel`'s instruction set; lane `i` of the result
-/// is bit-identical to [`rotate_symmetric_one`]`(&inputs[i], h[i], kicks)` on every path.
+/// kick of its impulse for a kicking `flow`), on the `kernel`'s instruction set; lane `i` of the
+/// result is bit-identical to [`rotate_symmetric_one`]`(&inputs[i], h[i], flow)` on every path.
 // Not inlined: the portable kernel compiles into this function, and inlined into the batch
 // loops (three of them, one per phase) it bloats them past what the instruction cache and the
 // register allocator handle well; one call per eight bodies costs nothing in comparison.
@@ -470,13 +544,13 @@ pub(super) fn rotate_symmetric_lanes(
     kernel: Kernel,
     inputs: &LaneInputs,
     h: [Real; LANES],
-    kicks: bool,
+    flow: LaneFlow,
 ) -> RotatedLanes {
     match kernel {
         // Not paired: `wide`'s `f64x4` is already two SSE2 registers side by side, and a pair of
         // them spills so many values to the stack that it loses to one run of four (the
         // kernel rows of `tumble bench`).
-        Kernel::Portable => rotate_symmetric_lanes_in::<F64x4>(Portable, inputs, h, kicks),
+        Kernel::Portable => rotate_symmetric_lanes_in::<F64x4>(Portable, inputs, h, flow),
         #[cfg(target_arch = "x86_64")]
         #[expect(
             unsafe_code,
@@ -484,7 +558,7 @@ pub(super) fn rotate_symmetric_lanes(
         )]
         // SAFETY: the `Avx2` token exists, so the CPU has AVX2, the only requirement of calling
         // a function compiled with `#[target_feature(enable = "avx2")]`.
-        Kernel::Avx2(cpu) => unsafe { rotate_symmetric_lanes_avx2(cpu, inputs, h, kicks) },
+        Kernel::Avx2(cpu) => unsafe { rotate_symmetric_lanes_avx2(cpu, inputs, h, flow) },
         #[cfg(target_arch = "x86_64")]
         #[expect(
             unsafe_code,
@@ -492,7 +566,7 @@ pub(super) fn rotate_symmetric_lanes(
         )]
         // SAFETY: the `Avx512` token exists, so the CPU has AVX-512F, the only requirement of
         // calling a function compiled with `#[target_feature(enable = "avx512f")]`.
-        Kernel::Avx512(cpu) => unsafe { rotate_symmetric_lanes_avx512(cpu, inputs, h, kicks) },
+        Kernel::Avx512(cpu) => unsafe { rotate_symmetric_lanes_avx512(cpu, inputs, h, flow) },
     }
 }
 
@@ -503,9 +577,9 @@ fn rotate_symmetric_lanes_avx512(
     cpu: Avx512,
     inputs: &LaneInputs,
     h: [Real; LANES],
-    kicks: bool,
+    flow: LaneFlow,
 ) -> RotatedLanes {
-    rotate_symmetric_lanes_in::<Avx8>(cpu, inputs, h, kicks)
+    rotate_symmetric_lanes_in::<Avx8>(cpu, inputs, h, flow)
 }
 
 /// The kernel compiled with AVX2 enabled: eight bodies as two 256-bit registers side by side
@@ -518,9 +592,9 @@ fn rotate_symmetric_lanes_avx2(
     cpu: Avx2,
     inputs: &LaneInputs,
     h: [Real; LANES],
-    kicks: bool,
+    flow: LaneFlow,
 ) -> RotatedLanes {
-    rotate_symmetric_lanes_in::<Pair<Avx4>>(cpu, inputs, h, kicks)
+    rotate_symmetric_lanes_in::<Pair<Avx4>>(cpu, inputs, h, flow)
 }
 
 /// Runs the kernel over the batch in runs of `T::WIDTH` bodies: loads each input component of a
@@ -530,7 +604,7 @@ fn rotate_symmetric_lanes_in<T: Lane>(
     cpu: T::Cpu,
     inputs: &LaneInputs,
     h: [Real; LANES],
-    kicks: bool,
+    flow: LaneFlow,
 ) -> RotatedLanes {
     let mut out = RotatedLanes {
         rotation: [[0.0; LANES]; 4],
@@ -538,7 +612,7 @@ fn rotate_symmetric_lanes_in<T: Lane>(
     };
     let mut start = 0;
     while start < LANES {
-        rotate_run::<T>(cpu, inputs, &h, start, kicks, &mut out);
+        rotate_run::<T>(cpu, inputs, &h, start, flow, &mut out);
         start += T::WIDTH;
     }
     out
@@ -554,7 +628,7 @@ fn rotate_run<T: Lane>(
     inputs: &LaneInputs,
     h: &[Real; LANES],
     start: usize,
-    kicks: bool,
+    flow: LaneFlow,
     out: &mut RotatedLanes,
 ) {
     let zero = T::splat(cpu, 0.0);
@@ -574,11 +648,11 @@ fn rotate_run<T: Lane>(
     for k in 0..3 {
         input.omega[k] = T::load_real(cpu, &inputs.omega[k][start..]);
         input.inertia[k] = T::load_real(cpu, &inputs.inertia[k][start..]);
-        if kicks {
+        if flow.kicks() {
             input.impulse[k] = T::load_real(cpu, &inputs.impulse[k][start..]);
         }
     }
-    let (q, w) = symmetric_rotation::<T>(&input, T::load_real(cpu, &h[start..]), kicks);
+    let (q, w) = symmetric_rotation::<T>(&input, T::load_real(cpu, &h[start..]), flow);
     // Rounded lane-wise, exactly as `to_real` rounds one body.
     for k in 0..4 {
         q[k].store_real(&mut out.rotation[k][start..]);
@@ -639,9 +713,9 @@ mod tests {
             1.0 / 60.0,
             0.01,
         ];
-        let expected = |kicks: bool| -> Vec<(Quat, Vec3)> {
+        let expected = |flow: LaneFlow| -> Vec<(Quat, Vec3)> {
             (0..LANES)
-                .map(|i| rotate_symmetric_one(&owned[i], h[i], kicks))
+                .map(|i| rotate_symmetric_one(&owned[i], h[i], flow))
                 .collect()
         };
         let bits = |r: &[(Quat, Vec3)]| -> Vec<u64> {
@@ -656,25 +730,37 @@ mod tests {
         };
         let mut inputs = LaneInputs::default();
         for (lane, &(rotation, omega, mass)) in bodies_in.iter().enumerate() {
-            inputs.set(lane, rotation, omega, &mass, impulses[lane]);
+            inputs.set(lane, rotation, omega, &mass, impulses[lane], true);
             assert_eq!(inputs.get(lane), owned[lane], "lane {lane}");
         }
         let inputs = &inputs;
         let lanes = |r: RotatedLanes| (0..LANES).map(|i| r.lane(i)).collect::<Vec<_>>();
         let kernels = Kernel::available();
         assert_eq!(kernels[0].path(), KernelPath::Portable);
-        for kicks in [false, true] {
+        let flows = [
+            LaneFlow::Symmetric { kicks: false },
+            LaneFlow::Symmetric { kicks: true },
+            LaneFlow::Composed(&super::super::stages::TRIPLE_JUMP),
+            LaneFlow::Xyz { kicks: false },
+            LaneFlow::Xyz { kicks: true },
+            LaneFlow::Rk4 { kicks: false },
+            LaneFlow::Rk4 { kicks: true },
+        ];
+        for flow in flows {
             for &kernel in &kernels {
                 assert_eq!(
-                    bits(&lanes(rotate_symmetric_lanes(kernel, inputs, h, kicks))),
-                    bits(&expected(kicks)),
-                    "{} kicks {kicks}",
+                    bits(&lanes(rotate_symmetric_lanes(kernel, inputs, h, flow))),
+                    bits(&expected(flow)),
+                    "{} {flow:?}",
                     kernel.path()
                 );
             }
         }
         // A zero impulse is no kick, bit for bit; a non-zero one changes the motion.
-        let (unkicked, kicked) = (expected(false), expected(true));
+        let (unkicked, kicked) = (
+            expected(LaneFlow::Symmetric { kicks: false }),
+            expected(LaneFlow::Symmetric { kicks: true }),
+        );
         for lane in 0..LANES {
             let same = bits(&unkicked[lane..=lane]) == bits(&kicked[lane..=lane]);
             assert_eq!(same, impulses[lane] == Vec3::ZERO, "lane {lane}");
@@ -714,10 +800,12 @@ mod tests {
         let rotation = Quat::from_rotation_y(1.1) * Quat::from_rotation_x(0.3);
         let (omega, impulse, h) = (Vec3::new(1.0, -2.0, 0.5), Vec3::new(0.3, 0.1, -0.2), 0.01);
         let folded = SymmetricInput::new(rotation, omega, &mass).with_impulse(impulse);
-        let (q_folded, w_folded) = rotate_symmetric_one(&folded, h, true);
+        let (q_folded, w_folded) =
+            rotate_symmetric_one(&folded, h, LaneFlow::Symmetric { kicks: true });
         let kicked = omega + mass.world_inv_inertia_mul(rotation, impulse);
         let first = SymmetricInput::new(rotation, kicked, &mass);
-        let (q_first, w_first) = rotate_symmetric_one(&first, h, false);
+        let (q_first, w_first) =
+            rotate_symmetric_one(&first, h, LaneFlow::Symmetric { kicks: false });
         // ω ≈ 3 rad/s rounded once more on the second path: a few ulps of it.
         let tolerance = 16.0 * Real::EPSILON * 4.0;
         assert!(

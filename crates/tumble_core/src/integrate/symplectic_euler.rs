@@ -8,71 +8,28 @@
 //! ω' = ω + Δt I⁻¹ (τ − ω × I ω)    q' = exp(½ Δt ω') q
 //! ```
 //!
-//! `I = (R P) diag(I_b) (R P)ᵀ` is applied in the principal frame, never inverted. Cost: about
-//! 3 quaternion–vector rotations, one cross product and one `sin_cos` per body-step.
+//! `I = (R P) diag(I_b) (R P)ᵀ` is applied in the principal frame, never inverted; the rotation
+//! runs on the kick–drift kernel (`kick_drift_kernel`), one body or eight at a time. Cost: about
+//! 3 quaternion–vector rotations, one cross product and one sine and cosine per body-step.
 //! Under constant force the position carries the known bias `½ F/m Δt t`:
 //! `x_n = x₀ + v₀ nΔt + F/m Δt² n(n+1)/2`.
 
-use super::frame::clear_locked_axes;
-use crate::mass::MassProperties;
-use crate::math::{Real, Vec3, quat_mul, quat_rotate};
-use crate::rotation::{rotate_exact, rotate_linearized};
-use crate::state::{BodyState, Wrench};
+use super::kick_drift_kernel::PrincipalBody;
+use super::lanes::{Vec3L, cross};
+use crate::simd::Lane;
 
-/// Explicit angular-velocity kick with the gyroscopic term:
-/// `ω ← ω + Δt I⁻¹(τ − ω × Iω)`, evaluated in the principal frame. For spherical inertia the
-/// gyroscopic term vanishes and is skipped.
-///
-/// Only the increment is rotated back to the world frame, so the rotation round trip (which
-/// scales a vector by `|q|²`, one ulp off unity) never touches `ω` itself: a torque-free spin
-/// about a principal axis keeps its rate to the bit.
-#[inline]
-pub(super) fn explicit_gyroscopic_kick(
-    state: &mut BodyState,
-    mass: &MassProperties,
-    torque: Vec3,
-    dt: Real,
-) {
-    let frame = quat_mul(state.rotation, mass.principal_frame());
-    let to_principal = frame.conjugate();
-    let mut rate = quat_rotate(to_principal, torque);
-    if !mass.is_spherical() {
-        let omega = quat_rotate(to_principal, state.angular_velocity);
-        rate -= omega.cross(mass.principal_inertia() * omega);
-    }
-    state.angular_velocity += quat_rotate(frame, dt * mass.inv_principal_inertia() * rate);
-}
-
-#[inline]
-fn linear_kick_drift(state: &mut BodyState, mass: &MassProperties, force: Vec3, dt: Real) {
-    state.linear_velocity += (dt * mass.inv_mass()) * force;
-    state.position += dt * state.linear_velocity;
-}
-
-/// One step of the textbook symplectic Euler method with the exact rotation update.
-#[inline]
-pub(super) fn symplectic_euler(
-    state: &mut BodyState,
-    mass: &MassProperties,
-    wrench: &Wrench,
-    dt: Real,
-) {
-    linear_kick_drift(state, mass, wrench.force, dt);
-    explicit_gyroscopic_kick(state, mass, wrench.torque, dt);
-    clear_locked_axes(state, mass);
-    state.rotation = rotate_exact(state.rotation, state.angular_velocity, dt);
-}
-
-/// One step of symplectic Euler with the linearized rotation update `q += ½Δt (ω,0) q`.
-#[inline]
-pub(super) fn symplectic_euler_linear(
-    state: &mut BodyState,
-    mass: &MassProperties,
-    wrench: &Wrench,
-    dt: Real,
-) {
-    linear_kick_drift(state, mass, wrench.force, dt);
-    explicit_gyroscopic_kick(state, mass, wrench.torque, dt);
-    clear_locked_axes(state, mass);
-    state.rotation = rotate_linearized(state.rotation, state.angular_velocity, dt);
+/// The explicit gyroscopic kick of the body rates, `Δ = h r ⊙ (t − b × I b)` (the gyroscopic
+/// term only for a body that is not spherical: for a spherical one it vanishes, and is skipped
+/// so that it does not leave round-off).
+#[inline(always)]
+pub(super) fn explicit_kick<T: Lane>(body: &PrincipalBody<T>, h: T) -> Vec3L<T> {
+    let (b, i, r, t) = (body.omega, body.inertia, body.r, body.torque);
+    let zero = T::splat(h.cpu(), 0.0);
+    let gyro = cross(b, [i[0] * b[0], i[1] * b[1], i[2] * b[2]]);
+    let rate = [
+        t[0] - T::select(body.gyroscopic, gyro[0], zero),
+        t[1] - T::select(body.gyroscopic, gyro[1], zero),
+        t[2] - T::select(body.gyroscopic, gyro[2], zero),
+    ];
+    [h * r[0] * rate[0], h * r[1] * rate[1], h * r[2] * rate[2]]
 }

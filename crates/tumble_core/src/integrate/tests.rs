@@ -201,43 +201,58 @@ fn bits(states: &[BodyState]) -> Vec<u64> {
 use crate::simd::Kernel;
 
 /// The population after `rounds` rounds of a whole step and a stage in two phases, one body at
-/// a time on the scalar path: the reference the batches must match bit for bit.
+/// a time on the scalar path: the reference the batches must match bit for bit. A body whose
+/// step diverges keeps its state, as in a batch.
 fn scalar_rounds(integrator: Integrator, dt: Real, rounds: usize) -> Bodies {
     let mut scalar = population();
     for _ in 0..rounds {
         for (i, state) in scalar.states.iter_mut().enumerate() {
             let (mass, wrench) = (&scalar.masses[i], &scalar.wrenches[i]);
-            integrator.try_step(state, mass, wrench, dt).unwrap();
-            integrator.try_begin_stage(state, mass, dt).unwrap();
-            integrator
-                .try_finish_stage(state, mass, wrench, dt)
-                .unwrap();
+            let whole = integrator.try_step(state, mass, wrench, dt);
+            let begin = integrator.try_begin_stage(state, mass, dt);
+            let finish = integrator.try_finish_stage(state, mass, wrench, dt);
+            if whole.is_err() || begin.is_err() || finish.is_err() {
+                scalar.diverged.push(i);
+            }
         }
     }
     scalar
 }
 
+/// Every integrator, batched on every kernel path the CPU has (whole steps, and stages in two
+/// phases), gives each body the bits of its scalar step: the population mixes every relabelling,
+/// a spherical body, a locked axis, a thin rod, fast spins and torques, in batches that leave
+/// partial runs of lanes.
 #[test]
 fn every_kernel_path_the_cpu_has_gives_the_same_bits_as_the_scalar_step() {
     let dt = 1.0 / 60.0;
-    let integrator = Integrator::Splitting;
-    let scalar = scalar_rounds(integrator, dt, 20);
     let kernels = Kernel::available();
     assert!(!kernels.is_empty());
-    for kernel in kernels {
-        let mut batch = population();
-        for _ in 0..20 {
-            for phase in [StepPhase::Whole, StepPhase::Begin, StepPhase::Finish] {
-                integrator.stage_batch_on(kernel, phase, &mut batch, dt, None);
+    for &integrator in Integrator::ALL {
+        let scalar = scalar_rounds(integrator, dt, 20);
+        for &kernel in &kernels {
+            let mut batch = population();
+            for _ in 0..20 {
+                integrator.step_batch_on(kernel, &mut batch, dt, None);
+                integrator.stage_batch_on(kernel, StepPhase::Begin, &mut batch, dt, None);
+                integrator.stage_batch_on(kernel, StepPhase::Finish, &mut batch, dt, None);
             }
+            let mut diverged = batch.diverged.clone();
+            diverged.sort_unstable();
+            diverged.dedup();
+            let mut expected = scalar.diverged.clone();
+            expected.sort_unstable();
+            expected.dedup();
+            assert_eq!(diverged, expected, "{integrator} on {}", kernel.path());
+            let differ: Vec<usize> = (0..batch.states.len())
+                .filter(|&i| bits(&batch.states[i..=i]) != bits(&scalar.states[i..=i]))
+                .collect();
+            assert!(
+                differ.is_empty(),
+                "{integrator} on {}: bodies {differ:?} differ",
+                kernel.path()
+            );
         }
-        assert!(batch.diverged.is_empty());
-        assert_eq!(
-            bits(&batch.states),
-            bits(&scalar.states),
-            "{}",
-            kernel.path()
-        );
     }
 }
 

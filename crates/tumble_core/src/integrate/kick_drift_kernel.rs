@@ -1,0 +1,600 @@
+//! The rotation of the four kick–drift methods (`symplectic-euler`, `symplectic-euler-linear`,
+//! `lclamp`, `implicit-gyroscopic`) as one lane-generic kernel: the same code steps one body
+//! (`f64`) or [`LANES`] of them (SIMD), so a body's result does not depend on how it was
+//! batched, and the single-body step is this kernel on `f64`.
+//!
+//! Every method kicks the angular velocity in the principal frame and then turns the
+//! orientation by the new velocity:
+//!
+//! ```text
+//! Q = q F,  b = Qᵀ ω,  t = Qᵀ τ          (principal frame F, moments I, reciprocals r)
+//! Δ = the method's kick of b under t       (its own file: `symplectic_euler`, `lclamp`,
+//!                                           `implicit_gyroscopic`)
+//! Δ_k = −b_k on a locked axis (r_k = 0),   so that ω' has no rate about it
+//! ω' = ω + Q Δ
+//! q' = normalize(exp(½ h ω') q)            (or normalize(q + ½ h (ω', 0) q), linearized)
+//! ```
+//!
+//! Only the increment `Δ` is rotated back to the world, so a torque-free spin about a principal
+//! axis keeps its rate (`Δ` is round-off of it, below half an ulp of `ω` in the engine
+//! precision). Everything runs in `f64` and is rounded to the engine precision once.
+
+use super::Integrator;
+use super::frame::reciprocal;
+use super::implicit_gyroscopic::implicit_kick;
+use super::lanes::{Quat4, Rotor, Vec3L, conjugate, mul, normalize};
+use super::lclamp::clamped_kick;
+use super::symmetric_kernel::{RotatedLanes, to_real};
+use super::symplectic_euler::explicit_kick;
+use crate::mass::MassProperties;
+use crate::math::{Quat, Real, Vec3, Widen};
+#[cfg(target_arch = "x86_64")]
+use crate::simd::{Avx2, Avx4, Avx8, Avx512};
+use crate::simd::{F64x4, Kernel, LANES, Lane, Pair, Portable, sin_cos};
+use crate::state::{BodyState, Wrench};
+
+/// Which of the four kick–drift methods a kernel runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum KickDrift {
+    /// `symplectic-euler`: explicit gyroscopic kick, exact turn.
+    Explicit,
+    /// `symplectic-euler-linear`: explicit gyroscopic kick, linearized turn.
+    ExplicitLinear,
+    /// `lclamp`: explicit kick with `|L|` rescaled, exact turn.
+    Clamped,
+    /// `implicit-gyroscopic`: one Newton step of backward Euler, exact turn.
+    Implicit,
+}
+
+impl KickDrift {
+    /// The kernel of `integrator`, if it is a kick–drift method.
+    pub(super) fn of(integrator: Integrator) -> Option<Self> {
+        match integrator {
+            Integrator::SymplecticEuler => Some(Self::Explicit),
+            Integrator::SymplecticEulerLinear => Some(Self::ExplicitLinear),
+            Integrator::Lclamp => Some(Self::Clamped),
+            Integrator::ImplicitGyroscopic => Some(Self::Implicit),
+            _ => None,
+        }
+    }
+}
+
+/// A body as a method's kick sees it, in its principal frame.
+pub(super) struct PrincipalBody<T: Lane> {
+    /// Body rates `b = Qᵀ ω`.
+    pub omega: Vec3L<T>,
+    /// Body torque `t = Qᵀ τ`.
+    pub torque: Vec3L<T>,
+    /// Principal moments `I` (0 on a locked axis).
+    pub inertia: Vec3L<T>,
+    /// Reciprocal moments `r` (0 on a locked axis).
+    pub r: Vec3L<T>,
+    /// Set in the lanes whose body is not spherical (a spherical body has no gyroscopic term,
+    /// and its methods skip it exactly).
+    pub gyroscopic: T::Mask,
+}
+
+/// Inputs of the kernel for one body (`T = f64`) or a run of bodies.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub(super) struct KickDriftInput<T = f64> {
+    /// Body orientation `q`.
+    pub rotation: Quat4<T>,
+    /// World angular velocity `ω`.
+    pub omega: Vec3L<T>,
+    /// Principal frame `F`.
+    pub frame: Quat4<T>,
+    /// Principal moments `I`.
+    pub inertia: Vec3L<T>,
+    /// World torque `τ`, held over the step.
+    pub torque: Vec3L<T>,
+    /// 1 for a spherical body, 0 otherwise.
+    pub spherical: T,
+}
+
+impl KickDriftInput {
+    /// The inputs of one body under `torque`.
+    #[inline]
+    pub(super) fn new(rotation: Quat, omega: Vec3, mass: &MassProperties, torque: Vec3) -> Self {
+        let (q, w, f) = (
+            rotation.widen(),
+            omega.widen(),
+            mass.principal_frame().widen(),
+        );
+        let (i, t) = (mass.principal_inertia().widen(), torque.widen());
+        Self {
+            rotation: [q.x, q.y, q.z, q.w],
+            omega: [w.x, w.y, w.z],
+            frame: [f.x, f.y, f.z, f.w],
+            inertia: [i.x, i.y, i.z],
+            torque: [t.x, t.y, t.z],
+            spherical: if mass.is_spherical() { 1.0 } else { 0.0 },
+        }
+    }
+}
+
+/// `normalize(exp(½ h ω) q)`: the exact turn by `ω` over `h` (the identity for `ω = 0`).
+#[inline(always)]
+fn turn_exactly<T: Lane>(q: Quat4<T>, omega: Vec3L<T>, h: T) -> Quat4<T> {
+    let [w0, w1, w2] = omega;
+    let cpu = h.cpu();
+    let zero = T::splat(cpu, 0.0);
+    let length = (w0 * w0 + w1 * w1 + w2 * w2).sqrt();
+    let (s, c) = sin_cos(T::splat(cpu, 0.5) * h * length);
+    let scale = T::select(length.gt(zero), s / length, zero);
+    normalize(mul([w0 * scale, w1 * scale, w2 * scale, c], q))
+}
+
+/// `normalize(q + ½ h (ω, 0) q)`: the linearized turn.
+#[inline(always)]
+fn turn_linearized<T: Lane>(q: Quat4<T>, omega: Vec3L<T>, h: T) -> Quat4<T> {
+    let half = T::splat(h.cpu(), 0.5) * h;
+    let [x, y, z, w] = mul([omega[0], omega[1], omega[2], T::splat(h.cpu(), 0.0)], q);
+    normalize([
+        q[0] + x * half,
+        q[1] + y * half,
+        q[2] + z * half,
+        q[3] + w * half,
+    ])
+}
+
+/// One kick–drift rotation over `h` in lanes: the new orientation (unit, f64) and world angular
+/// velocity. See the module documentation for the sequence.
+#[inline(always)]
+pub(super) fn kick_drift_rotation<T: Lane>(
+    input: &KickDriftInput<T>,
+    h: T,
+    method: KickDrift,
+) -> (Quat4<T>, Vec3L<T>) {
+    let cpu = h.cpu();
+    let zero = T::splat(cpu, 0.0);
+    let inertia = input.inertia;
+    let q = mul(input.rotation, input.frame);
+    let to_body = Rotor::new(conjugate(q));
+    let omega = to_body.apply(input.omega);
+    let body = PrincipalBody {
+        omega,
+        torque: to_body.apply(input.torque),
+        inertia,
+        // Written out, not `map`: inside a `#[target_feature]` function every helper must
+        // inline, and `map` need not.
+        r: [
+            reciprocal(inertia[0]),
+            reciprocal(inertia[1]),
+            reciprocal(inertia[2]),
+        ],
+        gyroscopic: T::splat(cpu, 0.5).gt(input.spherical),
+    };
+    let kick = match method {
+        KickDrift::Explicit | KickDrift::ExplicitLinear => explicit_kick(&body, h),
+        KickDrift::Clamped => clamped_kick(&body, h),
+        KickDrift::Implicit => implicit_kick(&body, h),
+    };
+    let change = [
+        T::select(inertia[0].gt(zero), kick[0], -omega[0]),
+        T::select(inertia[1].gt(zero), kick[1], -omega[1]),
+        T::select(inertia[2].gt(zero), kick[2], -omega[2]),
+    ];
+    let world = Rotor::new(q).apply(change);
+    let next = [
+        input.omega[0] + world[0],
+        input.omega[1] + world[1],
+        input.omega[2] + world[2],
+    ];
+    let rotation = match method {
+        KickDrift::ExplicitLinear => turn_linearized(input.rotation, next, h),
+        _ => turn_exactly(input.rotation, next, h),
+    };
+    (rotation, next)
+}
+
+/// One body through the kernel (`f64` lanes): its new `(q, ω)`, rounded to the engine precision
+/// once.
+#[inline]
+pub(super) fn kick_drift_one(input: &KickDriftInput, h: Real, method: KickDrift) -> (Quat, Vec3) {
+    let (q, w) = kick_drift_rotation::<f64>(input, h.widen(), method);
+    to_real(q, w)
+}
+
+/// The translation of a kick–drift step, in the engine precision: `v ← v + h m⁻¹ F`,
+/// `x ← x + h v`.
+#[inline(always)]
+pub(super) fn kick_drift_translation(
+    state: &mut BodyState,
+    mass: &MassProperties,
+    force: Vec3,
+    h: Real,
+) {
+    state.linear_velocity += (h * mass.inv_mass()) * force;
+    state.position += h * state.linear_velocity;
+}
+
+/// One whole kick–drift step of one body over `h` under a constant `wrench`: the translation,
+/// then the rotation through the kernel.
+#[inline]
+pub(super) fn kick_drift_step(
+    state: &mut BodyState,
+    mass: &MassProperties,
+    wrench: &Wrench,
+    h: Real,
+    method: KickDrift,
+) {
+    kick_drift_translation(state, mass, wrench.force, h);
+    let input = KickDriftInput::new(state.rotation, state.angular_velocity, mass, wrench.torque);
+    (state.rotation, state.angular_velocity) = kick_drift_one(&input, h, method);
+}
+
+/// The inputs of [`LANES`] bodies, component by component, in the engine precision (every
+/// input is exact in `Real`).
+#[derive(Debug, Clone, Copy, Default)]
+pub(super) struct KickDriftLanes {
+    rotation: [[Real; LANES]; 4],
+    omega: [[Real; LANES]; 3],
+    frame: [[Real; LANES]; 4],
+    inertia: [[Real; LANES]; 3],
+    torque: [[Real; LANES]; 3],
+    spherical: [Real; LANES],
+}
+
+impl KickDriftLanes {
+    /// Puts one body's inputs into lane `lane` (what [`KickDriftInput::new`] makes of them).
+    #[inline(always)]
+    pub(super) fn set(
+        &mut self,
+        lane: usize,
+        rotation: Quat,
+        omega: Vec3,
+        mass: &MassProperties,
+        torque: Vec3,
+    ) {
+        let frame = mass.principal_frame();
+        let inertia = mass.principal_inertia();
+        for (k, (q, f)) in [rotation.x, rotation.y, rotation.z, rotation.w]
+            .into_iter()
+            .zip([frame.x, frame.y, frame.z, frame.w])
+            .enumerate()
+        {
+            self.rotation[k][lane] = q;
+            self.frame[k][lane] = f;
+        }
+        for (k, ((w, i), t)) in [omega.x, omega.y, omega.z]
+            .into_iter()
+            .zip([inertia.x, inertia.y, inertia.z])
+            .zip([torque.x, torque.y, torque.z])
+            .enumerate()
+        {
+            self.omega[k][lane] = w;
+            self.inertia[k][lane] = i;
+            self.torque[k][lane] = t;
+        }
+        self.spherical[lane] = if mass.is_spherical() { 1.0 } else { 0.0 };
+    }
+
+    /// The inputs in lane `lane`.
+    #[inline(always)]
+    pub(super) fn get(&self, lane: usize) -> KickDriftInput {
+        KickDriftInput {
+            rotation: self.rotation.map(|c| c[lane].widen()),
+            omega: self.omega.map(|c| c[lane].widen()),
+            frame: self.frame.map(|c| c[lane].widen()),
+            inertia: self.inertia.map(|c| c[lane].widen()),
+            torque: self.torque.map(|c| c[lane].widen()),
+            spherical: self.spherical[lane].widen(),
+        }
+    }
+
+    /// Copies lane 0 into lanes `from..LANES` (the filler of a partial batch).
+    #[inline(always)]
+    pub(super) fn fill_from_first(&mut self, from: usize) {
+        let fill = |c: &mut [Real; LANES]| {
+            let first = c[0];
+            c[from..].fill(first);
+        };
+        self.rotation.iter_mut().for_each(fill);
+        self.omega.iter_mut().for_each(fill);
+        self.frame.iter_mut().for_each(fill);
+        self.inertia.iter_mut().for_each(fill);
+        self.torque.iter_mut().for_each(fill);
+        fill(&mut self.spherical);
+    }
+}
+
+/// [`LANES`] bodies through the kernel at once, each over its own `h`, on the `kernel`'s
+/// instruction set; lane `i` of the result is bit-identical to
+/// [`kick_drift_one`]`(&inputs.get(i), h[i], method)` on every path.
+// Not inlined, for the reason `rotate_symmetric_lanes` is not.
+#[inline(never)]
+pub(super) fn kick_drift_lanes(
+    kernel: Kernel,
+    inputs: &KickDriftLanes,
+    h: [Real; LANES],
+    method: KickDrift,
+) -> RotatedLanes {
+    match kernel {
+        Kernel::Portable => kick_drift_lanes_in::<F64x4>(Portable, inputs, h, method),
+        #[cfg(target_arch = "x86_64")]
+        #[expect(
+            unsafe_code,
+            reason = "a call into code compiled for AVX2, proven by the token"
+        )]
+        // SAFETY: the `Avx2` token exists, so the CPU has AVX2, the only requirement of calling
+        // a function compiled with `#[target_feature(enable = "avx2")]`.
+        Kernel::Avx2(cpu) => unsafe { kick_drift_lanes_avx2(cpu, inputs, h, method) },
+        #[cfg(target_arch = "x86_64")]
+        #[expect(
+            unsafe_code,
+            reason = "a call into code compiled for AVX-512F, proven by the token"
+        )]
+        // SAFETY: the `Avx512` token exists, so the CPU has AVX-512F, the only requirement of
+        // calling a function compiled with `#[target_feature(enable = "avx512f")]`.
+        Kernel::Avx512(cpu) => unsafe { kick_drift_lanes_avx512(cpu, inputs, h, method) },
+    }
+}
+
+/// The kernel compiled with AVX-512F enabled, on one 512-bit register ([`Avx8`]).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+fn kick_drift_lanes_avx512(
+    cpu: Avx512,
+    inputs: &KickDriftLanes,
+    h: [Real; LANES],
+    method: KickDrift,
+) -> RotatedLanes {
+    kick_drift_lanes_in::<Avx8>(cpu, inputs, h, method)
+}
+
+/// The kernel compiled with AVX2 enabled: eight bodies as two 256-bit registers side by side.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn kick_drift_lanes_avx2(
+    cpu: Avx2,
+    inputs: &KickDriftLanes,
+    h: [Real; LANES],
+    method: KickDrift,
+) -> RotatedLanes {
+    kick_drift_lanes_in::<Pair<Avx4>>(cpu, inputs, h, method)
+}
+
+/// Runs the kernel over the batch in runs of `T::WIDTH` bodies. Plain indexing, no closures:
+/// inside a `#[target_feature]` function every helper must inline.
+#[inline(always)]
+#[allow(clippy::needless_range_loop)]
+fn kick_drift_lanes_in<T: Lane>(
+    cpu: T::Cpu,
+    inputs: &KickDriftLanes,
+    h: [Real; LANES],
+    method: KickDrift,
+) -> RotatedLanes {
+    let mut out = RotatedLanes {
+        rotation: [[0.0; LANES]; 4],
+        omega: [[0.0; LANES]; 3],
+    };
+    let zero = T::splat(cpu, 0.0);
+    let mut start = 0;
+    while start < LANES {
+        let mut input = KickDriftInput::<T> {
+            rotation: [zero; 4],
+            omega: [zero; 3],
+            frame: [zero; 4],
+            inertia: [zero; 3],
+            torque: [zero; 3],
+            spherical: T::load_real(cpu, &inputs.spherical[start..]),
+        };
+        for k in 0..4 {
+            input.rotation[k] = T::load_real(cpu, &inputs.rotation[k][start..]);
+            input.frame[k] = T::load_real(cpu, &inputs.frame[k][start..]);
+        }
+        for k in 0..3 {
+            input.omega[k] = T::load_real(cpu, &inputs.omega[k][start..]);
+            input.inertia[k] = T::load_real(cpu, &inputs.inertia[k][start..]);
+            input.torque[k] = T::load_real(cpu, &inputs.torque[k][start..]);
+        }
+        let (q, w) = kick_drift_rotation::<T>(&input, T::load_real(cpu, &h[start..]), method);
+        for k in 0..4 {
+            q[k].store_real(&mut out.rotation[k][start..]);
+        }
+        for k in 0..3 {
+            w[k].store_real(&mut out.omega[k][start..]);
+        }
+        start += T::WIDTH;
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::integrate::KernelPath;
+    use crate::mass::Mass;
+    use glam::{DMat3, DQuat, DVec3};
+
+    const METHODS: [KickDrift; 4] = [
+        KickDrift::Explicit,
+        KickDrift::ExplicitLinear,
+        KickDrift::Clamped,
+        KickDrift::Implicit,
+    ];
+
+    /// Eight bodies that exercise a spherical body, a locked axis (whose Newton matrix is
+    /// singular), a zero rate, a zero torque, the wide-angle sine path and (lane 6) an angle
+    /// beyond the polynomial's range.
+    fn bodies() -> [(Quat, Vec3, MassProperties, Vec3); LANES] {
+        let cases: [(Vec3, Vec3, Vec3); LANES] = [
+            (
+                Vec3::new(1.0, 2.0, 3.0),
+                Vec3::new(0.3, 5.0, 0.1),
+                Vec3::ZERO,
+            ),
+            (
+                Vec3::new(2.0, 1.0, 2.05),
+                Vec3::new(-40.0, 1.0, 3.0),
+                Vec3::X,
+            ),
+            (Vec3::new(3.0, 3.1, 0.2), Vec3::new(1.0, 1.0, 90.0), Vec3::Y),
+            (Vec3::new(0.0, 1.0, 1.5), Vec3::new(2.0, -1.0, 0.5), Vec3::Z),
+            (Vec3::splat(0.7), Vec3::new(0.01, 0.02, -0.03), Vec3::ONE),
+            (
+                Vec3::new(1.0, 2.0, 3.0),
+                Vec3::ZERO,
+                Vec3::new(0.0, -2.0, 0.5),
+            ),
+            (
+                Vec3::new(1.0, 29.0, 30.0),
+                Vec3::new(1e8, -3e7, 2e7),
+                Vec3::X,
+            ),
+            (
+                Vec3::new(5.0, 0.5, 4.6),
+                Vec3::new(7.0, 0.1, -7.0),
+                Vec3::ZERO,
+            ),
+        ];
+        std::array::from_fn(|i| {
+            let (inertia, omega, torque) = cases[i];
+            let mass = MassProperties::new(Mass::new(1.0).unwrap(), inertia)
+                .unwrap()
+                .with_principal_frame(Quat::from_rotation_x(0.2 * i as Real))
+                .unwrap();
+            (Quat::from_rotation_y(i as Real), omega, mass, torque)
+        })
+    }
+
+    fn bits(r: &[(Quat, Vec3)]) -> Vec<u64> {
+        r.iter()
+            .flat_map(|(q, w)| {
+                q.to_array()
+                    .into_iter()
+                    .chain(w.to_array())
+                    .map(|x| x.widen().to_bits())
+            })
+            .collect()
+    }
+
+    /// Every compilation of the kernel the CPU runs (portable, and AVX2 or AVX-512 where it has
+    /// them) and the one-body kernel agree bit for bit, for each method; a lane beyond the
+    /// sine's range does not change its neighbours' bits.
+    #[test]
+    fn lane_kernels_match_the_one_body_kernel() {
+        let bodies = bodies();
+        let h = [
+            1.0 / 60.0,
+            0.1,
+            0.05,
+            1.0 / 240.0,
+            0.2,
+            1.0 / 60.0,
+            1.0 / 60.0,
+            0.01,
+        ];
+        let mut inputs = KickDriftLanes::default();
+        for (lane, &(rotation, omega, mass, torque)) in bodies.iter().enumerate() {
+            inputs.set(lane, rotation, omega, &mass, torque);
+            let one = KickDriftInput::new(rotation, omega, &mass, torque);
+            assert_eq!(inputs.get(lane), one, "lane {lane}");
+        }
+        let kernels = Kernel::available();
+        assert_eq!(kernels[0].path(), KernelPath::Portable);
+        for method in METHODS {
+            let expected: Vec<_> = (0..LANES)
+                .map(|i| kick_drift_one(&inputs.get(i), h[i], method))
+                .collect();
+            for &kernel in &kernels {
+                let lanes = kick_drift_lanes(kernel, &inputs, h, method);
+                let got: Vec<_> = (0..LANES).map(|i| lanes.lane(i)).collect();
+                assert_eq!(
+                    bits(&got),
+                    bits(&expected),
+                    "{method:?} on {}",
+                    kernel.path()
+                );
+            }
+        }
+    }
+
+    /// Each method's formula, written out independently with `glam`'s f64 types: the new world
+    /// rate and orientation (see the method files).
+    fn reference(method: KickDrift, input: &KickDriftInput, h: f64) -> (DQuat, DVec3) {
+        let quat = |q: [f64; 4]| DQuat::from_xyzw(q[0], q[1], q[2], q[3]);
+        let (q, frame) = (quat(input.rotation), quat(input.frame));
+        let (omega, inertia, torque) = (
+            DVec3::from(input.omega),
+            DVec3::from(input.inertia),
+            DVec3::from(input.torque),
+        );
+        // The kernel rotates by `q v q* / |q|²`, a rotation even for the inputs' f32 rounding.
+        let principal = (q * frame).normalize();
+        let b = principal.conjugate() * omega;
+        let t = principal.conjugate() * torque;
+        let r = inertia
+            .to_array()
+            .map(|i| if i > 0.0 { 1.0 / i } else { 0.0 });
+        let r = DVec3::from(r);
+        let spherical = input.spherical == 1.0;
+        let mut next = match method {
+            KickDrift::Explicit | KickDrift::ExplicitLinear => {
+                let gyro = if spherical {
+                    DVec3::ZERO
+                } else {
+                    b.cross(inertia * b)
+                };
+                b + h * r * (t - gyro)
+            }
+            KickDrift::Clamped => {
+                let n = b + h * r * (t - b.cross(inertia * b));
+                n * ((inertia * b + h * t).length() / (inertia * n).length())
+            }
+            KickDrift::Implicit => {
+                let w = b + h * r * t;
+                let skew = |a: DVec3| {
+                    DMat3::from_cols(
+                        DVec3::new(0.0, a.z, -a.y),
+                        DVec3::new(-a.z, 0.0, a.x),
+                        DVec3::new(a.y, -a.x, 0.0),
+                    )
+                };
+                let diag = DMat3::from_diagonal(inertia);
+                let jacobian = diag + (skew(w) * diag - skew(inertia * w)) * h;
+                if spherical || jacobian.determinant() == 0.0 {
+                    w
+                } else {
+                    w - jacobian.inverse() * (h * w.cross(inertia * w))
+                }
+            }
+        };
+        for k in 0..3 {
+            if inertia[k] == 0.0 {
+                next[k] = 0.0;
+            }
+        }
+        let world = principal * next;
+        let turned = match method {
+            KickDrift::ExplicitLinear => {
+                (q + DQuat::from_xyzw(world.x, world.y, world.z, 0.0) * q * (0.5 * h)).normalize()
+            }
+            _ => (DQuat::from_scaled_axis(world * h) * q).normalize(),
+        };
+        (turned, world)
+    }
+
+    /// The kernel computes each method's formula: on the eight bodies (the one beyond the
+    /// sine's range aside, where only the rate is compared), the new rate and orientation agree
+    /// with the written-out reference to f64 round-off of their size.
+    #[test]
+    fn the_kernel_computes_each_method() {
+        for (lane, &(rotation, omega, mass, torque)) in bodies().iter().enumerate() {
+            let input = KickDriftInput::new(rotation, omega, &mass, torque);
+            for method in METHODS {
+                let h = 1.0 / 60.0;
+                let (q, w) = kick_drift_rotation::<f64>(&input, h, method);
+                let (q_ref, w_ref) = reference(method, &input, h);
+                let scale = 1.0 + w_ref.length();
+                let rate_error = (DVec3::from(w) - w_ref).length() / scale;
+                assert!(rate_error < 1e-13, "{method:?} lane {lane}: {rate_error:e}");
+                if lane != 6 {
+                    let q = DQuat::from_array(q);
+                    let turn_error = (q - q_ref).length().min((q + q_ref).length());
+                    assert!(turn_error < 1e-13, "{method:?} lane {lane}: {turn_error:e}");
+                }
+            }
+        }
+    }
+}
