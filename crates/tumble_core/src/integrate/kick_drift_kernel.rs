@@ -309,8 +309,42 @@ pub(super) fn kick_drift_lanes(
     h: [Real; LANES],
     method: KickDrift,
 ) -> RotatedLanes {
+    // One compilation of the kernel per method, its method a constant (as for the symmetric
+    // kernel's flows).
+    match method {
+        KickDrift::Explicit => lanes_of::<EXPLICIT>(kernel, inputs, h),
+        KickDrift::ExplicitLinear => lanes_of::<EXPLICIT_LINEAR>(kernel, inputs, h),
+        KickDrift::Clamped => lanes_of::<CLAMPED>(kernel, inputs, h),
+        KickDrift::Implicit => lanes_of::<IMPLICIT>(kernel, inputs, h),
+    }
+}
+
+/// The methods as constants (a kernel compiled for each).
+const EXPLICIT: u8 = 0;
+const EXPLICIT_LINEAR: u8 = 1;
+const CLAMPED: u8 = 2;
+const IMPLICIT: u8 = 3;
+
+/// The method `METHOD` (see [`kick_drift_lanes`]).
+#[inline(always)]
+fn method_of<const METHOD: u8>() -> KickDrift {
+    match METHOD {
+        EXPLICIT => KickDrift::Explicit,
+        EXPLICIT_LINEAR => KickDrift::ExplicitLinear,
+        CLAMPED => KickDrift::Clamped,
+        _ => KickDrift::Implicit,
+    }
+}
+
+/// [`kick_drift_lanes`] for the method `METHOD`.
+#[inline(always)]
+fn lanes_of<const METHOD: u8>(
+    kernel: Kernel,
+    inputs: &KickDriftLanes,
+    h: [Real; LANES],
+) -> RotatedLanes {
     match kernel {
-        Kernel::Portable => kick_drift_lanes_in::<F64x4>(Portable, inputs, h, method),
+        Kernel::Portable => kick_drift_lanes_in::<F64x4, METHOD>(Portable, inputs, h),
         #[cfg(target_arch = "x86_64")]
         #[expect(
             unsafe_code,
@@ -318,7 +352,7 @@ pub(super) fn kick_drift_lanes(
         )]
         // SAFETY: the `Avx2` token exists, so the CPU has AVX2, the only requirement of calling
         // a function compiled with `#[target_feature(enable = "avx2")]`.
-        Kernel::Avx2(cpu) => unsafe { kick_drift_lanes_avx2(cpu, inputs, h, method) },
+        Kernel::Avx2(cpu) => unsafe { kick_drift_lanes_avx2::<METHOD>(cpu, inputs, h) },
         #[cfg(target_arch = "x86_64")]
         #[expect(
             unsafe_code,
@@ -326,44 +360,42 @@ pub(super) fn kick_drift_lanes(
         )]
         // SAFETY: the `Avx512` token exists, so the CPU has AVX-512F, the only requirement of
         // calling a function compiled with `#[target_feature(enable = "avx512f")]`.
-        Kernel::Avx512(cpu) => unsafe { kick_drift_lanes_avx512(cpu, inputs, h, method) },
+        Kernel::Avx512(cpu) => unsafe { kick_drift_lanes_avx512::<METHOD>(cpu, inputs, h) },
     }
 }
 
 /// The kernel compiled with AVX-512F enabled, on one 512-bit register ([`Avx8`]).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f")]
-fn kick_drift_lanes_avx512(
+fn kick_drift_lanes_avx512<const METHOD: u8>(
     cpu: Avx512,
     inputs: &KickDriftLanes,
     h: [Real; LANES],
-    method: KickDrift,
 ) -> RotatedLanes {
-    kick_drift_lanes_in::<Avx8>(cpu, inputs, h, method)
+    kick_drift_lanes_in::<Avx8, METHOD>(cpu, inputs, h)
 }
 
 /// The kernel compiled with AVX2 enabled: eight bodies as two 256-bit registers side by side.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-fn kick_drift_lanes_avx2(
+fn kick_drift_lanes_avx2<const METHOD: u8>(
     cpu: Avx2,
     inputs: &KickDriftLanes,
     h: [Real; LANES],
-    method: KickDrift,
 ) -> RotatedLanes {
-    kick_drift_lanes_in::<Pair<Avx4>>(cpu, inputs, h, method)
+    kick_drift_lanes_in::<Pair<Avx4>, METHOD>(cpu, inputs, h)
 }
 
 /// Runs the kernel over the batch in runs of `T::WIDTH` bodies. Plain indexing, no closures:
 /// inside a `#[target_feature]` function every helper must inline.
 #[inline(always)]
 #[allow(clippy::needless_range_loop)]
-fn kick_drift_lanes_in<T: Lane>(
+fn kick_drift_lanes_in<T: Lane, const METHOD: u8>(
     cpu: T::Cpu,
     inputs: &KickDriftLanes,
     h: [Real; LANES],
-    method: KickDrift,
 ) -> RotatedLanes {
+    let method = method_of::<METHOD>();
     let mut out = RotatedLanes {
         rotation: [[0.0; LANES]; 4],
         omega: [[0.0; LANES]; 3],

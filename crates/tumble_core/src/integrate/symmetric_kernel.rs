@@ -546,11 +546,51 @@ pub(super) fn rotate_symmetric_lanes(
     h: [Real; LANES],
     flow: LaneFlow,
 ) -> RotatedLanes {
+    // One compilation of the kernel per kind of flow, its kind a constant: one compilation
+    // holding every kind's code runs the hot `splitting` flow measurably slower (the free-body
+    // rows of `tumble bench`).
+    let kicks = flow.kicks();
+    match flow {
+        LaneFlow::Symmetric { .. } => lanes_of::<SYMMETRIC>(kernel, inputs, h, kicks, &[]),
+        LaneFlow::Composed(weights) => lanes_of::<COMPOSED>(kernel, inputs, h, kicks, weights),
+        LaneFlow::Xyz { .. } => lanes_of::<XYZ>(kernel, inputs, h, kicks, &[]),
+        LaneFlow::Rk4 { .. } => lanes_of::<RK4>(kernel, inputs, h, kicks, &[]),
+    }
+}
+
+/// The kinds of [`LaneFlow`] as constants (a kernel compiled for each).
+const SYMMETRIC: u8 = 0;
+const COMPOSED: u8 = 1;
+const XYZ: u8 = 2;
+const RK4: u8 = 3;
+
+/// The flow of kind `KIND` (see [`rotate_symmetric_lanes`]).
+#[inline(always)]
+fn flow_of<const KIND: u8>(kicks: bool, weights: &'static [Real]) -> LaneFlow {
+    match KIND {
+        SYMMETRIC => LaneFlow::Symmetric { kicks },
+        COMPOSED => LaneFlow::Composed(weights),
+        XYZ => LaneFlow::Xyz { kicks },
+        _ => LaneFlow::Rk4 { kicks },
+    }
+}
+
+/// [`rotate_symmetric_lanes`] for the flows of kind `KIND`.
+#[inline(always)]
+fn lanes_of<const KIND: u8>(
+    kernel: Kernel,
+    inputs: &LaneInputs,
+    h: [Real; LANES],
+    kicks: bool,
+    weights: &'static [Real],
+) -> RotatedLanes {
     match kernel {
         // Not paired: `wide`'s `f64x4` is already two SSE2 registers side by side, and a pair of
         // them spills so many values to the stack that it loses to one run of four (the
         // kernel rows of `tumble bench`).
-        Kernel::Portable => rotate_symmetric_lanes_in::<F64x4>(Portable, inputs, h, flow),
+        Kernel::Portable => {
+            rotate_symmetric_lanes_in::<F64x4, KIND>(Portable, inputs, h, kicks, weights)
+        }
         #[cfg(target_arch = "x86_64")]
         #[expect(
             unsafe_code,
@@ -558,7 +598,9 @@ pub(super) fn rotate_symmetric_lanes(
         )]
         // SAFETY: the `Avx2` token exists, so the CPU has AVX2, the only requirement of calling
         // a function compiled with `#[target_feature(enable = "avx2")]`.
-        Kernel::Avx2(cpu) => unsafe { rotate_symmetric_lanes_avx2(cpu, inputs, h, flow) },
+        Kernel::Avx2(cpu) => unsafe {
+            rotate_symmetric_lanes_avx2::<KIND>(cpu, inputs, h, kicks, weights)
+        },
         #[cfg(target_arch = "x86_64")]
         #[expect(
             unsafe_code,
@@ -566,20 +608,23 @@ pub(super) fn rotate_symmetric_lanes(
         )]
         // SAFETY: the `Avx512` token exists, so the CPU has AVX-512F, the only requirement of
         // calling a function compiled with `#[target_feature(enable = "avx512f")]`.
-        Kernel::Avx512(cpu) => unsafe { rotate_symmetric_lanes_avx512(cpu, inputs, h, flow) },
+        Kernel::Avx512(cpu) => unsafe {
+            rotate_symmetric_lanes_avx512::<KIND>(cpu, inputs, h, kicks, weights)
+        },
     }
 }
 
 /// The kernel compiled with AVX-512F enabled, on one 512-bit register ([`Avx8`]).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f")]
-fn rotate_symmetric_lanes_avx512(
+fn rotate_symmetric_lanes_avx512<const KIND: u8>(
     cpu: Avx512,
     inputs: &LaneInputs,
     h: [Real; LANES],
-    flow: LaneFlow,
+    kicks: bool,
+    weights: &'static [Real],
 ) -> RotatedLanes {
-    rotate_symmetric_lanes_in::<Avx8>(cpu, inputs, h, flow)
+    rotate_symmetric_lanes_in::<Avx8, KIND>(cpu, inputs, h, kicks, weights)
 }
 
 /// The kernel compiled with AVX2 enabled: eight bodies as two 256-bit registers side by side
@@ -588,24 +633,27 @@ fn rotate_symmetric_lanes_avx512(
 /// of four dependent rotations leaves the core idle, and the other run fills it.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-fn rotate_symmetric_lanes_avx2(
+fn rotate_symmetric_lanes_avx2<const KIND: u8>(
     cpu: Avx2,
     inputs: &LaneInputs,
     h: [Real; LANES],
-    flow: LaneFlow,
+    kicks: bool,
+    weights: &'static [Real],
 ) -> RotatedLanes {
-    rotate_symmetric_lanes_in::<Pair<Avx4>>(cpu, inputs, h, flow)
+    rotate_symmetric_lanes_in::<Pair<Avx4>, KIND>(cpu, inputs, h, kicks, weights)
 }
 
 /// Runs the kernel over the batch in runs of `T::WIDTH` bodies: loads each input component of a
 /// run with one vector load, rotates, rounds the results to the engine precision.
 #[inline(always)]
-fn rotate_symmetric_lanes_in<T: Lane>(
+fn rotate_symmetric_lanes_in<T: Lane, const KIND: u8>(
     cpu: T::Cpu,
     inputs: &LaneInputs,
     h: [Real; LANES],
-    flow: LaneFlow,
+    kicks: bool,
+    weights: &'static [Real],
 ) -> RotatedLanes {
+    let flow = flow_of::<KIND>(kicks, weights);
     let mut out = RotatedLanes {
         rotation: [[0.0; LANES]; 4],
         omega: [[0.0; LANES]; 3],
