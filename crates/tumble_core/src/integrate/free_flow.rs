@@ -227,6 +227,23 @@ pub struct ExactSwitch {
     quick: Real,
 }
 
+/// `|ω|² / ω_turn²` at or below which a body's springs outweigh its split whatever its inertia
+/// (see [`ExactSwitch::applies_turned`]): `e_orbit ≤ 0.75 h² |ω|²` (module docs), so
+/// `e_orbit |ω| ≤ ω_turn³ h²/24` holds wherever `|ω|³ ≤ ω_turn³/18`, i.e.
+/// `|ω|² ≤ ω_turn² / 18^{2/3}`; less a margin for the rounding of `|ω|²` and `ω_turn²`.
+const TURN_BOUND: Real = (1.0 / 6.868_285_4) / (1.0 + 1e-3);
+
+/// False when the body's springs turn it fast enough that the switch cannot apply to it, one
+/// `|ω|²` against `ω_turn²` ([`TURN_BOUND`]): the second cheap test of
+/// [`ExactSwitch::applies_turned`], which spares a swinging chain link the full judgement.
+#[inline(always)]
+fn spins_past_turn_bound(state: &BodyState, turn_rate: Real) -> bool {
+    let w = state.angular_velocity;
+    // A fixed order of operations: the same bits on every path.
+    let w2 = w.x * w.x + w.y * w.y + w.z * w.z;
+    w2 > TURN_BOUND * (turn_rate * turn_rate)
+}
+
 impl ExactSwitch {
     /// The switch of `integrator` with substeps of `substep` (s) under `free_flow`; `None` when
     /// every body keeps the method's flow (a method that is not split, or
@@ -249,12 +266,12 @@ impl ExactSwitch {
             let cube = limit / (2.2 * span * span * ACCURACY_HORIZON.widen());
             (Rule::Drift, limit, cube.powf(2.0 / 3.0) / margin)
         } else {
-            // e_orbit ≤ 0.75 h² |ω|² (module docs).
+            // e_orbit ≤ 0.75 h² |ω|² (module docs): inside the limit for |ω|² ≤ limit / (0.75 h²).
             let limit = COMPOSED_SPLIT_ERROR_LIMIT.widen();
             (
                 Rule::StageError,
                 limit,
-                2.0 * limit / (span * span) / margin,
+                limit / (0.75 * span * span) / margin,
             )
         };
         Some(Self {
@@ -306,7 +323,9 @@ impl ExactSwitch {
         if turn_rate == 0.0 {
             return self.applies(state, mass);
         }
-        self.spins_past_quick_bound(state) && self.exceeds_turned(*state, mass, turn_rate)
+        self.spins_past_quick_bound(state)
+            && spins_past_turn_bound(state, turn_rate)
+            && self.exceeds_turned(*state, mass, turn_rate)
     }
 
     /// The split costs more than the limit and more than the springs' error (see
@@ -357,5 +376,83 @@ impl ExactSwitch {
             Rule::StageError => e_orbit,
         };
         (measure, e_orbit, omega)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mass::Mass;
+    use crate::math::{Quat, Vec3};
+
+    /// A deterministic stream of numbers in `[0, 1)`.
+    fn uniform(seed: &mut u64) -> f64 {
+        *seed = seed
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        (*seed >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    /// The two cheap tests never pass over a body the full judgement would switch: below the
+    /// quick bound the measure is within the limit, and below the turn bound the springs'
+    /// error outweighs the split's. Bodies from rods and plates at the triangle limit to
+    /// near-spheres, rates just under each bound (where the bounds are tight), random axes.
+    #[test]
+    fn the_cheap_bounds_never_skip_a_body_the_judgement_would_switch() {
+        let mut seed = 7;
+        let shapes = [
+            [1e-4, 1.0, 1.0001],
+            [0.01, 1.0, 1.01],
+            [0.5, 0.5, 1.0],
+            [1.0, 2.0, 3.0],
+            [1.0, 1.0, 1.9999],
+            [0.9, 1.0, 1.1],
+            // At the triangle limit with `|I_b − I_c| = I_a`: the tightest case of both bounds.
+            [1.0, 1.5, 2.5],
+        ];
+        for integrator in [Integrator::Splitting, Integrator::Yoshida4] {
+            for dt in [1.0 / 240.0, 1.0 / 60.0, 0.05] {
+                let switch = ExactSwitch::new(integrator, FreeFlow::Auto, dt).unwrap();
+                for _ in 0..4000 {
+                    let shape = shapes[(uniform(&mut seed) * shapes.len() as f64) as usize];
+                    let inertia = Vec3::new(shape[0], shape[1], shape[2]) as Vec3;
+                    let mass = MassProperties::new(Mass::new(1.0).unwrap(), inertia)
+                        .unwrap()
+                        .with_principal_frame(Quat::from_rotation_x(uniform(&mut seed) as Real))
+                        .unwrap();
+                    let axis = Vec3::new(
+                        uniform(&mut seed) as Real - 0.5,
+                        uniform(&mut seed) as Real - 0.5,
+                        uniform(&mut seed) as Real - 0.5,
+                    )
+                    .normalize();
+                    let turn = (0.1 + 40.0 * uniform(&mut seed)) as Real;
+                    let below = 1.0 - 1e-4 * uniform(&mut seed);
+                    let rotation = Quat::from_rotation_y(uniform(&mut seed) as Real);
+                    // Just under the quick bound.
+                    let quick = (switch.quick.widen() * below).sqrt() as Real;
+                    let state = BodyState {
+                        rotation,
+                        angular_velocity: axis * quick,
+                        ..BodyState::default()
+                    };
+                    if !switch.spins_past_quick_bound(&state) {
+                        let measure = switch.measure(&state, &mass);
+                        assert!(measure <= switch.limit(), "{measure} at {state:?}");
+                    }
+                    // Just under the turn bound.
+                    let rate = (TURN_BOUND.widen() * below).sqrt() * turn.widen();
+                    let state = BodyState {
+                        angular_velocity: axis * rate as Real,
+                        ..state
+                    };
+                    if !spins_past_turn_bound(&state, turn) {
+                        let (_, e_orbit, omega) = switch.judge(&state, &mass);
+                        let springs = turn.widen().powi(3) * switch.span * switch.span / 24.0;
+                        assert!(e_orbit * omega.length() <= springs, "{state:?}");
+                    }
+                }
+            }
+        }
     }
 }
