@@ -21,6 +21,7 @@ pub mod population;
 pub mod rollback;
 pub mod scaling;
 pub mod springs;
+pub mod targets;
 
 use std::path::PathBuf;
 use tumble_core::math::Vec3;
@@ -164,7 +165,11 @@ pub struct BenchResults {
     pub rollback: Vec<rollback::RollbackRow>,
     /// Trajectory CSV writing throughput.
     pub csv: Vec<csv::CsvRow>,
-    /// The project's speed targets, free bodies and springs.
+    /// Whether this was a `--quick` run.
+    pub quick: bool,
+    /// The run's wall-clock time (s), the measurements alone.
+    pub seconds: f64,
+    /// The speed issue's targets ([`targets::TARGETS`]) as this run measured them.
     pub targets: Vec<Target>,
 }
 
@@ -266,12 +271,12 @@ pub fn run_bench(options: &BenchOptions, mut progress: impl FnMut(&str)) -> Benc
     ));
     let runner_check = Some(runner_check(check_bodies, &effort));
     let springs = springs::run(options.quick, &mut progress);
-    let method_sizes: &[usize] = if options.quick {
-        &[1_000]
+    let method_sizes: Vec<usize> = if options.quick {
+        vec![max.min(1_000)]
     } else {
-        &[1_000, 100_000]
+        [1_000, 100_000].into_iter().filter(|&n| n <= max).collect()
     };
-    let methods = methods::run(method_sizes, &effort, &mut progress);
+    let methods = methods::run(&method_sizes, &effort, &mut progress);
     let rollback_sizes: &[usize] = if options.quick {
         &[1_000]
     } else {
@@ -289,7 +294,7 @@ pub fn run_bench(options: &BenchOptions, mut progress: impl FnMut(&str)) -> Benc
         .into_iter()
         .collect();
     let mut results = BenchResults {
-        schema: 4,
+        schema: 5,
         pool_threads: pool_threads(),
         kernel_path: tumble_core::kernel_path().to_string(),
         widest_kernel_path: widest_kernel_path(),
@@ -307,9 +312,12 @@ pub fn run_bench(options: &BenchOptions, mut progress: impl FnMut(&str)) -> Benc
         methods,
         rollback,
         csv,
+        quick: options.quick,
+        seconds: f64::NAN,
         targets: Vec::new(),
     };
-    results.targets = output::targets(&results);
+    results.seconds = started.elapsed().map_or(f64::NAN, |d| d.as_secs_f64());
+    results.targets = targets::evaluate(&results);
     results
 }
 
@@ -378,7 +386,7 @@ fn cpu_name() -> String {
 
 /// Both the raw loop and the ECS really moved the bodies, to the same place bit for bit (the
 /// same core function on the same data, the same number of steps).
-fn check_moved(raw: &RawLoop, ecs: &Ecs, scene: &tumble_rapier::ComparisonScene) {
+pub(crate) fn check_moved(raw: &RawLoop, ecs: &Ecs, scene: &tumble_rapier::ComparisonScene) {
     let last = scene.bodies.len() - 1;
     for i in [0, last / 2, last] {
         let (a, b) = (raw.state(i), ecs.state(i));
@@ -456,7 +464,10 @@ pub fn run_and_write(options: &BenchOptions) -> Result<(), Box<dyn std::error::E
         )?;
         let runs = machines::with_run(kept_runs, &name, RunSummary::from(&results));
         let summary_file = dir.join(format!("{}.md", machines::SUMMARY_NAME));
-        files.add(&summary_file, machines::targets_by_run(&runs).as_bytes())?;
+        files.add(
+            &summary_file,
+            machines::targets_by_run(&runs, &results.targets).as_bytes(),
+        )?;
     }
     if let Some(readme) = &options.readme {
         // The README gets the frame budget; the full tables and the targets stay in `--out`.

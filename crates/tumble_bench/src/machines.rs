@@ -144,13 +144,13 @@ fn cell_text(text: &str) -> String {
     tumble_scene::text::terminal_safe(text).replace('|', "\\|")
 }
 
-/// The targets of every run as one markdown table: a row per target (in the order the runs
-/// first name them), a column per run, each cell the measured value and whether it met the
-/// bound (`–` where a run did not measure that target), and a last column counting the runs
-/// that met it.
-pub fn targets_by_run(runs: &[RunSummary]) -> String {
+/// The targets of every run as one markdown table: a row per target of `current` (this
+/// version's targets, in its order: a kept run's targets that this version no longer sets are
+/// left out), a column per run, each cell the measured value and whether it met the bound (`–`
+/// where a run did not measure that target), and a last column counting the runs that met it.
+pub fn targets_by_run(runs: &[RunSummary], current: &[Target]) -> String {
     let mut names: Vec<(&str, String)> = Vec::new();
-    for target in runs.iter().flat_map(|r| &r.targets) {
+    for target in current {
         if !names.iter().any(|(name, _)| *name == target.name) {
             names.push((
                 &target.name,
@@ -227,7 +227,12 @@ mod tests {
             ),
             run("avx2", "avx2", vec![target("floor", 4.0, false)]),
         ];
-        let table = targets_by_run(&runs);
+        // The current version's targets are the rows: a target only an old run has is left out.
+        let current = [target("floor", 0.0, true), target("ratio", 0.0, true)];
+        let mut with_old = runs.clone();
+        with_old[1].targets.push(target("retired", 1.0, true));
+        let table = targets_by_run(&with_old, &current);
+        assert!(!table.contains("retired"), "{table}");
         let lines: Vec<&str> = table.lines().collect();
         assert_eq!(lines.len(), 4, "{table}");
         assert!(

@@ -1,16 +1,17 @@
-//! Every integrator's free-body step against the default `splitting`, on the same scene, ECS,
-//! one thread, in one interleaved timing (the ratios are what the speed issue bounds).
+//! Every integrator's free-body step through the ECS and the raw loop, on one and two threads,
+//! against the default `splitting` on the same scene (the ratios are what the speed issue
+//! bounds: [`METHOD_BOUNDS`], and the ECS layer's cost per method).
 
 use serde::Serialize;
 use tumble_core::Integrator;
 use tumble_ecs::parallel::Parallelism;
 
-use crate::engines::{Ecs, Engine};
+use crate::engines::{Ecs, Engine, RawLoop};
 use crate::measure::{Effort, compare};
 use crate::population;
 
 /// What a method's cost is bounded against: `bound ×` the cost of `relative_to`.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MethodBound {
     /// The method bounded.
     pub integrator: Integrator,
@@ -45,49 +46,84 @@ pub const METHOD_BOUNDS: [MethodBound; 9] = {
     ]
 };
 
-/// One size: ns per body-step of every integrator, in [`Integrator::ALL`] order.
+/// One method at one size: ns per body-step through the raw loop and the ECS, on one thread
+/// and on the pool, and `splitting`'s ECS step on one thread timed in the same interleaved run
+/// (the reference its ratios are taken against).
 #[derive(Debug, Clone, Serialize)]
 pub struct MethodRow {
+    /// The method.
+    pub integrator: Integrator,
     /// Bodies in the scene.
     pub bodies: usize,
-    /// `(integrator, ns per body-step)`, ECS, one thread.
-    pub ns: Vec<(Integrator, f64)>,
+    /// Raw loop, one thread.
+    pub raw_1t: f64,
+    /// ECS, one thread.
+    pub ecs_1t: f64,
+    /// Raw loop, the pool's threads.
+    pub raw_2t: f64,
+    /// ECS, the pool's threads.
+    pub ecs_2t: f64,
+    /// `splitting` through the ECS, one thread, in the same run.
+    pub splitting_ecs_1t: f64,
 }
 
 impl MethodRow {
-    /// ns per body-step of `integrator` (NaN when it was not measured).
-    pub fn ns_of(&self, integrator: Integrator) -> f64 {
-        self.ns
-            .iter()
-            .find(|(i, _)| *i == integrator)
-            .map_or(f64::NAN, |&(_, ns)| ns)
-    }
-
-    /// The cost of `integrator` over that of `relative_to`.
-    pub fn ratio(&self, integrator: Integrator, relative_to: Integrator) -> f64 {
-        self.ns_of(integrator) / self.ns_of(relative_to)
+    /// The ECS step over `splitting`'s, one thread.
+    pub fn per_splitting(&self) -> f64 {
+        self.ecs_1t / self.splitting_ecs_1t
     }
 }
 
-/// Times every integrator on the benchmark population at each of `sizes`.
+/// The cost of `integrator` over that of `relative_to` at `bodies`, each against the
+/// `splitting` of its own run (`None` when either was not measured).
+pub fn ratio(
+    rows: &[MethodRow],
+    bodies: usize,
+    integrator: Integrator,
+    relative_to: Integrator,
+) -> Option<f64> {
+    let of = |i: Integrator| {
+        rows.iter()
+            .find(|r| r.bodies == bodies && r.integrator == i)
+            .map(MethodRow::per_splitting)
+    };
+    Some(of(integrator)? / of(relative_to)?)
+}
+
+/// Times every integrator on the benchmark population at each of `sizes`: one interleaved run
+/// per method, of its four engines and `splitting`'s ECS step (five worlds in memory at once,
+/// not forty).
 pub fn run(sizes: &[usize], effort: &Effort, mut progress: impl FnMut(&str)) -> Vec<MethodRow> {
-    sizes
-        .iter()
-        .map(|&n| {
-            progress(&format!("{n} bodies · every integrator"));
-            let scene = population::scene(n);
-            let single = Parallelism::SINGLE_THREAD;
-            let mut worlds: Vec<Ecs> = Integrator::ALL
-                .iter()
-                .map(|&i| Ecs::new(&scene, i, single))
-                .collect();
+    let single = Parallelism::SINGLE_THREAD;
+    let threaded = Parallelism::default();
+    let mut rows = Vec::new();
+    for &n in sizes {
+        let scene = population::scene(n);
+        for &integrator in Integrator::ALL {
+            progress(&format!(
+                "{n} bodies · {integrator}: ECS and raw, 1 and 2 threads"
+            ));
+            let mut raw1 = RawLoop::new(&scene, integrator, single);
+            let mut ecs1 = Ecs::new(&scene, integrator, single);
+            let mut raw2 = RawLoop::new(&scene, integrator, threaded);
+            let mut ecs2 = Ecs::new(&scene, integrator, threaded);
+            let mut reference = Ecs::new(&scene, Integrator::Splitting, single);
             let mut engines: Vec<&mut dyn Engine> =
-                worlds.iter_mut().map(|w| w as &mut dyn Engine).collect();
+                vec![&mut raw1, &mut ecs1, &mut raw2, &mut ecs2, &mut reference];
             let ns = compare(&mut engines, n, effort);
-            MethodRow {
+            // The same steps through the same core: the raw loop is the ECS's work, bit for bit.
+            crate::check_moved(&raw1, &ecs1, &scene);
+            crate::check_moved(&raw2, &ecs2, &scene);
+            rows.push(MethodRow {
+                integrator,
                 bodies: n,
-                ns: Integrator::ALL.iter().copied().zip(ns).collect(),
-            }
-        })
-        .collect()
+                raw_1t: ns[0],
+                ecs_1t: ns[1],
+                raw_2t: ns[2],
+                ecs_2t: ns[3],
+                splitting_ecs_1t: ns[4],
+            });
+        }
+    }
+    rows
 }

@@ -3,9 +3,8 @@
 
 use std::fmt::Write;
 
-use crate::methods::{METHOD_BOUNDS, MethodRow};
+use crate::methods::MethodRow;
 use crate::{BenchResults, Row, Target};
-use tumble_core::Integrator;
 
 /// The default integrator's name (the targets are stated for it).
 const DEFAULT: &str = "splitting";
@@ -21,235 +20,6 @@ fn row(results: &BenchResults, integrator: &str, bodies: usize) -> Option<Row> {
     rows_of(results, integrator)
         .find(|r| r.bodies == bodies)
         .cloned()
-}
-
-fn target(name: &str, value: f64, relation: &str, bound: f64) -> Target {
-    let met = match relation {
-        "<=" => value <= bound,
-        _ => value >= bound,
-    };
-    Target {
-        name: name.to_owned(),
-        value,
-        bound,
-        relation: relation.to_owned(),
-        met,
-    }
-}
-
-/// Evaluates the project's speed targets on the measured rows (those whose sizes were
-/// measured).
-pub fn targets(results: &BenchResults) -> Vec<Target> {
-    let mut out = Vec::new();
-    ecs_over_raw_targets(results, &mut out);
-    against_rapier_targets(results, &mut out);
-    memory_floor_targets(results, &mut out);
-    springs_targets(results, &mut out);
-    fixed_costs_targets(results, &mut out);
-    exact_and_implicit_targets(results, &mut out);
-    out
-}
-
-/// Free-body targets: the ECS against the raw loop, for the default and the simplest method.
-fn ecs_over_raw_targets(results: &BenchResults, out: &mut Vec<Target>) {
-    for integrator in [DEFAULT, "symplectic-euler"] {
-        let big: Vec<&Row> = rows_of(results, integrator)
-            .filter(|r| r.bodies >= 10_000)
-            .collect();
-        if !big.is_empty() {
-            let worst_1t = big.iter().map(|r| r.ecs_1t / r.raw_1t).fold(0.0, f64::max);
-            let worst_2t = big.iter().map(|r| r.ecs_2t / r.raw_2t).fold(0.0, f64::max);
-            out.push(target(
-                &format!("{integrator}: ECS / raw, 1 thread, worst N ≥ 1e4"),
-                worst_1t,
-                "<=",
-                1.15,
-            ));
-            out.push(target(
-                &format!("{integrator}: ECS / raw, 2 threads, worst N ≥ 1e4"),
-                worst_2t,
-                "<=",
-                1.15,
-            ));
-        }
-    }
-}
-
-/// Free-body targets against rapier and for two threads.
-fn against_rapier_targets(results: &BenchResults, out: &mut Vec<Target>) {
-    if let Some(r) = row(results, DEFAULT, 100_000) {
-        if let Some(rapier) = r.rapier {
-            out.push(target(
-                "rapier / tumble at 1e5, default integrator, 1 thread each",
-                rapier / r.ecs_1t,
-                ">=",
-                15.0,
-            ));
-            out.push(target(
-                "rapier (1 thread) / tumble (2 threads) at 1e5, default integrator",
-                rapier / r.ecs_2t,
-                ">=",
-                10.0,
-            ));
-        }
-        out.push(target(
-            "2 threads / 1 thread speed-up at 1e5, default integrator",
-            r.ecs_1t / r.ecs_2t,
-            ">=",
-            1.8,
-        ));
-        // Ours, beside the issue's: whatever the machine allows two threads, the threaded
-        // step gets nearly all of it.
-        out.push(target(
-            "2 threads / 1 thread at 1e5 over this machine's two-copy ceiling",
-            r.ecs_1t / r.ecs_2t / results.two_copy_ceiling,
-            ">=",
-            0.9,
-        ));
-    }
-    let small: Vec<f64> = rows_of(results, DEFAULT)
-        .filter(|r| (100..=10_000).contains(&r.bodies))
-        .filter_map(|r| Some(r.rapier? / r.ecs_1t))
-        .collect();
-    if !small.is_empty() {
-        out.push(target(
-            "rapier / tumble, default integrator, 1 thread each, worst N = 1e2 … 1e4",
-            small.iter().copied().fold(f64::INFINITY, f64::min),
-            ">=",
-            8.0,
-        ));
-    }
-}
-
-/// Free-body targets against the memory floor.
-fn memory_floor_targets(results: &BenchResults, out: &mut Vec<Target>) {
-    let floor = results.bytes_per_body_step as f64 / results.bandwidth_gb_s[0];
-    for n in [100_000, 1_000_000] {
-        if let Some(r) = row(results, DEFAULT, n) {
-            out.push(target(
-                &format!("default integrator, ECS 1 thread / memory floor, N = {n}"),
-                r.ecs_1t / floor,
-                "<=",
-                3.0,
-            ));
-        }
-    }
-}
-
-/// Spring-chain targets: loaded explicit chains against a free body and rapier.
-fn springs_targets(results: &BenchResults, out: &mut Vec<Target>) {
-    let springs = &results.springs;
-    for r in springs.throughput.iter().filter(|r| r.threads == 1) {
-        let Some(free) = row(results, DEFAULT, r.springs).map(|f| f.ecs_1t) else {
-            continue;
-        };
-        if r.mode == crate::springs::RAPIER_JOINT {
-            if let Some(tumble) = springs.throughput_one_thread(r.springs, "explicit") {
-                out.push(target(
-                    &format!(
-                        "loaded spring chains, {} springs: rapier SpringJoint / tumble explicit",
-                        r.springs
-                    ),
-                    r.ns_per_spring_step / tumble,
-                    ">=",
-                    10.0,
-                ));
-            }
-        } else {
-            out.push(target(
-                &format!(
-                    "loaded spring chains, {} springs, {} at ωΔt {}: per body-step / free body",
-                    r.springs, r.mode, r.omega_dt
-                ),
-                r.ns_per_spring_step / free,
-                "<=",
-                2.0,
-            ));
-        }
-    }
-}
-
-/// Fixed costs, flat costs and features that must cost nothing unused.
-fn fixed_costs_targets(results: &BenchResults, out: &mut Vec<Target>) {
-    for (integrator, ns) in &results.fixed_cost_ns {
-        out.push(target(
-            &format!("{integrator}: fixed cost per step at N = 1 (µs)"),
-            ns / 1000.0,
-            "<=",
-            2.0,
-        ));
-    }
-    let flat: Vec<f64> = rows_of(results, DEFAULT)
-        .filter(|r| r.bodies >= 1_000)
-        .map(|r| r.ecs_1t)
-        .collect();
-    if flat.len() >= 2 && results.rows.iter().any(|r| r.bodies >= 1_000_000) {
-        let max = flat.iter().copied().fold(0.0, f64::max);
-        let min = flat.iter().copied().fold(f64::INFINITY, f64::min);
-        out.push(target(
-            "default integrator: max / min cost per body, N = 1e3 … 1e6",
-            max / min,
-            "<=",
-            1.5,
-        ));
-    }
-    let u = &results.unused_feature;
-    out.push(target(
-        "no gravity / zero gravity (unused feature costs nothing)",
-        u.without / u.with_zero,
-        "<=",
-        1.05,
-    ));
-    // The check is one pass over the archetypes: a fixed cost per step, a target where a step
-    // is big enough for it to be measured against.
-    if let Some(c) = results
-        .runner_check
-        .as_ref()
-        .filter(|c| c.bodies >= 100_000)
-    {
-        out.push(target(
-            "runner's world check / whole step, 1e5 bodies (a stale plan never runs, for free)",
-            c.check / c.step,
-            "<=",
-            0.01,
-        ));
-    }
-}
-
-/// Every integrator against its bound ([`METHOD_BOUNDS`]), and the implicit spring step
-/// against the explicit one.
-fn exact_and_implicit_targets(results: &BenchResults, out: &mut Vec<Target>) {
-    for row in &results.methods {
-        for b in &METHOD_BOUNDS {
-            out.push(target(
-                &format!(
-                    "{} / {}, ECS 1 thread, {} bodies",
-                    b.integrator, b.relative_to, row.bodies
-                ),
-                row.ratio(b.integrator, b.relative_to),
-                "<=",
-                b.bound,
-            ));
-        }
-    }
-    if let Some(explicit) = results.springs.explicit_reference() {
-        for row in results
-            .springs
-            .stiffness
-            .iter()
-            .filter(|r| r.springs == "implicit" && r.start == "relaxed" && r.omega_dt >= 100.0)
-        {
-            out.push(target(
-                &format!(
-                    "spring chain: implicit at ωΔt {} / explicit at 0.5",
-                    row.omega_dt
-                ),
-                row.us_per_step / explicit,
-                "<=",
-                10.0,
-            ));
-        }
-    }
 }
 
 fn fmt_ns(ns: f64) -> String {
@@ -459,24 +229,32 @@ pub fn rollback_markdown(rows: &[crate::rollback::RollbackRow]) -> String {
     )
 }
 
-/// Every integrator's cost against the default.
+/// Every integrator's cost against the default, and its ECS layer's cost.
 pub fn methods_markdown(rows: &[MethodRow]) -> String {
     let mut s = String::new();
-    for row in rows {
+    let mut sizes: Vec<usize> = rows.iter().map(|r| r.bodies).collect();
+    sizes.dedup();
+    for n in sizes {
         s.push_str(&table_if_any(
             &format!(
-                "**Every integrator**, {} free bodies — ns per body-step, ECS, 1 thread, and \
-                 relative to `splitting`",
-                row.bodies
+                "**Every integrator**, {n} free bodies — ns per body-step through the ECS and the \
+                 raw loop, on one thread and on two; `× splitting` is the ECS step on one thread \
+                 against `splitting`'s, timed in the same run"
             ),
-            "| integrator | ns/body-step | × splitting |",
-            "|---|---:|---:|",
-            &row.ns,
-            |&(integrator, ns)| {
+            "| integrator | raw 1t | ECS 1t | ECS/raw | raw 2t | ECS 2t | ECS/raw | × splitting |",
+            "|---|---:|---:|---:|---:|---:|---:|---:|",
+            &rows.iter().filter(|r| r.bodies == n).collect::<Vec<_>>(),
+            |r| {
                 format!(
-                    "| `{integrator}` | {} | {:.2} |",
-                    fmt_ns(ns),
-                    ns / row.ns_of(Integrator::Splitting)
+                    "| `{}` | {} | {} | {:.2} | {} | {} | {:.2} | {:.2} |",
+                    r.integrator,
+                    fmt_ns(r.raw_1t),
+                    fmt_ns(r.ecs_1t),
+                    r.ecs_1t / r.raw_1t,
+                    fmt_ns(r.raw_2t),
+                    fmt_ns(r.ecs_2t),
+                    r.ecs_2t / r.raw_2t,
+                    r.per_splitting()
                 )
             },
         ));

@@ -29,22 +29,31 @@ fn small_run_measures_every_engine_and_writes_json() {
     }
     assert!(results.bandwidth_gb_s.iter().all(|b| *b > 0.1));
     assert_eq!(results.fixed_cost_ns.len(), 2);
-    // Targets that need big worlds are left out; the fixed cost and unused-feature ones are in.
-    assert!(
-        results
-            .targets
-            .iter()
-            .any(|t| t.name.contains("fixed cost"))
-    );
-    assert!(!results.targets.iter().any(|t| t.name.contains("1e5")));
+    // Targets that need big worlds are left out; the run's own duration is in, and met.
+    let seconds = results
+        .targets
+        .iter()
+        .find(|t| t.name.contains("--quick"))
+        .expect("the quick run's duration is a target");
+    assert!(seconds.value > 0.0 && seconds.value == results.seconds);
+    assert!(!results.targets.iter().any(|t| t.name.contains("100000")));
     let json: serde_json::Value = serde_json::to_value(&results).unwrap();
-    assert_eq!(json["schema"], 4);
-    // Every integrator timed against the default, in one interleaved run.
+    assert_eq!(json["schema"], 5);
+    // Every integrator timed through the ECS and the raw loop, against the default.
+    assert_eq!(results.methods.len(), tumble_core::Integrator::ALL.len());
     for row in &results.methods {
-        assert_eq!(row.ns.len(), tumble_core::Integrator::ALL.len());
-        assert!(row.ns.iter().all(|(_, ns)| ns.is_finite() && *ns > 0.0));
+        let times = [
+            row.raw_1t,
+            row.ecs_1t,
+            row.raw_2t,
+            row.ecs_2t,
+            row.splitting_ecs_1t,
+        ];
+        assert!(
+            times.iter().all(|ns| ns.is_finite() && *ns > 0.0),
+            "{row:?}"
+        );
     }
-    assert!(!results.methods.is_empty());
     assert!(
         (0.5..=2.2).contains(&results.two_copy_ceiling),
         "{}",

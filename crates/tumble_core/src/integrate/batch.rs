@@ -13,24 +13,22 @@
 //! bit-identical to [`Integrator::try_step`] and the stage functions on that body alone,
 //! whatever the batch, its order, the kernel path or the thread that runs it.
 
-use crate::math::{Quat, Real, Vec3};
+use crate::math::{Real, Vec3};
 use std::borrow::Borrow;
 
 use super::exact_flow::{rotate_exactly, rotate_exactly_pair};
-use super::kick_drift_kernel::{
-    KickDrift, KickDriftLanes, kick_drift_lanes, kick_drift_one, kick_drift_translation,
-};
+use super::kick_drift_kernel::{KickDrift, kick_drift_translation};
+use super::lane_input::LaneInputs;
+use super::pending::{KickDriftQueue, PendingRotations, QueuedLanes, SymmetricQueue};
 use super::splitting::{
     drift_kick_drift_linear, drift_kick_drift_translation, free_rotation_span, kick_angular,
 };
-use super::symmetric_kernel::{
-    LaneFlow, LaneInputs, RotatedLanes, rotate_symmetric_lanes, rotate_symmetric_one,
-};
+use super::symmetric_kernel::LaneFlow;
 use super::{ExactSwitch, Integrator};
 use crate::mass::MassProperties;
 use crate::prefetch::prefetch;
 use crate::rotation::rotate_exact;
-use crate::simd::{Kernel, LANES};
+use crate::simd::Kernel;
 use crate::state::{BodyState, Wrench};
 
 /// Which part of a stage a batch performs (see [`Integrator::begin_stage`] and
@@ -128,170 +126,11 @@ const PREFETCH_AHEAD: usize = 32;
 
 /// Hands `next` to `bodies` as body `i`'s new state if it is valid, else reports divergence.
 #[inline(always)]
-fn commit(bodies: &mut impl BodyBatch, i: usize, next: &BodyState) {
+pub(super) fn commit(bodies: &mut impl BodyBatch, i: usize, next: &BodyState) {
     if next.is_valid() {
         bodies.write(i, next);
     } else {
         bodies.diverged(i);
-    }
-}
-
-/// A lane kernel's inputs for [`LANES`] bodies, as a batch queues them: the rotation each of
-/// them is waiting for.
-trait QueuedLanes {
-    /// Puts the body `state` (already translated) into lane `lane`, under `load`: the angular
-    /// impulse of its kick for `splitting`, its torque for a kick–drift method.
-    fn set(&mut self, lane: usize, state: &BodyState, mass: &MassProperties, load: Vec3);
-    /// Copies lane 0 into lanes `from..LANES` (the filler of a partial batch; lanes are
-    /// independent, so any valid input will do).
-    fn fill_from_first(&mut self, from: usize);
-    /// Lane `lane` rotated alone, through the kernel on `f64`: its new `(q, ω)`.
-    fn one(&self, lane: usize, h: Real) -> (Quat, Vec3);
-    /// Every lane rotated at once on `kernel`'s instruction set (the same bits as [`one`](Self::one)).
-    fn all(&self, kernel: Kernel, h: [Real; LANES]) -> RotatedLanes;
-}
-
-/// The symmetric-top flows of `splitting` (after their kicks) or of a composed step.
-struct SymmetricQueue {
-    inputs: LaneInputs,
-    flow: LaneFlow,
-}
-
-impl QueuedLanes for SymmetricQueue {
-    #[inline(always)]
-    fn set(&mut self, lane: usize, state: &BodyState, mass: &MassProperties, load: Vec3) {
-        let relabels = self.flow.relabels();
-        self.inputs.set(
-            lane,
-            state.rotation,
-            state.angular_velocity,
-            mass,
-            load,
-            relabels,
-        );
-    }
-    #[inline(always)]
-    fn fill_from_first(&mut self, from: usize) {
-        self.inputs.fill_from_first(from);
-    }
-    #[inline(always)]
-    fn one(&self, lane: usize, h: Real) -> (Quat, Vec3) {
-        rotate_symmetric_one(&self.inputs.get(lane), h, self.flow)
-    }
-    #[inline(always)]
-    fn all(&self, kernel: Kernel, h: [Real; LANES]) -> RotatedLanes {
-        rotate_symmetric_lanes(kernel, &self.inputs, h, self.flow)
-    }
-}
-
-/// The rotations of a kick–drift method.
-struct KickDriftQueue {
-    inputs: KickDriftLanes,
-    method: KickDrift,
-}
-
-impl QueuedLanes for KickDriftQueue {
-    #[inline(always)]
-    fn set(&mut self, lane: usize, state: &BodyState, mass: &MassProperties, load: Vec3) {
-        self.inputs
-            .set(lane, state.rotation, state.angular_velocity, mass, load);
-    }
-    #[inline(always)]
-    fn fill_from_first(&mut self, from: usize) {
-        self.inputs.fill_from_first(from);
-    }
-    #[inline(always)]
-    fn one(&self, lane: usize, h: Real) -> (Quat, Vec3) {
-        kick_drift_one(&self.inputs.get(lane), h, self.method)
-    }
-    #[inline(always)]
-    fn all(&self, kernel: Kernel, h: [Real; LANES]) -> RotatedLanes {
-        kick_drift_lanes(kernel, &self.inputs, h, self.method)
-    }
-}
-
-/// Bodies waiting for their rotation over the same `h`, flushed [`LANES`] at a time: each
-/// body's translated position and velocity, and its kernel inputs component by component so
-/// that the kernel loads them as vectors. (`h` is written once, not per body: scalar stores
-/// read back at once by a vector load stall store forwarding.)
-struct PendingRotations<L> {
-    index: [usize; LANES],
-    /// Each queued body's `(position, linear_velocity)`: the rest of its state is the kernel's.
-    translated: [(Vec3, Vec3); LANES],
-    lanes: L,
-    h: [Real; LANES],
-    len: usize,
-    kernel: Kernel,
-}
-
-impl<L: QueuedLanes> PendingRotations<L> {
-    /// No bodies yet; all of them will rotate over `h`, `LANES` at a time on `kernel`.
-    fn new(h: Real, kernel: Kernel, lanes: L) -> Self {
-        Self {
-            index: [0; LANES],
-            translated: [(Vec3::ZERO, Vec3::ZERO); LANES],
-            lanes,
-            h: [h; LANES],
-            len: 0,
-            kernel,
-        }
-    }
-
-    /// Queues body `index` (already translated, as `state`) for its rotation under `load` (see
-    /// [`QueuedLanes::set`]); returns true when the batch is full and must be flushed.
-    #[inline(always)]
-    fn queue(
-        &mut self,
-        index: usize,
-        state: &BodyState,
-        mass: &MassProperties,
-        load: Vec3,
-    ) -> bool {
-        let lane = self.len;
-        self.lanes.set(lane, state, mass, load);
-        self.index[lane] = index;
-        self.translated[lane] = (state.position, state.linear_velocity);
-        self.len = lane + 1;
-        self.len == LANES
-    }
-
-    /// Rotates the queued bodies and commits each result. A batch of one goes through the
-    /// scalar kernel; a partial batch fills its empty lanes with copies of its first body
-    /// (lanes are independent, so the results are the same bits either way).
-    #[inline(always)]
-    fn flush(&mut self, bodies: &mut impl BodyBatch) {
-        match self.len {
-            0 => {}
-            1 => {
-                let (rotation, omega) = self.lanes.one(0, self.h[0]);
-                self.finish(0, rotation, omega, bodies);
-            }
-            len => {
-                self.lanes.fill_from_first(len);
-                let rotated = self.lanes.all(self.kernel, self.h);
-                for lane in 0..len {
-                    let (rotation, omega) = rotated.lane(lane);
-                    self.finish(lane, rotation, omega, bodies);
-                }
-            }
-        }
-        self.len = 0;
-    }
-
-    /// Commits lane `lane`'s rotated body.
-    #[inline(always)]
-    fn finish(&self, lane: usize, rotation: Quat, omega: Vec3, bodies: &mut impl BodyBatch) {
-        // A fresh value rather than an update of the queued one in place: stores of the new
-        // fields followed by the wide loads of `is_finite` across field boundaries would stall
-        // store forwarding.
-        let (position, linear_velocity) = self.translated[lane];
-        let next = BodyState {
-            position,
-            rotation,
-            linear_velocity,
-            angular_velocity: omega,
-        };
-        commit(bodies, self.index[lane], &next);
     }
 }
 
@@ -372,6 +211,57 @@ fn batched(
     pending.flush(bodies);
 }
 
+/// What a queued batch does with a body it has read (see [`queued`]).
+enum Route {
+    /// Step it whole by the single-body step.
+    Alone,
+    /// It is stepped and ready to commit.
+    Done,
+    /// Queue its rotation under this load (see [`QueuedLanes::set`]).
+    Queue(Vec3),
+}
+
+/// The loop of a batch whose rotations run in lanes: reads each body, steps it alone where the
+/// exact switch applies to it, else lets `route` advance what runs first and say where the body
+/// goes; queued rotations are flushed eight (`LANES`) at a time.
+#[inline(always)]
+fn queued<L: QueuedLanes>(
+    mut pending: PendingRotations<L>,
+    bodies: &mut impl BodyBatch,
+    switch: Option<ExactSwitch>,
+    mut alone: impl FnMut(&mut BodyState, &MassProperties, &Wrench, Real),
+    mut route: impl FnMut(&mut BodyState, &MassProperties, &Wrench) -> Route,
+) {
+    let mut next = BodyState::ZEROED;
+    for i in 0..bodies.len() {
+        bodies.prefetch(i + PREFETCH_AHEAD);
+        let Some(wrench) = bodies.read(i, &mut next) else {
+            continue;
+        };
+        let mass = bodies.mass(i);
+        let turn = bodies.spring_turn_rate(i);
+        let route = if switch.is_some_and(|switch| switch.applies_turned(&next, mass, turn)) {
+            Route::Alone
+        } else {
+            route(&mut next, mass, &wrench)
+        };
+        match route {
+            Route::Alone => {
+                let mut single = next;
+                alone(&mut single, mass, &wrench, turn);
+                commit(bodies, i, &single);
+            }
+            Route::Done => commit(bodies, i, &next),
+            Route::Queue(load) => {
+                if pending.queue(i, &next, mass, load) {
+                    pending.flush(bodies);
+                }
+            }
+        }
+    }
+    pending.flush(bodies);
+}
+
 /// The batch of whole composed steps (`yoshida4`): a body without torque takes the exact
 /// translation over `dt` and its stages' free rotations in sequence, queued for the SIMD kernel
 /// (as [`Integrator::step`] does alone); a spherical body turns exactly; a body under a torque
@@ -383,36 +273,23 @@ fn composed(
     bodies: &mut impl BodyBatch,
     dt: Real,
     switch: Option<ExactSwitch>,
-    mut alone: impl FnMut(&mut BodyState, &MassProperties, &Wrench, Real),
+    alone: impl FnMut(&mut BodyState, &MassProperties, &Wrench, Real),
 ) {
     let flow = LaneFlow::Composed(weights);
     let inputs = LaneInputs::default();
-    let mut pending = PendingRotations::new(dt, kernel, SymmetricQueue { inputs, flow });
-    let mut next = BodyState::ZEROED;
-    for i in 0..bodies.len() {
-        bodies.prefetch(i + PREFETCH_AHEAD);
-        let Some(wrench) = bodies.read(i, &mut next) else {
-            continue;
-        };
-        let mass = bodies.mass(i);
-        let turn = bodies.spring_turn_rate(i);
-        if wrench.torque != Vec3::ZERO
-            || switch.is_some_and(|switch| switch.applies_turned(&next, mass, turn))
-        {
-            let mut single = next;
-            alone(&mut single, mass, &wrench, turn);
-            commit(bodies, i, &single);
-            continue;
+    let pending = PendingRotations::new(dt, kernel, SymmetricQueue { inputs, flow });
+    queued(pending, bodies, switch, alone, |next, mass, wrench| {
+        if wrench.torque != Vec3::ZERO {
+            return Route::Alone;
         }
-        drift_kick_drift_translation(StepPhase::Whole, &mut next, mass, &wrench, dt);
+        drift_kick_drift_translation(StepPhase::Whole, next, mass, wrench, dt);
         if mass.is_spherical() {
             next.rotation = rotate_exact(next.rotation, next.angular_velocity, dt);
-            commit(bodies, i, &next);
-        } else if pending.queue(i, &next, mass, Vec3::ZERO) {
-            pending.flush(bodies);
+            Route::Done
+        } else {
+            Route::Queue(Vec3::ZERO)
         }
-    }
-    pending.flush(bodies);
+    });
 }
 
 /// The kick–drift batch (`symplectic-euler*`, `lclamp`, `implicit-gyroscopic`): each body's
@@ -425,30 +302,14 @@ fn kick_drifted(
     bodies: &mut impl BodyBatch,
     h: Real,
     switch: Option<ExactSwitch>,
-    mut alone: impl FnMut(&mut BodyState, &MassProperties, &Wrench, Real),
+    alone: impl FnMut(&mut BodyState, &MassProperties, &Wrench, Real),
 ) {
-    let inputs = KickDriftLanes::default();
-    let mut pending = PendingRotations::new(h, kernel, KickDriftQueue { inputs, method });
-    let mut next = BodyState::ZEROED;
-    for i in 0..bodies.len() {
-        bodies.prefetch(i + PREFETCH_AHEAD);
-        let Some(wrench) = bodies.read(i, &mut next) else {
-            continue;
-        };
-        let mass = bodies.mass(i);
-        let turn = bodies.spring_turn_rate(i);
-        if switch.is_some_and(|switch| switch.applies_turned(&next, mass, turn)) {
-            let mut single = next;
-            alone(&mut single, mass, &wrench, turn);
-            commit(bodies, i, &single);
-            continue;
-        }
-        kick_drift_translation(&mut next, mass, wrench.force, h);
-        if pending.queue(i, &next, mass, wrench.torque) {
-            pending.flush(bodies);
-        }
-    }
-    pending.flush(bodies);
+    let inputs = LaneInputs::default();
+    let pending = PendingRotations::new(h, kernel, KickDriftQueue { inputs, method });
+    queued(pending, bodies, switch, alone, |next, mass, wrench| {
+        kick_drift_translation(next, mass, wrench.force, h);
+        Route::Queue(wrench.torque)
+    });
 }
 
 /// The `exact` batch: each body's drift–kick–drift translation, then its free rotation, two

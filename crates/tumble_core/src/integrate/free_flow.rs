@@ -230,8 +230,9 @@ pub struct ExactSwitch {
 /// `|ω|² / ω_turn²` at or below which a body's springs outweigh its split whatever its inertia
 /// (see [`ExactSwitch::applies_turned`]): `e_orbit ≤ 0.75 h² |ω|²` (module docs), so
 /// `e_orbit |ω| ≤ ω_turn³ h²/24` holds wherever `|ω|³ ≤ ω_turn³/18`, i.e.
-/// `|ω|² ≤ ω_turn² / 18^{2/3}`; less a margin for the rounding of `|ω|²` and `ω_turn²`.
-const TURN_BOUND: Real = (1.0 / 6.868_285_4) / (1.0 + 1e-3);
+/// `|ω|² ≤ ω_turn² / 18^{2/3}` (`18^{2/3} = 6.86828…`, rounded up); less a margin for the
+/// rounding of `|ω|²` and `ω_turn²`.
+const TURN_BOUND: Real = (1.0 / 6.8683) / (1.0 + 1e-3);
 
 /// False when the body's springs turn it fast enough that the switch cannot apply to it, one
 /// `|ω|²` against `ω_turn²` ([`TURN_BOUND`]): the second cheap test of

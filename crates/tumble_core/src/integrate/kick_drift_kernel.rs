@@ -22,9 +22,9 @@
 use super::Integrator;
 use super::frame::reciprocal;
 use super::implicit_gyroscopic::implicit_kick;
+use super::lane_input::{LaneInput, LaneInputs, RotatedLanes, to_real};
 use super::lanes::{Quat4, Rotor, Vec3L, conjugate, mul, normalize};
 use super::lclamp::clamped_kick;
-use super::symmetric_kernel::{RotatedLanes, to_real};
 use super::symplectic_euler::explicit_kick;
 use crate::mass::MassProperties;
 use crate::math::{Quat, Real, Vec3, Widen};
@@ -74,44 +74,6 @@ pub(super) struct PrincipalBody<T: Lane> {
     pub gyroscopic: T::Mask,
 }
 
-/// Inputs of the kernel for one body (`T = f64`) or a run of bodies.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub(super) struct KickDriftInput<T = f64> {
-    /// Body orientation `q`.
-    pub rotation: Quat4<T>,
-    /// World angular velocity `ω`.
-    pub omega: Vec3L<T>,
-    /// Principal frame `F`.
-    pub frame: Quat4<T>,
-    /// Principal moments `I`.
-    pub inertia: Vec3L<T>,
-    /// World torque `τ`, held over the step.
-    pub torque: Vec3L<T>,
-    /// 1 for a spherical body, 0 otherwise.
-    pub spherical: T,
-}
-
-impl KickDriftInput {
-    /// The inputs of one body under `torque`.
-    #[inline]
-    pub(super) fn new(rotation: Quat, omega: Vec3, mass: &MassProperties, torque: Vec3) -> Self {
-        let (q, w, f) = (
-            rotation.widen(),
-            omega.widen(),
-            mass.principal_frame().widen(),
-        );
-        let (i, t) = (mass.principal_inertia().widen(), torque.widen());
-        Self {
-            rotation: [q.x, q.y, q.z, q.w],
-            omega: [w.x, w.y, w.z],
-            frame: [f.x, f.y, f.z, f.w],
-            inertia: [i.x, i.y, i.z],
-            torque: [t.x, t.y, t.z],
-            spherical: if mass.is_spherical() { 1.0 } else { 0.0 },
-        }
-    }
-}
-
 /// `normalize(exp(½ h ω) q)`: the exact turn by `ω` over `h` (the identity for `ω = 0`).
 #[inline(always)]
 fn turn_exactly<T: Lane>(q: Quat4<T>, omega: Vec3L<T>, h: T) -> Quat4<T> {
@@ -141,7 +103,7 @@ fn turn_linearized<T: Lane>(q: Quat4<T>, omega: Vec3L<T>, h: T) -> Quat4<T> {
 /// velocity. See the module documentation for the sequence.
 #[inline(always)]
 pub(super) fn kick_drift_rotation<T: Lane>(
-    input: &KickDriftInput<T>,
+    input: &LaneInput<T>,
     h: T,
     method: KickDrift,
 ) -> (Quat4<T>, Vec3L<T>) {
@@ -153,7 +115,7 @@ pub(super) fn kick_drift_rotation<T: Lane>(
     let omega = to_body.apply(input.omega);
     let body = PrincipalBody {
         omega,
-        torque: to_body.apply(input.torque),
+        torque: to_body.apply(input.impulse),
         inertia,
         // Written out, not `map`: inside a `#[target_feature]` function every helper must
         // inline, and `map` need not.
@@ -190,7 +152,7 @@ pub(super) fn kick_drift_rotation<T: Lane>(
 /// One body through the kernel (`f64` lanes): its new `(q, ω)`, rounded to the engine precision
 /// once.
 #[inline]
-pub(super) fn kick_drift_one(input: &KickDriftInput, h: Real, method: KickDrift) -> (Quat, Vec3) {
+pub(super) fn kick_drift_one(input: &LaneInput, h: Real, method: KickDrift) -> (Quat, Vec3) {
     let (q, w) = kick_drift_rotation::<f64>(input, h.widen(), method);
     to_real(q, w)
 }
@@ -208,6 +170,17 @@ pub(super) fn kick_drift_translation(
     state.position += h * state.linear_velocity;
 }
 
+/// A body's kernel inputs under `torque`: its principal frame as it is (the kick–drift kernel
+/// does not relabel), the torque where a free flow takes its impulse.
+#[inline(always)]
+pub(super) fn kick_drift_input(
+    state: &BodyState,
+    mass: &MassProperties,
+    torque: Vec3,
+) -> LaneInput {
+    LaneInput::for_flow(state.rotation, state.angular_velocity, mass, false).with_impulse(torque)
+}
+
 /// One whole kick–drift step of one body over `h` under a constant `wrench`: the translation,
 /// then the rotation through the kernel.
 #[inline]
@@ -219,83 +192,8 @@ pub(super) fn kick_drift_step(
     method: KickDrift,
 ) {
     kick_drift_translation(state, mass, wrench.force, h);
-    let input = KickDriftInput::new(state.rotation, state.angular_velocity, mass, wrench.torque);
-    (state.rotation, state.angular_velocity) = kick_drift_one(&input, h, method);
-}
-
-/// The inputs of [`LANES`] bodies, component by component, in the engine precision (every
-/// input is exact in `Real`).
-#[derive(Debug, Clone, Copy, Default)]
-pub(super) struct KickDriftLanes {
-    rotation: [[Real; LANES]; 4],
-    omega: [[Real; LANES]; 3],
-    frame: [[Real; LANES]; 4],
-    inertia: [[Real; LANES]; 3],
-    torque: [[Real; LANES]; 3],
-    spherical: [Real; LANES],
-}
-
-impl KickDriftLanes {
-    /// Puts one body's inputs into lane `lane` (what [`KickDriftInput::new`] makes of them).
-    #[inline(always)]
-    pub(super) fn set(
-        &mut self,
-        lane: usize,
-        rotation: Quat,
-        omega: Vec3,
-        mass: &MassProperties,
-        torque: Vec3,
-    ) {
-        let frame = mass.principal_frame();
-        let inertia = mass.principal_inertia();
-        for (k, (q, f)) in [rotation.x, rotation.y, rotation.z, rotation.w]
-            .into_iter()
-            .zip([frame.x, frame.y, frame.z, frame.w])
-            .enumerate()
-        {
-            self.rotation[k][lane] = q;
-            self.frame[k][lane] = f;
-        }
-        for (k, ((w, i), t)) in [omega.x, omega.y, omega.z]
-            .into_iter()
-            .zip([inertia.x, inertia.y, inertia.z])
-            .zip([torque.x, torque.y, torque.z])
-            .enumerate()
-        {
-            self.omega[k][lane] = w;
-            self.inertia[k][lane] = i;
-            self.torque[k][lane] = t;
-        }
-        self.spherical[lane] = if mass.is_spherical() { 1.0 } else { 0.0 };
-    }
-
-    /// The inputs in lane `lane`.
-    #[inline(always)]
-    pub(super) fn get(&self, lane: usize) -> KickDriftInput {
-        KickDriftInput {
-            rotation: self.rotation.map(|c| c[lane].widen()),
-            omega: self.omega.map(|c| c[lane].widen()),
-            frame: self.frame.map(|c| c[lane].widen()),
-            inertia: self.inertia.map(|c| c[lane].widen()),
-            torque: self.torque.map(|c| c[lane].widen()),
-            spherical: self.spherical[lane].widen(),
-        }
-    }
-
-    /// Copies lane 0 into lanes `from..LANES` (the filler of a partial batch).
-    #[inline(always)]
-    pub(super) fn fill_from_first(&mut self, from: usize) {
-        let fill = |c: &mut [Real; LANES]| {
-            let first = c[0];
-            c[from..].fill(first);
-        };
-        self.rotation.iter_mut().for_each(fill);
-        self.omega.iter_mut().for_each(fill);
-        self.frame.iter_mut().for_each(fill);
-        self.inertia.iter_mut().for_each(fill);
-        self.torque.iter_mut().for_each(fill);
-        fill(&mut self.spherical);
-    }
+    (state.rotation, state.angular_velocity) =
+        kick_drift_one(&kick_drift_input(state, mass, wrench.torque), h, method);
 }
 
 /// [`LANES`] bodies through the kernel at once, each over its own `h`, on the `kernel`'s
@@ -305,7 +203,7 @@ impl KickDriftLanes {
 #[inline(never)]
 pub(super) fn kick_drift_lanes(
     kernel: Kernel,
-    inputs: &KickDriftLanes,
+    inputs: &LaneInputs,
     h: [Real; LANES],
     method: KickDrift,
 ) -> RotatedLanes {
@@ -340,7 +238,7 @@ fn method_of<const METHOD: u8>() -> KickDrift {
 #[inline(always)]
 fn lanes_of<const METHOD: u8>(
     kernel: Kernel,
-    inputs: &KickDriftLanes,
+    inputs: &LaneInputs,
     h: [Real; LANES],
 ) -> RotatedLanes {
     match kernel {
@@ -369,7 +267,7 @@ fn lanes_of<const METHOD: u8>(
 #[target_feature(enable = "avx512f")]
 fn kick_drift_lanes_avx512<const METHOD: u8>(
     cpu: Avx512,
-    inputs: &KickDriftLanes,
+    inputs: &LaneInputs,
     h: [Real; LANES],
 ) -> RotatedLanes {
     kick_drift_lanes_in::<Avx8, METHOD>(cpu, inputs, h)
@@ -380,53 +278,26 @@ fn kick_drift_lanes_avx512<const METHOD: u8>(
 #[target_feature(enable = "avx2")]
 fn kick_drift_lanes_avx2<const METHOD: u8>(
     cpu: Avx2,
-    inputs: &KickDriftLanes,
+    inputs: &LaneInputs,
     h: [Real; LANES],
 ) -> RotatedLanes {
     kick_drift_lanes_in::<Pair<Avx4>, METHOD>(cpu, inputs, h)
 }
 
-/// Runs the kernel over the batch in runs of `T::WIDTH` bodies. Plain indexing, no closures:
-/// inside a `#[target_feature]` function every helper must inline.
+/// Runs the kernel over the batch in runs of `T::WIDTH` bodies.
 #[inline(always)]
-#[allow(clippy::needless_range_loop)]
 fn kick_drift_lanes_in<T: Lane, const METHOD: u8>(
     cpu: T::Cpu,
-    inputs: &KickDriftLanes,
+    inputs: &LaneInputs,
     h: [Real; LANES],
 ) -> RotatedLanes {
     let method = method_of::<METHOD>();
-    let mut out = RotatedLanes {
-        rotation: [[0.0; LANES]; 4],
-        omega: [[0.0; LANES]; 3],
-    };
-    let zero = T::splat(cpu, 0.0);
+    let mut out = RotatedLanes::new();
     let mut start = 0;
     while start < LANES {
-        let mut input = KickDriftInput::<T> {
-            rotation: [zero; 4],
-            omega: [zero; 3],
-            frame: [zero; 4],
-            inertia: [zero; 3],
-            torque: [zero; 3],
-            spherical: T::load_real(cpu, &inputs.spherical[start..]),
-        };
-        for k in 0..4 {
-            input.rotation[k] = T::load_real(cpu, &inputs.rotation[k][start..]);
-            input.frame[k] = T::load_real(cpu, &inputs.frame[k][start..]);
-        }
-        for k in 0..3 {
-            input.omega[k] = T::load_real(cpu, &inputs.omega[k][start..]);
-            input.inertia[k] = T::load_real(cpu, &inputs.inertia[k][start..]);
-            input.torque[k] = T::load_real(cpu, &inputs.torque[k][start..]);
-        }
+        let input = inputs.load::<T>(cpu, start, false, true, true);
         let (q, w) = kick_drift_rotation::<T>(&input, T::load_real(cpu, &h[start..]), method);
-        for k in 0..4 {
-            q[k].store_real(&mut out.rotation[k][start..]);
-        }
-        for k in 0..3 {
-            w[k].store_real(&mut out.omega[k][start..]);
-        }
+        out.store(start, q, w);
         start += T::WIDTH;
     }
     out
@@ -434,6 +305,7 @@ fn kick_drift_lanes_in<T: Lane, const METHOD: u8>(
 
 #[cfg(test)]
 mod tests {
+    use super::super::lane_input::fixtures::{SPANS, bits};
     use super::*;
     use crate::integrate::KernelPath;
     use crate::mass::Mass;
@@ -490,37 +362,22 @@ mod tests {
         })
     }
 
-    fn bits(r: &[(Quat, Vec3)]) -> Vec<u64> {
-        r.iter()
-            .flat_map(|(q, w)| {
-                q.to_array()
-                    .into_iter()
-                    .chain(w.to_array())
-                    .map(|x| x.widen().to_bits())
-            })
-            .collect()
-    }
-
     /// Every compilation of the kernel the CPU runs (portable, and AVX2 or AVX-512 where it has
     /// them) and the one-body kernel agree bit for bit, for each method; a lane beyond the
     /// sine's range does not change its neighbours' bits.
     #[test]
     fn lane_kernels_match_the_one_body_kernel() {
         let bodies = bodies();
-        let h = [
-            1.0 / 60.0,
-            0.1,
-            0.05,
-            1.0 / 240.0,
-            0.2,
-            1.0 / 60.0,
-            1.0 / 60.0,
-            0.01,
-        ];
-        let mut inputs = KickDriftLanes::default();
+        let h = SPANS;
+        let mut inputs = LaneInputs::default();
         for (lane, &(rotation, omega, mass, torque)) in bodies.iter().enumerate() {
-            inputs.set(lane, rotation, omega, &mass, torque);
-            let one = KickDriftInput::new(rotation, omega, &mass, torque);
+            inputs.set(lane, rotation, omega, &mass, torque, false);
+            let state = BodyState {
+                rotation,
+                angular_velocity: omega,
+                ..BodyState::default()
+            };
+            let one = kick_drift_input(&state, &mass, torque);
             assert_eq!(inputs.get(lane), one, "lane {lane}");
         }
         let kernels = Kernel::available();
@@ -544,13 +401,13 @@ mod tests {
 
     /// Each method's formula, written out independently with `glam`'s f64 types: the new world
     /// rate and orientation (see the method files).
-    fn reference(method: KickDrift, input: &KickDriftInput, h: f64) -> (DQuat, DVec3) {
+    fn reference(method: KickDrift, input: &LaneInput, h: f64) -> (DQuat, DVec3) {
         let quat = |q: [f64; 4]| DQuat::from_xyzw(q[0], q[1], q[2], q[3]);
         let (q, frame) = (quat(input.rotation), quat(input.frame));
         let (omega, inertia, torque) = (
             DVec3::from(input.omega),
             DVec3::from(input.inertia),
-            DVec3::from(input.torque),
+            DVec3::from(input.impulse),
         );
         // The kernel rotates by `q v q* / |q|²`, a rotation even for the inputs' f32 rounding.
         let principal = (q * frame).normalize();
@@ -613,7 +470,12 @@ mod tests {
     #[test]
     fn the_kernel_computes_each_method() {
         for (lane, &(rotation, omega, mass, torque)) in bodies().iter().enumerate() {
-            let input = KickDriftInput::new(rotation, omega, &mass, torque);
+            let state = BodyState {
+                rotation,
+                angular_velocity: omega,
+                ..BodyState::default()
+            };
+            let input = kick_drift_input(&state, &mass, torque);
             for method in METHODS {
                 let h = 1.0 / 60.0;
                 let (q, w) = kick_drift_rotation::<f64>(&input, h, method);

@@ -40,9 +40,11 @@ pub use free_flow::{
 };
 mod implicit_gyroscopic;
 mod kick_drift_kernel;
+mod lane_input;
 mod lanes;
 mod lclamp;
 mod momentum_flow;
+mod pending;
 pub(crate) use momentum_flow::free_turn;
 mod rk4;
 mod splitting;

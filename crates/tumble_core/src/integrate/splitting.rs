@@ -55,7 +55,8 @@ use glam::{DQuat, DVec3};
 
 use super::StepPhase;
 use super::frame::{reciprocal, rotate64};
-use super::symmetric_kernel::{LaneFlow, SymmetricInput, rotate_symmetric_one};
+use super::lane_input::LaneInput;
+use super::symmetric_kernel::{LaneFlow, rotate_symmetric_one};
 use crate::mass::MassProperties;
 use crate::rotation::rotate_exact;
 use crate::state::{BodyState, Wrench};
@@ -128,7 +129,7 @@ pub(super) fn rotate_on_kernel(
         return;
     }
     let flow = flow.with_kick(false);
-    let input = SymmetricInput::for_flow(
+    let input = LaneInput::for_flow(
         state.rotation,
         state.angular_velocity,
         mass,
@@ -155,7 +156,7 @@ pub(super) fn rotate_kicked_on_kernel(
         return;
     }
     let flow = flow.with_kick(true);
-    let input = SymmetricInput::for_flow(
+    let input = LaneInput::for_flow(
         state.rotation,
         state.angular_velocity,
         mass,

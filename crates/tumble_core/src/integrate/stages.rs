@@ -26,7 +26,8 @@
 use std::num::NonZeroU32;
 
 use super::Integrator;
-use super::symmetric_kernel::{LaneFlow, SymmetricInput, rotate_symmetric_one};
+use super::lane_input::LaneInput;
+use super::symmetric_kernel::{LaneFlow, rotate_symmetric_one};
 use crate::mass::MassProperties;
 use crate::math::Real;
 use crate::rotation::rotate_exact;
@@ -60,7 +61,7 @@ pub(super) fn rotate_composed(
         state.rotation = rotate_exact(state.rotation, state.angular_velocity, h);
         return;
     }
-    let input = SymmetricInput::new(state.rotation, state.angular_velocity, mass);
+    let input = LaneInput::new(state.rotation, state.angular_velocity, mass);
     (state.rotation, state.angular_velocity) =
         rotate_symmetric_one(&input, h, LaneFlow::Composed(weights));
 }

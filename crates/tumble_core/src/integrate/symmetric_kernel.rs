@@ -22,10 +22,11 @@
 //! (`r = 0`) and symmetric bodies need no branches.
 
 use super::frame::reciprocal;
+use super::lane_input::{LaneInput, LaneInputs, RotatedLanes, to_real};
 use super::lanes::{Quat4, Rotor, Vec3L, conjugate, mul, rotate};
 use super::rk4::rk4_flow;
 use crate::mass::MassProperties;
-use crate::math::{Narrow, Quat, Real, Vec3, Widen};
+use crate::math::{Quat, Real, Vec3, Widen};
 #[cfg(target_arch = "x86_64")]
 use crate::simd::{Avx2, Avx4, Avx8, Avx512};
 use crate::simd::{
@@ -91,172 +92,6 @@ impl<T: Lane> Free<T> {
     }
 }
 
-/// Inputs of the kernel for one body (`T = f64`) or a run of bodies (a [`Run`] type).
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub(super) struct SymmetricInput<T = f64> {
-    /// Body orientation `q`.
-    pub rotation: Quat4<T>,
-    /// World angular velocity `ω`.
-    pub omega: Vec3L<T>,
-    /// Principal frame `F`.
-    pub frame: Quat4<T>,
-    /// The relabelling `P` (identity, or 120° / 240° about `(1,1,1)`).
-    pub relabel: Quat4<T>,
-    /// Relabelled principal moments `I'`.
-    pub inertia: Vec3L<T>,
-    /// Angular impulse `J` (world frame) of the kick just before this free flow (zero when
-    /// there is none); read only by a kicking flow (see [`symmetric_rotation`]).
-    pub impulse: Vec3L<T>,
-}
-
-/// The relabellings `P`: `x' = a`, for the odd axis `a` = x, y, z (exact in any precision).
-const RELABEL: [[Real; 4]; 3] = [
-    [0.0, 0.0, 0.0, 1.0],
-    [0.5, 0.5, 0.5, 0.5],
-    [-0.5, -0.5, -0.5, 0.5],
-];
-
-/// The relabelling `P` and the moments in its frame: [`relabelled_inertia`] with its `P` when
-/// `relabel`, else the identity and the moments as they are.
-#[inline(always)]
-fn relabelling(mass: &MassProperties, relabel: bool) -> ([Real; 4], [Real; 3]) {
-    if relabel {
-        (RELABEL[mass.odd_axis()], relabelled_inertia(mass))
-    } else {
-        (RELABEL[0], mass.principal_inertia().to_array())
-    }
-}
-
-/// A body's principal moments relabelled `(a, a+1, a+2) → (x, y, z)` for its odd axis `a`
-/// ([`MassProperties::odd_axis`]: the pair of axes with the closest reciprocal moments is the
-/// symmetric pair).
-#[inline(always)]
-fn relabelled_inertia(mass: &MassProperties) -> [Real; 3] {
-    let i = mass.principal_inertia();
-    match mass.odd_axis() {
-        0 => [i.x, i.y, i.z],
-        1 => [i.y, i.z, i.x],
-        _ => [i.z, i.x, i.y],
-    }
-}
-
-impl SymmetricInput {
-    /// Builds the inputs for one body, relabelled so that its odd axis is `x` (see the module
-    /// documentation).
-    #[inline]
-    pub(super) fn new(rotation: Quat, omega: Vec3, mass: &MassProperties) -> Self {
-        Self::for_flow(rotation, omega, mass, true)
-    }
-
-    /// Builds the inputs for one body, relabelled so that its odd axis is `x` when `relabel`
-    /// (see [`LaneFlow::relabels`]), else in its principal frame as it is.
-    #[inline]
-    pub(super) fn for_flow(
-        rotation: Quat,
-        omega: Vec3,
-        mass: &MassProperties,
-        relabel: bool,
-    ) -> Self {
-        let f = mass.principal_frame().widen();
-        let (q, w) = (rotation.widen(), omega.widen());
-        let (relabel, inertia) = relabelling(mass, relabel);
-        Self {
-            rotation: [q.x, q.y, q.z, q.w],
-            omega: [w.x, w.y, w.z],
-            frame: [f.x, f.y, f.z, f.w],
-            relabel: relabel.map(Widen::widen),
-            inertia: inertia.map(Widen::widen),
-            impulse: [0.0; 3],
-        }
-    }
-
-    /// The same inputs after a kick of angular impulse `impulse` (world frame).
-    #[inline]
-    pub(super) fn with_impulse(self, impulse: Vec3) -> Self {
-        let j = impulse.widen();
-        Self {
-            impulse: [j.x, j.y, j.z],
-            ..self
-        }
-    }
-}
-
-/// The inputs of [`LANES`] bodies, component by component (`rotation[k][i]` is component `k` of
-/// body `i`), in the engine precision: the kernel loads each component of all bodies with one
-/// vector load and widens it with one vector conversion (every value is exact in `Real`, the
-/// relabelling's `0, ±½, 1` included).
-pub(super) type LaneInputs = SymmetricInput<[Real; LANES]>;
-
-impl LaneInputs {
-    /// Puts one body's inputs into lane `lane` (what [`SymmetricInput::new`] and
-    /// [`with_impulse`](SymmetricInput::with_impulse) make of them).
-    #[inline(always)]
-    pub(super) fn set(
-        &mut self,
-        lane: usize,
-        rotation: Quat,
-        omega: Vec3,
-        mass: &MassProperties,
-        impulse: Vec3,
-        relabel: bool,
-    ) {
-        let (relabel, inertia) = relabelling(mass, relabel);
-        let frame = mass.principal_frame();
-        for (k, (q, (f, p))) in [rotation.x, rotation.y, rotation.z, rotation.w]
-            .into_iter()
-            .zip(
-                [frame.x, frame.y, frame.z, frame.w]
-                    .into_iter()
-                    .zip(relabel),
-            )
-            .enumerate()
-        {
-            self.rotation[k][lane] = q;
-            self.frame[k][lane] = f;
-            self.relabel[k][lane] = p;
-        }
-        for (k, ((w, i), j)) in [omega.x, omega.y, omega.z]
-            .into_iter()
-            .zip(inertia)
-            .zip([impulse.x, impulse.y, impulse.z])
-            .enumerate()
-        {
-            self.omega[k][lane] = w;
-            self.inertia[k][lane] = i;
-            self.impulse[k][lane] = j;
-        }
-    }
-
-    /// The inputs in lane `lane`.
-    #[inline(always)]
-    pub(super) fn get(&self, lane: usize) -> SymmetricInput {
-        SymmetricInput {
-            rotation: self.rotation.map(|c| c[lane].widen()),
-            omega: self.omega.map(|c| c[lane].widen()),
-            frame: self.frame.map(|c| c[lane].widen()),
-            relabel: self.relabel.map(|c| c[lane].widen()),
-            inertia: self.inertia.map(|c| c[lane].widen()),
-            impulse: self.impulse.map(|c| c[lane].widen()),
-        }
-    }
-
-    /// Copies lane 0 into lanes `from..LANES` (the filler of a partial batch; lanes are
-    /// independent, so any valid input will do).
-    #[inline(always)]
-    pub(super) fn fill_from_first(&mut self, from: usize) {
-        let fill = |c: &mut [Real; LANES]| {
-            let first = c[0];
-            c[from..].fill(first);
-        };
-        self.rotation.iter_mut().for_each(fill);
-        self.omega.iter_mut().for_each(fill);
-        self.frame.iter_mut().for_each(fill);
-        self.relabel.iter_mut().for_each(fill);
-        self.inertia.iter_mut().for_each(fill);
-        self.impulse.iter_mut().for_each(fill);
-    }
-}
-
 /// A free flow under way: the body in its relabelled principal frame `F'`, its reciprocal
 /// moments `r` (0 on a locked axis), and `F'` to return through.
 pub(super) struct Flowing<T> {
@@ -270,7 +105,7 @@ impl<T: Lane> Flowing<T> {
     /// every lane whose impulse `J` is not zero (or is NaN, which must show), so that a lane
     /// without a torque gets the bits of a flow without a kick.
     #[inline(always)]
-    pub(super) fn start(input: &SymmetricInput<T>, kicks: bool) -> Self {
+    pub(super) fn start(input: &LaneInput<T>, kicks: bool) -> Self {
         let inertia = input.inertia;
         // Written out, not `inertia.map(reciprocal)`: inside a `#[target_feature]` function
         // every helper must inline, and `map` need not (see `rotate_run`).
@@ -434,7 +269,7 @@ impl LaneFlow {
 /// world angular velocity. See the module documentation for the sequence.
 #[inline(always)]
 pub(super) fn symmetric_rotation<T: Lane>(
-    input: &SymmetricInput<T>,
+    input: &LaneInput<T>,
     h: T,
     flow: LaneFlow,
 ) -> (Quat4<T>, Vec3L<T>) {
@@ -452,19 +287,20 @@ pub fn symmetric_rotation_flops(kicks: bool) -> OpCounts {
     use crate::mass::Mass;
     let mass = MassProperties::new(Mass::new(1.0).expect("positive"), Vec3::new(1.0, 2.0, 3.0))
         .expect("valid moments");
-    let input = SymmetricInput::new(
+    let input = LaneInput::new(
         Quat::from_xyzw(0.1, 0.2, 0.3, 0.927_361_8).normalize(),
         Vec3::new(0.3, 1.0, 0.2),
         &mass,
     )
     .with_impulse(Vec3::new(0.01, 0.0, -0.02));
-    let lanes = SymmetricInput::<Counted> {
+    let lanes = LaneInput::<Counted> {
         rotation: input.rotation.map(Counted),
         omega: input.omega.map(Counted),
         frame: input.frame.map(Counted),
         relabel: input.relabel.map(Counted),
         inertia: input.inertia.map(Counted),
         impulse: input.impulse.map(Counted),
+        spherical: Counted(input.spherical),
     };
     counted(|| symmetric_rotation(&lanes, Counted(1.0 / 60.0), LaneFlow::Symmetric { kicks })).1
 }
@@ -487,50 +323,12 @@ pub(super) fn turn_from_momentum(flow: LaneFlow, m: [f64; 3], r: [f64; 3], h: f6
     flowing.free.q
 }
 
-/// Rounds a kernel result to the engine's precision.
-#[inline(always)]
-pub(super) fn to_real(q: [f64; 4], w: [f64; 3]) -> (Quat, Vec3) {
-    (
-        Quat::from_xyzw(q[0].narrow(), q[1].narrow(), q[2].narrow(), q[3].narrow()),
-        Vec3::new(w[0].narrow(), w[1].narrow(), w[2].narrow()),
-    )
-}
-
 /// One body through the kernel (`f64` lanes): the new `(q, ω)` after `flow`, rounded to the
 /// engine precision once.
 #[inline]
-pub(super) fn rotate_symmetric_one(
-    input: &SymmetricInput,
-    h: Real,
-    flow: LaneFlow,
-) -> (Quat, Vec3) {
+pub(super) fn rotate_symmetric_one(input: &LaneInput, h: Real, flow: LaneFlow) -> (Quat, Vec3) {
     let (q, w) = symmetric_rotation::<f64>(input, h.widen(), flow);
     to_real(q, w)
-}
-
-/// The results of [`rotate_symmetric_lanes`], component by component (structure of arrays,
-/// already rounded to the engine precision): the kernel stores each component of a run of
-/// bodies with one vector store, and a reader that picks one body's scalars out of them is
-/// served by store forwarding (four scalar stores read back as one vector stall instead).
-#[derive(Debug, Clone, Copy)]
-pub(super) struct RotatedLanes {
-    /// New orientations: `rotation[k][i]` is component `k` (x, y, z, w) of body `i`.
-    pub rotation: [[Real; LANES]; 4],
-    /// New world angular velocities: `omega[k][i]` is component `k` of body `i`.
-    pub omega: [[Real; LANES]; 3],
-}
-
-impl RotatedLanes {
-    /// Body `i`'s new orientation and world angular velocity.
-    #[inline(always)]
-    pub(super) fn lane(&self, i: usize) -> (Quat, Vec3) {
-        let [qx, qy, qz, qw] = &self.rotation;
-        let [wx, wy, wz] = &self.omega;
-        (
-            Quat::from_xyzw(qx[i], qy[i], qz[i], qw[i]),
-            Vec3::new(wx[i], wy[i], wz[i]),
-        )
-    }
 }
 
 /// [`LANES`] bodies through the kernel at once (SIMD lanes), each over its own `h` (after the
@@ -654,10 +452,7 @@ fn rotate_symmetric_lanes_in<T: Lane, const KIND: u8>(
     weights: &'static [Real],
 ) -> RotatedLanes {
     let flow = flow_of::<KIND>(kicks, weights);
-    let mut out = RotatedLanes {
-        rotation: [[0.0; LANES]; 4],
-        omega: [[0.0; LANES]; 3],
-    };
+    let mut out = RotatedLanes::new();
     let mut start = 0;
     while start < LANES {
         rotate_run::<T>(cpu, inputs, &h, start, flow, &mut out);
@@ -666,11 +461,8 @@ fn rotate_symmetric_lanes_in<T: Lane, const KIND: u8>(
     out
 }
 
-/// The kernel on bodies `start .. start + T::WIDTH` of the batch. Plain indexing, no closures:
-/// inside a `#[target_feature]` function every helper must inline, and a closure is compiled
-/// without the feature (its intrinsics then become calls).
+/// The kernel on bodies `start .. start + T::WIDTH` of the batch.
 #[inline(always)]
-#[allow(clippy::needless_range_loop)]
 fn rotate_run<T: Lane>(
     cpu: T::Cpu,
     inputs: &LaneInputs,
@@ -679,39 +471,14 @@ fn rotate_run<T: Lane>(
     flow: LaneFlow,
     out: &mut RotatedLanes,
 ) {
-    let zero = T::splat(cpu, 0.0);
-    let mut input = SymmetricInput::<T> {
-        rotation: [zero; 4],
-        omega: [zero; 3],
-        frame: [zero; 4],
-        relabel: [zero; 4],
-        inertia: [zero; 3],
-        impulse: [zero; 3],
-    };
-    for k in 0..4 {
-        input.rotation[k] = T::load_real(cpu, &inputs.rotation[k][start..]);
-        input.frame[k] = T::load_real(cpu, &inputs.frame[k][start..]);
-        input.relabel[k] = T::load_real(cpu, &inputs.relabel[k][start..]);
-    }
-    for k in 0..3 {
-        input.omega[k] = T::load_real(cpu, &inputs.omega[k][start..]);
-        input.inertia[k] = T::load_real(cpu, &inputs.inertia[k][start..]);
-        if flow.kicks() {
-            input.impulse[k] = T::load_real(cpu, &inputs.impulse[k][start..]);
-        }
-    }
+    let input = inputs.load::<T>(cpu, start, true, flow.kicks(), false);
     let (q, w) = symmetric_rotation::<T>(&input, T::load_real(cpu, &h[start..]), flow);
-    // Rounded lane-wise, exactly as `to_real` rounds one body.
-    for k in 0..4 {
-        q[k].store_real(&mut out.rotation[k][start..]);
-    }
-    for k in 0..3 {
-        w[k].store_real(&mut out.omega[k][start..]);
-    }
+    out.store(start, q, w);
 }
 
 #[cfg(test)]
 mod tests {
+    use super::super::lane_input::fixtures::{SPANS, bits};
     use super::*;
     use crate::integrate::KernelPath;
     use crate::mass::Mass;
@@ -747,33 +514,14 @@ mod tests {
             3 => Vec3::new(0.4, 0.0, 0.0),
             _ => Vec3::new(0.05 * i as Real, -0.02, 0.01 * (i * i) as Real),
         });
-        let owned: [SymmetricInput; LANES] = std::array::from_fn(|i| {
+        let owned: [LaneInput; LANES] = std::array::from_fn(|i| {
             let (rotation, omega, mass) = bodies_in[i];
-            SymmetricInput::new(rotation, omega, &mass).with_impulse(impulses[i])
+            LaneInput::new(rotation, omega, &mass).with_impulse(impulses[i])
         });
-        let h = [
-            1.0 / 60.0,
-            0.1,
-            0.05,
-            1.0 / 240.0,
-            0.2,
-            1.0 / 60.0,
-            1.0 / 60.0,
-            0.01,
-        ];
+        let h = SPANS;
         let expected = |flow: LaneFlow| -> Vec<(Quat, Vec3)> {
             (0..LANES)
                 .map(|i| rotate_symmetric_one(&owned[i], h[i], flow))
-                .collect()
-        };
-        let bits = |r: &[(Quat, Vec3)]| -> Vec<u64> {
-            r.iter()
-                .flat_map(|(q, w)| {
-                    q.to_array()
-                        .into_iter()
-                        .chain(w.to_array())
-                        .map(|x| x.widen().to_bits())
-                })
                 .collect()
         };
         let mut inputs = LaneInputs::default();
@@ -847,11 +595,11 @@ mod tests {
             .unwrap();
         let rotation = Quat::from_rotation_y(1.1) * Quat::from_rotation_x(0.3);
         let (omega, impulse, h) = (Vec3::new(1.0, -2.0, 0.5), Vec3::new(0.3, 0.1, -0.2), 0.01);
-        let folded = SymmetricInput::new(rotation, omega, &mass).with_impulse(impulse);
+        let folded = LaneInput::new(rotation, omega, &mass).with_impulse(impulse);
         let (q_folded, w_folded) =
             rotate_symmetric_one(&folded, h, LaneFlow::Symmetric { kicks: true });
         let kicked = omega + mass.world_inv_inertia_mul(rotation, impulse);
-        let first = SymmetricInput::new(rotation, kicked, &mass);
+        let first = LaneInput::new(rotation, kicked, &mass);
         let (q_first, w_first) =
             rotate_symmetric_one(&first, h, LaneFlow::Symmetric { kicks: false });
         // ω ≈ 3 rad/s rounded once more on the second path: a few ulps of it.
