@@ -149,8 +149,6 @@ pub struct BenchResults {
     pub bytes_per_body_step: usize,
     /// All rows.
     pub rows: Vec<Row>,
-    /// ns per step of a one-body world through the ECS schedule, per integrator.
-    pub fixed_cost_ns: Vec<(String, f64)>,
     /// The cost of an unused feature.
     pub unused_feature: UnusedFeature,
     /// The runner's check of the world against the whole step (absent in runs from before it
@@ -255,14 +253,6 @@ pub fn run_bench(options: &BenchOptions, mut progress: impl FnMut(&str)) -> Benc
     ));
     let two_copy_ceiling = scaling::two_copy_ceiling(half, effort.steps(half), effort.repetitions);
     let rows = free_body_rows(&sizes, options.rapier_max_bodies, &effort, &mut progress);
-    let fixed_cost_ns = INTEGRATORS
-        .iter()
-        .filter_map(|i| {
-            rows.iter()
-                .find(|r| r.bodies == 1 && r.integrator == i.name())
-                .map(|r| (i.name().to_owned(), r.ecs_1t))
-        })
-        .collect();
     progress("unused feature: no gravity vs zero gravity");
     let unused_feature = unused_gravity(sizes.last().copied().unwrap_or(1).min(10_000), &effort);
     let check_bodies = max.min(100_000);
@@ -305,7 +295,6 @@ pub fn run_bench(options: &BenchOptions, mut progress: impl FnMut(&str)) -> Benc
         kernel_flops: KernelFlops::counted(),
         bytes_per_body_step: bytes_per_body_step(),
         rows,
-        fixed_cost_ns,
         unused_feature,
         runner_check,
         springs,
@@ -313,10 +302,9 @@ pub fn run_bench(options: &BenchOptions, mut progress: impl FnMut(&str)) -> Benc
         rollback,
         csv,
         quick: options.quick,
-        seconds: f64::NAN,
+        seconds: started.elapsed().map_or(f64::NAN, |d| d.as_secs_f64()),
         targets: Vec::new(),
     };
-    results.seconds = started.elapsed().map_or(f64::NAN, |d| d.as_secs_f64());
     results.targets = targets::evaluate(&results);
     results
 }

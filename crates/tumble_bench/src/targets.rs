@@ -141,6 +141,7 @@ pub const TARGETS: &[TargetSpec] = {
             },
             20.0,
         ),
+        // Each entry's bound is its own, from METHOD_BOUNDS.
         at_most(MethodBounds { bodies: 1_000 }, f64::NAN),
         at_most(MethodBounds { bodies: 100_000 }, f64::NAN),
         at_most(EcsOverRaw { threads: 1 }, 1.15),

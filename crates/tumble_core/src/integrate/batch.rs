@@ -211,25 +211,24 @@ fn batched(
     pending.flush(bodies);
 }
 
-/// What a queued batch does with a body it has read (see [`queued`]).
+/// Where a queued batch puts a body once `route` has advanced what runs first (see
+/// [`queued`]).
 enum Route {
-    /// Step it whole by the single-body step.
-    Alone,
     /// It is stepped and ready to commit.
     Done,
     /// Queue its rotation under this load (see [`QueuedLanes::set`]).
     Queue(Vec3),
 }
 
-/// The loop of a batch whose rotations run in lanes: reads each body, steps it alone where the
-/// exact switch applies to it, else lets `route` advance what runs first and say where the body
-/// goes; queued rotations are flushed eight (`LANES`) at a time.
+/// The loop of a batch whose rotations run in lanes: reads each body, steps it by `exact` where
+/// the exact switch applies to it (judged once), else lets `route` advance what runs first and
+/// say where the body goes; queued rotations are flushed eight (`LANES`) at a time.
 #[inline(always)]
 fn queued<L: QueuedLanes>(
     mut pending: PendingRotations<L>,
     bodies: &mut impl BodyBatch,
     switch: Option<ExactSwitch>,
-    mut alone: impl FnMut(&mut BodyState, &MassProperties, &Wrench, Real),
+    mut exact: impl FnMut(ExactSwitch, &mut BodyState, &MassProperties, &Wrench),
     mut route: impl FnMut(&mut BodyState, &MassProperties, &Wrench) -> Route,
 ) {
     let mut next = BodyState::ZEROED;
@@ -239,18 +238,15 @@ fn queued<L: QueuedLanes>(
             continue;
         };
         let mass = bodies.mass(i);
-        let turn = bodies.spring_turn_rate(i);
-        let route = if switch.is_some_and(|switch| switch.applies_turned(&next, mass, turn)) {
-            Route::Alone
-        } else {
-            route(&mut next, mass, &wrench)
-        };
-        match route {
-            Route::Alone => {
-                let mut single = next;
-                alone(&mut single, mass, &wrench, turn);
-                commit(bodies, i, &single);
-            }
+        if let Some(switch) = switch
+            && switch.applies_turned(&next, mass, bodies.spring_turn_rate(i))
+        {
+            let mut single = next;
+            exact(switch, &mut single, mass, &wrench);
+            commit(bodies, i, &single);
+            continue;
+        }
+        match route(&mut next, mass, &wrench) {
             Route::Done => commit(bodies, i, &next),
             Route::Queue(load) => {
                 if pending.queue(i, &next, mass, load) {
@@ -265,7 +261,7 @@ fn queued<L: QueuedLanes>(
 /// The batch of whole composed steps (`yoshida4`): a body without torque takes the exact
 /// translation over `dt` and its stages' free rotations in sequence, queued for the SIMD kernel
 /// (as [`Integrator::step`] does alone); a spherical body turns exactly; a body under a torque
-/// is stepped whole by `alone`, stage by stage.
+/// is stepped whole by `own` (the method's single-body step), stage by stage.
 #[inline(always)]
 fn composed(
     kernel: Kernel,
@@ -273,14 +269,21 @@ fn composed(
     bodies: &mut impl BodyBatch,
     dt: Real,
     switch: Option<ExactSwitch>,
-    alone: impl FnMut(&mut BodyState, &MassProperties, &Wrench, Real),
+    mut own: impl FnMut(&mut BodyState, &MassProperties, &Wrench),
 ) {
     let flow = LaneFlow::Composed(weights);
     let inputs = LaneInputs::default();
     let pending = PendingRotations::new(dt, kernel, SymmetricQueue { inputs, flow });
-    queued(pending, bodies, switch, alone, |next, mass, wrench| {
+    let exact = |switch: ExactSwitch, s: &mut BodyState, m: &MassProperties, w: &Wrench| {
+        switch.exact().step(s, m, w, dt);
+    };
+    queued(pending, bodies, switch, exact, |next, mass, wrench| {
         if wrench.torque != Vec3::ZERO {
-            return Route::Alone;
+            // A copy, so that `next` never escapes into the (not inlined) scalar step.
+            let mut single = *next;
+            own(&mut single, mass, wrench);
+            *next = single;
+            return Route::Done;
         }
         drift_kick_drift_translation(StepPhase::Whole, next, mass, wrench, dt);
         if mass.is_spherical() {
@@ -292,21 +295,24 @@ fn composed(
     });
 }
 
-/// The kick–drift batch (`symplectic-euler*`, `lclamp`, `implicit-gyroscopic`): each body's
-/// translation, then its rotation under its torque, queued for the SIMD kernel
-/// ([`PendingRotations`]).
+/// The kick–drift batch (`symplectic-euler*`, `lclamp`, `implicit-gyroscopic`) of `phase`
+/// (`Whole` or `Finish`, the same step): each body's translation, then its rotation under its
+/// torque, queued for the SIMD kernel ([`PendingRotations`]).
 #[inline(always)]
 fn kick_drifted(
     kernel: Kernel,
     method: KickDrift,
+    phase: StepPhase,
     bodies: &mut impl BodyBatch,
     h: Real,
     switch: Option<ExactSwitch>,
-    alone: impl FnMut(&mut BodyState, &MassProperties, &Wrench, Real),
 ) {
     let inputs = LaneInputs::default();
     let pending = PendingRotations::new(h, kernel, KickDriftQueue { inputs, method });
-    queued(pending, bodies, switch, alone, |next, mass, wrench| {
+    let exact = |switch: ExactSwitch, s: &mut BodyState, m: &MassProperties, w: &Wrench| {
+        switch.exact().stage(phase, s, m, w, h);
+    };
+    queued(pending, bodies, switch, exact, |next, mass, wrench| {
         kick_drift_translation(next, mass, wrench.force, h);
         Route::Queue(wrench.torque)
     });
@@ -453,11 +459,7 @@ impl Integrator {
         h: Real,
         switch: Option<ExactSwitch>,
     ) {
-        let kernel = if self.batches_in_lanes() {
-            Kernel::selected()
-        } else {
-            Kernel::Portable
-        };
+        let kernel = self.lane_kernel();
         self.stage_batch_on(kernel, phase, bodies, h, switch);
     }
 
@@ -488,7 +490,7 @@ impl Integrator {
             // The kick–drift methods do nothing before the forces (see `begin_stage`).
             return match phase {
                 StepPhase::Begin => each_alone(bodies, alone),
-                _ => kick_drifted(kernel, method, bodies, h, switch, alone),
+                _ => kick_drifted(kernel, method, phase, bodies, h, switch),
             };
         }
         // One loop per phase, each with its phase a constant, as if written out three times.
@@ -519,11 +521,7 @@ impl Integrator {
         dt: Real,
         switch: Option<ExactSwitch>,
     ) {
-        let kernel = if self.batches_in_lanes() {
-            Kernel::selected()
-        } else {
-            Kernel::Portable
-        };
+        let kernel = self.lane_kernel();
         self.step_batch_on(kernel, bodies, dt, switch);
     }
 
@@ -548,7 +546,8 @@ impl Integrator {
             return paired(StepPhase::Whole, bodies, dt, alone);
         }
         if self.rotates_on_symmetric_kernel() {
-            return composed(kernel, self.composition(), bodies, dt, switch, alone);
+            let own = |s: &mut BodyState, m: &MassProperties, w: &Wrench| self.step(s, m, w, dt);
+            return composed(kernel, self.composition(), bodies, dt, switch, own);
         }
         each_alone(bodies, alone);
     }

@@ -234,14 +234,19 @@ pub struct ExactSwitch {
 /// rounding of `|ω|²` and `ω_turn²`.
 const TURN_BOUND: Real = (1.0 / 6.8683) / (1.0 + 1e-3);
 
-/// False when the body's springs turn it fast enough that the switch cannot apply to it, one
-/// `|ω|²` against `ω_turn²` ([`TURN_BOUND`]): the second cheap test of
-/// [`ExactSwitch::applies_turned`], which spares a swinging chain link the full judgement.
+/// `|ω|²` of the body, the one number both cheap tests of the switch read.
 #[inline(always)]
-fn spins_past_turn_bound(state: &BodyState, turn_rate: Real) -> bool {
+fn rate_squared(state: &BodyState) -> Real {
     let w = state.angular_velocity;
     // A fixed order of operations: the same bits on every path.
-    let w2 = w.x * w.x + w.y * w.y + w.z * w.z;
+    w.x * w.x + w.y * w.y + w.z * w.z
+}
+
+/// False when the body's springs turn it fast enough that the switch cannot apply to it
+/// (`w2 = |ω|²` against `ω_turn²`, [`TURN_BOUND`]): the second cheap test of
+/// [`ExactSwitch::applies_turned`], which spares a swinging chain link the full judgement.
+#[inline(always)]
+fn spins_past_turn_bound(w2: Real, turn_rate: Real) -> bool {
     w2 > TURN_BOUND * (turn_rate * turn_rate)
 }
 
@@ -303,7 +308,7 @@ impl ExactSwitch {
         // A copy: a reference would escape into the cold call and keep the caller's state out
         // of registers on the hot path. A NaN rate fails the quick bound: the method's own step
         // takes it and reports it.
-        self.spins_past_quick_bound(state) && self.exceeds(*state, mass)
+        self.spins_past_quick_bound(rate_squared(state)) && self.exceeds(*state, mass)
     }
 
     /// [`applies`](Self::applies) for a body its springs can turn at up to `turn_rate` (rad/s;
@@ -324,8 +329,9 @@ impl ExactSwitch {
         if turn_rate == 0.0 {
             return self.applies(state, mass);
         }
-        self.spins_past_quick_bound(state)
-            && spins_past_turn_bound(state, turn_rate)
+        let w2 = rate_squared(state);
+        self.spins_past_quick_bound(w2)
+            && spins_past_turn_bound(w2, turn_rate)
             && self.exceeds_turned(*state, mass, turn_rate)
     }
 
@@ -341,13 +347,10 @@ impl ExactSwitch {
     }
 
     /// False when the body spins too slowly for the switch to apply to it whatever its inertia
-    /// and springs: the first, cheap test of [`applies`](Self::applies) and
-    /// [`applies_turned`](Self::applies_turned), one `|ω|²`.
+    /// and springs (`w2 = |ω|²`): the first, cheap test of [`applies`](Self::applies) and
+    /// [`applies_turned`](Self::applies_turned).
     #[inline(always)]
-    fn spins_past_quick_bound(&self, state: &BodyState) -> bool {
-        let w = state.angular_velocity;
-        // A fixed order of operations: the same bits on every path.
-        let w2 = w.x * w.x + w.y * w.y + w.z * w.z;
+    fn spins_past_quick_bound(&self, w2: Real) -> bool {
         w2 > self.quick
     }
 
@@ -437,7 +440,7 @@ mod tests {
                         angular_velocity: axis * quick,
                         ..BodyState::default()
                     };
-                    if !switch.spins_past_quick_bound(&state) {
+                    if !switch.spins_past_quick_bound(rate_squared(&state)) {
                         let measure = switch.measure(&state, &mass);
                         assert!(measure <= switch.limit(), "{measure} at {state:?}");
                     }
@@ -447,7 +450,7 @@ mod tests {
                         angular_velocity: axis * rate as Real,
                         ..state
                     };
-                    if !spins_past_turn_bound(&state, turn) {
+                    if !spins_past_turn_bound(rate_squared(&state), turn) {
                         let (_, e_orbit, omega) = switch.judge(&state, &mass);
                         let springs = turn.widen().powi(3) * switch.span * switch.span / 24.0;
                         assert!(e_orbit * omega.length() <= springs, "{state:?}");

@@ -224,8 +224,9 @@ impl Integrator {
         }
     }
 
-    /// True when the method's free rotation is `splitting`'s symmetric-top flow, which the
-    /// batched step runs in SIMD lanes (`splitting`, and `yoshida4`, a composition of it).
+    /// True when the batched step runs the method's free rotation on the lane kernel of
+    /// `symmetric_kernel` (`splitting`, `splitting-xyz`, `rk4`, and `yoshida4`, a composition
+    /// of `splitting`): see [`lane_flow`](Self::lane_flow).
     fn rotates_on_symmetric_kernel(self) -> bool {
         self.lane_flow().is_some()
     }
@@ -243,11 +244,16 @@ impl Integrator {
         }
     }
 
-    /// True when the batched step rotates the method's bodies in SIMD lanes on the
-    /// [`kernel_path`]: `splitting` and `yoshida4` (the symmetric-top kernel) and the four
-    /// kick–drift methods (their own kernel).
-    fn batches_in_lanes(self) -> bool {
-        self.rotates_on_symmetric_kernel() || kick_drift_kernel::KickDrift::of(self).is_some()
+    /// The SIMD path the batched step rotates the method's bodies on: the
+    /// [`kernel_path`] for every method with a lane kernel (the free-flow kernel of
+    /// `symmetric_kernel`, or the four kick–drift methods' own), the portable one (unused) for
+    /// `exact` and `exact4`, which need none.
+    fn lane_kernel(self) -> crate::simd::Kernel {
+        if self.rotates_on_symmetric_kernel() || KickDrift::of(self).is_some() {
+            crate::simd::Kernel::selected()
+        } else {
+            crate::simd::Kernel::Portable
+        }
     }
 
     /// The free rotation of a drift–kick–drift method, after the kick's angular impulse:

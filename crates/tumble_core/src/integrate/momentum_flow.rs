@@ -33,14 +33,8 @@ pub(crate) fn free_turn(
     };
     match integrator {
         Integrator::Splitting | Integrator::Yoshida4 => symmetric_free_flow(&mut body, r, odd, h),
-        Integrator::SplittingXyz | Integrator::Rk4 => {
-            let flow = match integrator {
-                Integrator::Rk4 => LaneFlow::Rk4 { kicks: false },
-                _ => LaneFlow::Xyz { kicks: false },
-            };
-            let [x, y, z, w] = turn_from_momentum(flow, m.to_array(), r.to_array(), h);
-            body.q = DQuat::from_xyzw(x, y, z, w);
-        }
+        Integrator::SplittingXyz => body.q = lane_turn(LaneFlow::Xyz { kicks: false }, m, r, h),
+        Integrator::Rk4 => body.q = lane_turn(LaneFlow::Rk4 { kicks: false }, m, r, h),
         Integrator::Exact | Integrator::Exact4 => exact_free_flow(&mut body, r, h),
         Integrator::SymplecticEuler
         | Integrator::SymplecticEulerLinear
@@ -48,6 +42,11 @@ pub(crate) fn free_turn(
         | Integrator::ImplicitGyroscopic => return None,
     }
     Some(body.q.normalize())
+}
+
+/// The turn of a lane flow that does not relabel ([`turn_from_momentum`]).
+fn lane_turn(flow: LaneFlow, m: DVec3, r: DVec3, h: f64) -> DQuat {
+    DQuat::from_array(turn_from_momentum(flow, m.to_array(), r.to_array(), h))
 }
 
 #[cfg(test)]

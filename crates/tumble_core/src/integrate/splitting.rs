@@ -115,32 +115,11 @@ pub(super) type FreeFlow = fn(&mut FreeBody, DVec3, f64);
 pub(super) type Rotation = fn(&mut BodyState, &MassProperties, Real, Vec3);
 
 /// The free rotation `flow` over `h` on the lane kernel of the module `symmetric_kernel` (the
-/// same code the batched step runs, so one body gets the same bits alone or in a batch);
-/// spherical bodies turn exactly about `ω` (`ω ∥ L` for them).
-#[inline]
-pub(super) fn rotate_on_kernel(
-    state: &mut BodyState,
-    mass: &MassProperties,
-    h: Real,
-    flow: LaneFlow,
-) {
-    if mass.is_spherical() {
-        state.rotation = rotate_exact(state.rotation, state.angular_velocity, h);
-        return;
-    }
-    let flow = flow.with_kick(false);
-    let input = LaneInput::for_flow(
-        state.rotation,
-        state.angular_velocity,
-        mass,
-        flow.relabels(),
-    );
-    (state.rotation, state.angular_velocity) = rotate_symmetric_one(&input, h, flow);
-}
-
-/// [`rotate_on_kernel`] after the kick `L += J` of the angular impulse `impulse` (world frame):
-/// the kernel folds `J` into the body momentum (see `symmetric_kernel`); a spherical body takes
-/// it as `ω += I⁻¹ J` first, as every other method does.
+/// same code the batched step runs, so one body gets the same bits alone or in a batch), after
+/// the kick `L += J` of the angular impulse `impulse` (world frame): the kernel folds `J` into
+/// the body momentum (see `symmetric_kernel`), and without an impulse runs the flow unkicked. A
+/// spherical body takes the kick as `ω += I⁻¹ J`, as every other method does, and turns exactly
+/// about `ω` (`ω ∥ L` for it).
 #[inline]
 pub(super) fn rotate_kicked_on_kernel(
     state: &mut BodyState,
@@ -149,13 +128,12 @@ pub(super) fn rotate_kicked_on_kernel(
     impulse: Vec3,
     flow: LaneFlow,
 ) {
-    if mass.is_spherical() || impulse == Vec3::ZERO {
-        // No impulse: the kernel's kicked flow would give the unkicked bits anyway.
+    if mass.is_spherical() {
         kick_angular(state, mass, impulse);
-        rotate_on_kernel(state, mass, h, flow);
+        state.rotation = rotate_exact(state.rotation, state.angular_velocity, h);
         return;
     }
-    let flow = flow.with_kick(true);
+    let flow = flow.with_kick(impulse != Vec3::ZERO);
     let input = LaneInput::for_flow(
         state.rotation,
         state.angular_velocity,
