@@ -9,10 +9,13 @@ use tumble_ecs::components::kinetic_energy_f64;
 use tumble_ecs::prelude::*;
 use tumble_scene::text::terminal_safe;
 
+/// The kinds of force generator a scene spawns, as [`Names`] calls them.
+const FORCE_KINDS: [&str; 3] = ["spring", "constant force", "torque"];
+
 /// Names of a built scene's entities: bodies by their `name`, force generators as
 /// `forces[i] (kind)` in file order.
 ///
-/// Compact for a million bodies (about 20 bytes a body, 24 a force): the names are kept in one
+/// Compact for a million bodies (about 20 bytes a body, 12 a force): the names are kept in one
 /// string and looked up by a binary search over the entities, and a message (a force's name
 /// too) is formatted only when one is printed.
 pub(crate) struct Names {
@@ -20,9 +23,9 @@ pub(crate) struct Names {
     bodies: Vec<(Entity, u32, u32)>,
     /// Every body name, one after the other.
     text: String,
-    /// `(entity, index in the file, kind)` of each force generator, sorted by entity; its
-    /// name is formatted when printed.
-    forces: Vec<(Entity, usize, &'static str)>,
+    /// Each force generator and its kind (an index into [`FORCE_KINDS`]), in file order: by
+    /// entity index. Its name is formatted when printed.
+    forces: Vec<(Entity, u8)>,
 }
 
 impl Names {
@@ -45,23 +48,17 @@ impl Names {
             spans.push((*e, start, end));
         }
         spans.sort_unstable_by_key(|&(e, _, _)| e);
-        let mut forces: Vec<(Entity, &'static str)> = world
+        let mut forces: Vec<(Entity, u8)> = world
             .query::<(Entity, Has<Spring>, Has<ConstantForce>, Has<ConstantTorque>)>()
             .iter(world)
             .filter_map(|(e, spring, force, torque)| match (spring, force, torque) {
-                (true, _, _) => Some((e, "spring")),
-                (_, true, _) => Some((e, "constant force")),
-                (_, _, true) => Some((e, "torque")),
+                (true, _, _) => Some((e, 0)),
+                (_, true, _) => Some((e, 1)),
+                (_, _, true) => Some((e, 2)),
                 _ => None,
             })
             .collect();
-        forces.sort_by_key(|(e, _)| e.index());
-        let mut forces: Vec<(Entity, usize, &'static str)> = forces
-            .into_iter()
-            .enumerate()
-            .map(|(i, (e, kind))| (e, i, kind))
-            .collect();
-        forces.sort_unstable_by_key(|&(e, _, _)| e);
+        forces.sort_unstable_by_key(|(e, _)| e.index());
         Self {
             bodies: spans,
             text,
@@ -78,11 +75,15 @@ impl Names {
                 terminal_safe(&self.text[start as usize..end as usize])
             );
         }
-        match self.forces.binary_search_by_key(&entity, |&(e, _, _)| e) {
-            Ok(i) => {
-                let (_, index, kind) = self.forces[i];
+        match self
+            .forces
+            .binary_search_by_key(&entity.index(), |(e, _)| e.index())
+        {
+            Ok(index) if self.forces[index].0 == entity => {
+                let kind = FORCE_KINDS[usize::from(self.forces[index].1)];
                 format!("forces[{index}] ({kind})")
             }
+            Ok(_) => format!("entity {entity}"),
             Err(_) => format!("entity {entity}"),
         }
     }

@@ -6,11 +6,13 @@ use tumble_core::math::{Real, Vec3};
 use bevy_ecs::prelude::*;
 
 use tumble_core::{Integrator, MassProperties};
+use tumble_ecs::components::SpringTurn;
 use tumble_ecs::prelude::*;
 
 use crate::error::{SaveError, SceneError};
 use crate::format::{SceneFile, WorldDef};
 use crate::json::JsonSource;
+use crate::spawn::{BodyKind, BodySpawn, batch, spawn_bodies};
 use crate::text::terminal_safe;
 use crate::validate::{Checker, Locate, NoText, TomlText};
 
@@ -336,12 +338,25 @@ impl Scene {
     pub fn build(&self) -> BuiltScene {
         let mut world = self.world_for_bodies();
         let loaded = self.loaded_bodies();
-        let bodies = self
-            .valid_bodies()
-            .zip(&self.file.bodies)
-            .zip(&loaded)
-            .map(|((body, def), &loaded)| (def.name.clone(), spawn_body(&mut world, &body, loaded)))
-            .collect();
+        let turns = self.spring_turns();
+        let kinds = self.body_kinds(&loaded, &turns);
+        let mut bodies: Vec<(String, Entity)> = Vec::with_capacity(kinds.len());
+        let mut valid = self.valid_bodies().zip(&self.file.bodies).enumerate();
+        for (start, len) in runs(&kinds) {
+            let run = (&mut valid).take(len).map(|(i, (body, def))| {
+                bodies.push((def.name.clone(), Entity::PLACEHOLDER));
+                BodySpawn {
+                    body,
+                    loaded: loaded[i],
+                    turn: turns.get(i).copied().flatten(),
+                }
+            });
+            let mut spawned = Vec::with_capacity(len);
+            spawn_bodies(&mut world, kinds[start], ExactLen(run, len), |e| {
+                spawned.push(e)
+            });
+            fill_entities(&mut bodies[start..], spawned);
+        }
         self.finish_build(world, bodies)
     }
 
@@ -351,6 +366,8 @@ impl Scene {
     pub fn into_built(mut self) -> BuiltScene {
         let mut world = self.world_for_bodies();
         let loaded = self.loaded_bodies();
+        let turns = self.spring_turns();
+        let kinds = self.body_kinds(&loaded, &turns);
         // The forces' file model (names as strings) is not needed once checked: `self.forces`
         // holds them by index. Dropped before the world grows.
         drop(std::mem::take(&mut self.file.forces));
@@ -360,15 +377,25 @@ impl Scene {
         // its pages back (a large allocation is shrunk in place).
         defs.reverse();
         let release_every = (n / 8).max(1 << 16);
-        let mut bodies = Vec::with_capacity(n);
-        let mut i = 0;
-        while let Some(def) = defs.pop() {
-            let body = checked_body(&self.file.name, i, &def);
-            bodies.push((def.name, spawn_body(&mut world, &body, loaded[i])));
-            i += 1;
-            if i % release_every == 0 {
-                defs.shrink_to_fit();
-            }
+        let file = &self.file.name;
+        let mut bodies: Vec<(String, Entity)> = Vec::with_capacity(n);
+        for (start, len) in runs(&kinds) {
+            let run = (start..start + len).map(|i| {
+                let def = defs.pop().expect("one definition per body");
+                let body = checked_body(file, i, &def);
+                bodies.push((def.name, Entity::PLACEHOLDER));
+                if (i + 1) % release_every == 0 {
+                    defs.shrink_to_fit();
+                }
+                BodySpawn {
+                    body,
+                    loaded: loaded[i],
+                    turn: turns.get(i).copied().flatten(),
+                }
+            });
+            let mut spawned = Vec::with_capacity(len);
+            spawn_bodies(&mut world, kinds[start], run, |e| spawned.push(e));
+            fill_entities(&mut bodies[start..], spawned);
         }
         drop(defs);
         self.finish_build(world, bodies)
@@ -396,6 +423,38 @@ impl Scene {
         loaded
     }
 
+    /// Per body, the optional components it is spawned with (see [`crate::spawn`]).
+    fn body_kinds(&self, loaded: &[bool], turns: &[Option<SpringTurn>]) -> Vec<BodyKind> {
+        self.valid_bodies()
+            .enumerate()
+            .map(|(i, b)| BodyKind::of(&b, loaded[i], turns.get(i).copied().flatten()))
+            .collect()
+    }
+
+    /// Per body, the [`SpringTurn`] the spring classification will put on it (see
+    /// [`Extras`]); empty when the scene has no springs.
+    fn spring_turns(&self) -> Vec<Option<SpringTurn>> {
+        let springs = self.forces.iter().filter_map(|f| match *f {
+            SceneForce::Spring {
+                a,
+                anchor_a,
+                b,
+                anchor_b,
+                k,
+                ..
+            } => Some([(Some(a), anchor_a, k), (b, anchor_b, k)]),
+            _ => None,
+        });
+        if springs.clone().next().is_none() {
+            return Vec::new();
+        }
+        let masses: Vec<MassProps> = self.valid_bodies().map(|b| MassProps(b.mass)).collect();
+        let ends = springs
+            .flatten()
+            .filter_map(|(body, anchor, k)| Some((body?, anchor, k)));
+        tumble_ecs::springs::spring_turns(&masses, ends)
+    }
+
     /// A world with the scene's resources, ready for its bodies.
     fn world_for_bodies(&self) -> World {
         let mut world = World::new();
@@ -409,45 +468,59 @@ impl Scene {
     /// Spawns the force generators between the spawned `bodies` and plans the schedule.
     fn finish_build(&self, mut world: World, bodies: Vec<(String, Entity)>) -> BuiltScene {
         let entity = |i: usize| bodies[i].1;
-        for f in &self.forces {
-            match *f {
-                SceneForce::Constant { body, force, point } => {
-                    world.spawn(ConstantForce {
-                        body: entity(body),
-                        force,
-                        local_point: point,
-                    });
+        let constant = |f: &SceneForce| match *f {
+            SceneForce::Constant { body, force, point } => Some(ConstantForce {
+                body: entity(body),
+                force,
+                local_point: point,
+            }),
+            _ => None,
+        };
+        let torque = |f: &SceneForce| match *f {
+            SceneForce::Torque { body, torque } => Some(ConstantTorque {
+                body: entity(body),
+                torque,
+            }),
+            _ => None,
+        };
+        let spring = |f: &SceneForce| match *f {
+            SceneForce::Spring {
+                a,
+                anchor_a,
+                b,
+                anchor_b,
+                k,
+                c,
+                rest,
+            } => Some(Spring {
+                a: entity(a),
+                anchor_a,
+                b: match b {
+                    Some(b) => SpringEnd::Body {
+                        body: entity(b),
+                        anchor: anchor_b,
+                    },
+                    None => SpringEnd::World(anchor_b),
+                },
+                stiffness: k,
+                damping: c,
+                rest_length: rest,
+            }),
+            _ => None,
+        };
+        let kinds: Vec<_> = self.forces.iter().map(std::mem::discriminant).collect();
+        const ONE_KIND: &str = "a run holds one kind of force";
+        for (start, len) in runs(&kinds) {
+            let run = self.forces[start..start + len].iter();
+            match self.forces[start] {
+                SceneForce::Constant { .. } => {
+                    batch(&mut world, run.map(|f| constant(f).expect(ONE_KIND)), drop);
                 }
-                SceneForce::Torque { body, torque } => {
-                    world.spawn(ConstantTorque {
-                        body: entity(body),
-                        torque,
-                    });
+                SceneForce::Torque { .. } => {
+                    batch(&mut world, run.map(|f| torque(f).expect(ONE_KIND)), drop);
                 }
-                SceneForce::Spring {
-                    a,
-                    anchor_a,
-                    b,
-                    anchor_b,
-                    k,
-                    c,
-                    rest,
-                } => {
-                    let end = match b {
-                        Some(b) => SpringEnd::Body {
-                            body: entity(b),
-                            anchor: anchor_b,
-                        },
-                        None => SpringEnd::World(anchor_b),
-                    };
-                    world.spawn(Spring {
-                        a: entity(a),
-                        anchor_a,
-                        b: end,
-                        stiffness: k,
-                        damping: c,
-                        rest_length: rest,
-                    });
+                SceneForce::Spring { .. } => {
+                    batch(&mut world, run.map(|f| spring(f).expect(ONE_KIND)), drop);
                 }
             }
         }
@@ -460,21 +533,41 @@ impl Scene {
     }
 }
 
-/// Spawns one body with only the components it needs: a [`ForceAccumulator`] only when a force
-/// generator will name it (`loaded`).
-fn spawn_body(world: &mut World, b: &ValidBody, loaded: bool) -> Entity {
-    let mut e = world.spawn((RigidBody, MassProps(b.mass), b.transform, b.velocity));
-    if loaded {
-        e.insert(ForceAccumulator::default());
-    }
-    if b.gravity_scale != 1.0 {
-        e.insert(GravityScale(b.gravity_scale));
-    }
-    if b.damping != Damping::default() {
-        e.insert(b.damping);
-    }
-    e.id()
+/// The runs of equal consecutive values of `kinds`, as `(start, length)`.
+fn runs<K: PartialEq>(kinds: &[K]) -> impl Iterator<Item = (usize, usize)> + '_ {
+    let mut start = 0;
+    std::iter::from_fn(move || {
+        let first = kinds.get(start)?;
+        let len = kinds[start..].iter().take_while(|k| *k == first).count();
+        start += len;
+        Some((start - len, len))
+    })
 }
+
+/// Writes the entities of a run, spawned in order, beside the names pushed for it.
+fn fill_entities(bodies: &mut [(String, Entity)], spawned: Vec<Entity>) {
+    debug_assert!(spawned.len() <= bodies.len());
+    for (slot, entity) in bodies.iter_mut().zip(spawned) {
+        slot.1 = entity;
+    }
+}
+
+/// An iterator whose length is known (`len` items) but whose adapters do not say so.
+struct ExactLen<I>(I, usize);
+
+impl<I: Iterator> Iterator for ExactLen<I> {
+    type Item = I::Item;
+    fn next(&mut self) -> Option<I::Item> {
+        let item = self.0.next()?;
+        self.1 = self.1.saturating_sub(1);
+        Some(item)
+    }
+    fn size_hint(&self) -> (usize, Option<usize>) {
+        (self.1, Some(self.1))
+    }
+}
+
+impl<I: Iterator> ExactSizeIterator for ExactLen<I> {}
 
 impl BuiltScene {
     /// Advances the world by one step (the schedule once per stage, re-planned first if the

@@ -21,6 +21,7 @@ mod json;
 mod json_locate;
 pub mod many;
 pub mod output;
+mod spawn;
 pub mod text;
 mod tool;
 mod trajectory;

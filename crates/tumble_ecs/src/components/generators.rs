@@ -280,6 +280,13 @@ pub(crate) fn generator_inserted<G: Generator>(mut world: DeferredWorld, ctx: Ho
     };
     let result = check_inserted(&g, |body| world.get_entity(body).is_ok());
     let rejected = world.get::<RejectedGenerator>(entity).is_some();
+    // Queued only where needed: a world spawned with its accumulators (a scene's, a million
+    // generators at once) would otherwise queue a command per end.
+    let lacks_accumulator = g.bodies().any(|(_, body)| {
+        world
+            .get_entity(body)
+            .is_ok_and(|e| !e.contains::<ForceAccumulator>())
+    });
     let mut commands = world.commands();
     match result {
         Err(kind) => {
@@ -294,7 +301,9 @@ pub(crate) fn generator_inserted<G: Generator>(mut world: DeferredWorld, ctx: Ho
             if rejected {
                 commands.entity(entity).remove::<RejectedGenerator>();
             }
-            crate::components::ensure_accumulators(&mut commands, g.bodies().map(|(_, b)| b));
+            if lacks_accumulator {
+                crate::components::ensure_accumulators(&mut commands, g.bodies().map(|(_, b)| b));
+            }
         }
     }
 }

@@ -211,6 +211,11 @@ impl SpringPush {
     }
 }
 
+/// Springs whose pushes [`apply_springs`] computes on the pool at once, then adds in order: the
+/// buffer stays a few megabytes however many springs there are, and a block is long enough
+/// that handing it out costs little beside its work.
+const PUSH_BLOCK: usize = 1 << 15;
+
 /// The springs' pushes of one run of [`apply_springs`] on the compute pool, kept between steps
 /// so that a step does not allocate.
 #[derive(Debug, Default)]
@@ -221,7 +226,7 @@ pub struct SpringPushes(Vec<SpringPush>);
 ///
 /// With [`Parallelism`] and enough springs, the pushes are computed on the compute pool's
 /// threads (each spring reads only its two bodies) into a buffer kept between steps, then added
-/// to the accumulators on this thread in spring order: a spring system writes to bodies in any
+/// to the accumulators on this thread in spring order, a block of springs at a time: a spring system writes to bodies in any
 /// order, and this keeps the threads busy without letting two of them add to one accumulator.
 /// The sums are the same bits for any thread count.
 pub fn apply_springs(
@@ -246,25 +251,24 @@ pub fn apply_springs(
         return;
     }
     let pushes = &mut pushes.0;
-    pushes.clear();
-    pushes.resize(count, SpringPush::Nothing);
-    let mut rest = pushes.as_mut_slice();
-    let shared = &targets;
     for table in dense(springs.contiguous_iter()) {
-        let (out, tail) = rest.split_at_mut(table.len());
-        rest = tail;
-        let per = table.len().div_ceil(threads).max(1);
-        scope(|spawn| {
-            for (springs, out) in table.chunks(per).zip(out.chunks_mut(per)) {
-                spawn(Box::new(move || {
-                    for (spring, push) in springs.iter().zip(out) {
-                        *push = SpringPush::of(spring, shared);
-                    }
-                }));
+        for block in table.chunks(PUSH_BLOCK) {
+            pushes.clear();
+            pushes.resize(block.len(), SpringPush::Nothing);
+            let per = block.len().div_ceil(threads).max(1);
+            let shared = &targets;
+            scope(|spawn| {
+                for (springs, out) in block.chunks(per).zip(pushes.chunks_mut(per)) {
+                    spawn(Box::new(move || {
+                        for (spring, push) in springs.iter().zip(out) {
+                            *push = SpringPush::of(spring, shared);
+                        }
+                    }));
+                }
+            });
+            for (spring, push) in block.iter().zip(pushes.iter()) {
+                push.apply(spring, &mut targets);
             }
-        });
-    }
-    for (spring, push) in springs.iter().zip(pushes.iter()) {
-        push.apply(spring, &mut targets);
+        }
     }
 }

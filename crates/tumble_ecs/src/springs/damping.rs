@@ -4,8 +4,8 @@ use bevy_ecs::prelude::*;
 use tumble_core::damping::decrement;
 use tumble_core::math::{Real, Vec3};
 
-use crate::components::Rejected;
 use crate::components::{Kinematic, MassProps, PhysicsSettings, Pose, RigidBody, Static, Velocity};
+use crate::components::{Rejected, dense};
 use crate::components::{Spring, SpringEnd};
 use crate::integrate::StageCursor;
 
@@ -45,24 +45,29 @@ pub fn damp_springs_start(
 
 /// Second half of the spring dampers' flow, `D(h/2)`, after the integration, in the last stage
 /// of each substep: the springs of [`damp_springs_start`] in the reverse order (the adjoint
-/// sweep, so the step is symmetric). `order` is a reused buffer (no allocation once the world
-/// stops growing).
+/// sweep, so the step is symmetric): the springs' tables from the last, each from its last row.
+/// (No copy of the springs: a world of a million springs would hold them twice.)
 pub fn damp_springs_end(
     settings: Res<PhysicsSettings>,
     cursor: Res<StageCursor>,
     springs: Query<&Spring>,
     mut bodies: DamperEnds,
-    mut order: Local<Vec<Spring>>,
 ) {
     let span = cursor.span(&settings);
     if !span.closes_substep {
         return;
     }
     let tau = 0.5 * span.substep;
-    order.clear();
-    order.extend(springs.iter().filter(|s| is_damped(s)).copied());
-    for spring in order.iter().rev() {
-        damp_spring(spring, tau, &mut bodies);
+    // Springs live in a handful of tables; finding each from the front keeps this free of
+    // allocations.
+    let tables = dense(springs.contiguous_iter()).count();
+    for t in (0..tables).rev() {
+        let Some(table) = dense(springs.contiguous_iter()).nth(t) else {
+            continue;
+        };
+        for spring in table.iter().rev() {
+            damp_spring(spring, tau, &mut bodies);
+        }
     }
 }
 

@@ -126,23 +126,26 @@ pub fn classify_springs(world: &mut World) {
         })
         .collect();
     let mut pull: Vec<Real> = vec![0.0; masses.len()];
-    // Per body, `Σ k c` over its spring ends, `c` the end's turning compliance: how stiffly
-    // its springs turn it (see the module docs).
-    let mut turn: Vec<Real> = vec![0.0; masses.len()];
     for ((_, spring), &(a, b, iota)) in springs.iter().zip(&ends) {
         for i in [a, b].into_iter().flatten() {
             pull[i] += spring.stiffness * (iota[0] + iota[1]);
         }
-        let anchor_b = match spring.b {
-            SpringEnd::Body { anchor, .. } => anchor,
-            SpringEnd::World(_) => Vec3::ZERO,
-        };
-        for (end, anchor) in [(a, spring.anchor_a), (b, anchor_b)] {
-            if let Some(i) = end {
-                turn[i] += spring.stiffness * turning_compliance(&masses[i], anchor);
-            }
-        }
     }
+    let rates = turn_rates(
+        &masses,
+        springs
+            .iter()
+            .zip(&ends)
+            .flat_map(|((_, spring), &(a, b, _))| {
+                let anchor_b = match spring.b {
+                    SpringEnd::Body { anchor, .. } => anchor,
+                    SpringEnd::World(_) => Vec3::ZERO,
+                };
+                [(a, spring.anchor_a), (b, anchor_b)]
+                    .into_iter()
+                    .filter_map(move |(end, anchor)| Some((end?, anchor, spring.stiffness)))
+            }),
+    );
     for ((_, spring), &(a, b, iota)) in springs.iter().zip(&ends) {
         // A body's pull includes this spring's own `k (ι_a + ι_b)`; a spring without a dynamic
         // end joins no group, and its own bound is all there is.
@@ -189,7 +192,6 @@ pub fn classify_springs(world: &mut World) {
     mark_stiff(world, &springs, implicit_spring, &index, &implicit_body);
     // After the implicit markers, in a pass of its own: the order components are added in
     // decides the tables' order, and with it the order an implicit group's solve sums in.
-    let rates: Vec<Real> = turn.iter().map(|t| t.sqrt()).collect();
     mark_turn_rates(world, &index, &rates);
     let springs = spring_count(world);
     world.insert_resource(SpringClassification {
@@ -197,6 +199,41 @@ pub fn classify_springs(world: &mut World) {
         solver: settings.springs,
         springs,
     });
+}
+
+/// Per body (an index into `masses`), how fast its springs can turn it: `ω_turn = √(Σ k c)`
+/// over its spring ends `(body, body-local anchor, stiffness k)`, summed in the order given, `c`
+/// the end's [`turning_compliance`] (see [`SpringTurn`]).
+fn turn_rates(
+    masses: &[MassProps],
+    ends: impl IntoIterator<Item = (usize, Vec3, Real)>,
+) -> Vec<Real> {
+    let mut turn: Vec<Real> = vec![0.0; masses.len()];
+    for (i, anchor, stiffness) in ends {
+        turn[i] += stiffness * turning_compliance(&masses[i], anchor);
+    }
+    for t in &mut turn {
+        *t = t.sqrt();
+    }
+    turn
+}
+
+/// Per body of `masses` (all dynamic), the [`SpringTurn`] the spring classification puts on
+/// it, given the spring ends `(body, body-local anchor, stiffness)` in the order the springs
+/// will be spawned: `None` where its springs cannot turn it.
+///
+/// For code that spawns a world whose springs it knows (a scene file): a body spawned with
+/// the component it will carry is never moved to another table by the classification (a
+/// move leaves the table it left at its size, so a world whose bodies all moved would hold
+/// their memory twice). The classification computes the same rates and changes nothing.
+pub fn spring_turns(
+    masses: &[MassProps],
+    ends: impl IntoIterator<Item = (usize, Vec3, Real)>,
+) -> Vec<Option<SpringTurn>> {
+    turn_rates(masses, ends)
+        .into_iter()
+        .map(|rate| (rate > 0.0).then(|| SpringTurn::new(rate)))
+        .collect()
 }
 
 /// Puts [`ImplicitSpring`] on the springs and [`ImplicitBody`] on the bodies the classification

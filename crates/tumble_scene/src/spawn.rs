@@ -1,0 +1,134 @@
+//! Spawning a checked scene into a world without moving a row.
+//!
+//! A bevy table never shrinks: a row that moves to another table (a component added after the
+//! spawn) leaves its old table at its size, so a world whose bodies all moved would hold them
+//! twice; and a table grown one spawn at a time doubles, up to twice what it holds. So each
+//! body is spawned with every component it will carry (a [`ForceAccumulator`] when a force
+//! generator names it, its [`GravityScale`], [`Damping`] and the [`SpringTurn`] the spring
+//! classification would give it), and each run of bodies (or of force generators) of one
+//! kind by one `spawn_batch`, which reserves the table once for the whole run. Entities are
+//! spawned in file order, as one `spawn` each would.
+
+use bevy_ecs::bundle::NoBundleEffect;
+use bevy_ecs::prelude::*;
+use tumble_ecs::components::SpringTurn;
+use tumble_ecs::prelude::*;
+
+use crate::build::ValidBody;
+
+/// A body to spawn and what it carries besides its state.
+pub(crate) struct BodySpawn {
+    pub(crate) body: ValidBody,
+    /// A force generator names it: spawned with its [`ForceAccumulator`] (which the
+    /// generator's hook would otherwise add).
+    pub(crate) loaded: bool,
+    pub(crate) turn: Option<SpringTurn>,
+}
+
+/// Which optional components a body carries: bodies of one kind share a table.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct BodyKind {
+    loaded: bool,
+    gravity: bool,
+    damping: bool,
+    turn: bool,
+}
+
+impl BodyKind {
+    /// The kind of `body`.
+    pub(crate) fn of(body: &ValidBody, loaded: bool, turn: Option<SpringTurn>) -> Self {
+        Self {
+            loaded,
+            gravity: body.gravity_scale != 1.0,
+            damping: body.damping != Damping::default(),
+            turn: turn.is_some(),
+        }
+    }
+}
+
+/// Spawns `run`, bodies all of kind `kind` (checked in debug builds), in order, by one
+/// `spawn_batch`, handing each entity to `out`. Each optional component picks one of two
+/// bundle types in its own stage, so every body of the run has the same bundle type.
+pub(crate) fn spawn_bodies(
+    world: &mut World,
+    kind: BodyKind,
+    run: impl ExactSizeIterator<Item = BodySpawn>,
+    out: impl FnMut(Entity),
+) {
+    let state = |b: &BodySpawn| {
+        (
+            RigidBody,
+            MassProps(b.body.mass),
+            b.body.transform,
+            b.body.velocity,
+        )
+    };
+    let run = run.inspect(move |b| {
+        debug_assert_eq!(BodyKind::of(&b.body, b.loaded, b.turn), kind);
+    });
+    if kind.loaded {
+        with_gravity(
+            world,
+            kind,
+            run,
+            move |b| (state(b), ForceAccumulator::default()),
+            out,
+        );
+    } else {
+        with_gravity(world, kind, run, state, out);
+    }
+}
+
+fn with_gravity<B: Bundle<Effect: NoBundleEffect>>(
+    world: &mut World,
+    kind: BodyKind,
+    run: impl ExactSizeIterator<Item = BodySpawn>,
+    bundle: impl Fn(&BodySpawn) -> B,
+    out: impl FnMut(Entity),
+) {
+    if kind.gravity {
+        let scale = |b: &BodySpawn| GravityScale(b.body.gravity_scale);
+        with_damping(world, kind, run, move |b| (bundle(b), scale(b)), out);
+    } else {
+        with_damping(world, kind, run, bundle, out);
+    }
+}
+
+fn with_damping<B: Bundle<Effect: NoBundleEffect>>(
+    world: &mut World,
+    kind: BodyKind,
+    run: impl ExactSizeIterator<Item = BodySpawn>,
+    bundle: impl Fn(&BodySpawn) -> B,
+    out: impl FnMut(Entity),
+) {
+    if kind.damping {
+        with_turn(world, kind, run, move |b| (bundle(b), b.body.damping), out);
+    } else {
+        with_turn(world, kind, run, bundle, out);
+    }
+}
+
+fn with_turn<B: Bundle<Effect: NoBundleEffect>>(
+    world: &mut World,
+    kind: BodyKind,
+    run: impl ExactSizeIterator<Item = BodySpawn>,
+    bundle: impl Fn(&BodySpawn) -> B,
+    out: impl FnMut(Entity),
+) {
+    if kind.turn {
+        let turn = |b: &BodySpawn| b.turn.unwrap_or_default();
+        batch(world, run.map(move |b| (bundle(&b), turn(&b))), out);
+    } else {
+        batch(world, run.map(move |b| bundle(&b)), out);
+    }
+}
+
+/// Spawns `bundles` in order by one `spawn_batch` (which reserves the table for all of them
+/// at once), handing each entity to `out`.
+pub(crate) fn batch<B: Bundle<Effect: NoBundleEffect>>(
+    world: &mut World,
+    bundles: impl ExactSizeIterator<Item = B>,
+    out: impl FnMut(Entity),
+) {
+    world.spawn_batch(bundles).for_each(out);
+}
