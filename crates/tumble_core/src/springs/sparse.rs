@@ -48,23 +48,33 @@ fn product(a: &Block, b: &Block) -> Block {
     c
 }
 
+/// An entry of a row or of a pivot: the column (or row) body and where its block sits in
+/// [`BlockLu`]'s block pool. Eight bytes, so that a body's short list costs little: a chain's
+/// rows hold two entries, and a vector of whole blocks would reserve four (1.2 kB) for them.
+type Entry = (u32, u32);
+
 /// One eliminated body: its pivot inverse, the multipliers `A_ip P` of the bodies below it and
-/// the blocks `A_pj` of the bodies after it (both over the bodies still present when it went).
+/// the blocks `A_pj` of the bodies after it (both over the bodies still present when it went),
+/// their blocks in the pool.
 #[derive(Debug, Clone, Default)]
 struct Pivot {
     body: usize,
     inverse: Block,
-    lower: Vec<(usize, Block)>,
-    upper: Vec<(usize, Block)>,
+    lower: Vec<Entry>,
+    upper: Vec<Entry>,
 }
 
 /// The factorization, with its working storage kept between factorizations (no allocation once
 /// warm for a group of the same shape).
 #[derive(Debug, Clone, Default)]
 pub(crate) struct BlockLu {
-    /// Off-diagonal blocks by row: `rows[i]` holds `(j, A_ij)`; the pattern is symmetric.
-    rows: Vec<Vec<(usize, Block)>>,
+    /// Off-diagonal entries by row: `rows[i]` holds `(j, block of A_ij)`; the pattern is
+    /// symmetric.
+    rows: Vec<Vec<Entry>>,
     diagonal: Vec<Block>,
+    /// Every off-diagonal block: the matrix's, the multipliers that replace the lower ones as
+    /// their bodies go, and the fill.
+    pool: Vec<Block>,
     /// Scratch of `analyze`: the bodies already ordered.
     eliminated: Vec<bool>,
     pivots: Vec<Pivot>,
@@ -83,6 +93,13 @@ pub(crate) struct BlockLu {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) struct SingularPivot;
 
+/// A body or block index as an entry stores it. Groups are bounded far below `u32::MAX`
+/// bodies and blocks by memory (a block is 288 bytes).
+#[inline]
+fn narrow(i: usize) -> u32 {
+    u32::try_from(i).expect("fewer than 2³² bodies and blocks in a group")
+}
+
 impl BlockLu {
     /// Starts a matrix of `n` bodies: the diagonal blocks `diagonal`, no off-diagonal blocks.
     pub(crate) fn reset(&mut self, diagonal: &[Block]) {
@@ -93,6 +110,7 @@ impl BlockLu {
         for row in &mut self.rows {
             row.clear();
         }
+        self.pool.clear();
         self.slot.clear();
         self.slot.resize(n, usize::MAX);
         self.pivot_count = 0;
@@ -113,21 +131,29 @@ impl BlockLu {
         &mut self.diagonal[i]
     }
 
+    /// A new zero block in the pool, and its index.
+    fn new_block(&mut self) -> u32 {
+        self.pool.push([[0.0; 6]; 6]);
+        narrow(self.pool.len() - 1)
+    }
+
     /// The block `(i, j)` (`i ≠ j`), zero when first named, to add to before
     /// [`factor`](Self::factor); `(j, i)` enters the pattern too, which stays symmetric.
     pub(crate) fn entry(&mut self, i: usize, j: usize) -> &mut Block {
-        if !self.rows[j].iter().any(|(c, _)| *c == i) {
-            self.rows[j].push((i, [[0.0; 6]; 6]));
+        let (ci, cj) = (narrow(i), narrow(j));
+        if !self.rows[j].iter().any(|(c, _)| *c == ci) {
+            let block = self.new_block();
+            self.rows[j].push((ci, block));
         }
-        let row = &mut self.rows[i];
-        let at = match row.iter().position(|(c, _)| *c == j) {
-            Some(at) => at,
+        let block = match self.rows[i].iter().find(|(c, _)| *c == cj) {
+            Some(&(_, block)) => block,
             None => {
-                row.push((j, [[0.0; 6]; 6]));
-                row.len() - 1
+                let block = self.new_block();
+                self.rows[i].push((cj, block));
+                block
             }
         };
-        &mut row[at].1
+        &mut self.pool[block as usize]
     }
 
     /// Chooses the elimination order from the present pattern (call after the `add`s; the
@@ -139,7 +165,7 @@ impl BlockLu {
         self.graph.resize_with(n.max(self.graph.len()), Vec::new);
         for (adjacent, row) in self.graph.iter_mut().zip(&self.rows) {
             adjacent.clear();
-            adjacent.extend(row.iter().map(|(j, _)| *j));
+            adjacent.extend(row.iter().map(|(j, _)| *j as usize));
         }
         self.slot.clear();
         self.slot.resize(n, usize::MAX);
@@ -149,6 +175,7 @@ impl BlockLu {
         self.order.clear();
         self.eliminated.clear();
         self.eliminated.resize(n, false);
+        let mut fill = 0;
         while let Some(Reverse((degree, p))) = self.queue.pop() {
             if self.eliminated[p] || degree != self.graph[p].len() {
                 continue; // a stale entry: p went already, or its degree changed since
@@ -166,6 +193,7 @@ impl BlockLu {
                 for &j in &neighbours {
                     if j != i && self.slot[j] != i {
                         adjacent.push(j);
+                        fill += 1;
                     }
                 }
                 self.queue.push(Reverse((adjacent.len(), i)));
@@ -174,6 +202,11 @@ impl BlockLu {
             self.graph[p].clear();
         }
         self.slot.fill(usize::MAX);
+        // Every block a factorization of this pattern holds: the matrix's and the fill. Sized
+        // exactly (a pool grown by doubling holds up to twice its blocks).
+        let blocks = self.pool.len() + fill;
+        self.pool.shrink_to(blocks);
+        self.pool.reserve_exact(blocks - self.pool.len());
     }
 
     /// Factors the matrix in place, in the order of the last [`BlockLu::analyze`].
@@ -182,6 +215,7 @@ impl BlockLu {
         let Self {
             rows,
             diagonal,
+            pool,
             pivots,
             pivot_count,
             order,
@@ -189,6 +223,7 @@ impl BlockLu {
             ..
         } = self;
         *pivot_count = 0;
+        pivots.reserve_exact(order.len().saturating_sub(pivots.len()));
         for &p in order.iter() {
             if pivots.len() <= *pivot_count {
                 pivots.push(Pivot::default());
@@ -197,41 +232,52 @@ impl BlockLu {
             *pivot_count += 1;
             pivot.body = p;
             pivot.inverse = invert(&diagonal[p]).ok_or(SingularPivot)?;
-            // Row p becomes the pivot's upper blocks A_pj (the vectors trade places, no block
-            // is copied); each A_jp leaves row j (p is gone from the remaining matrix) as the
-            // multiplier A_jp P.
+            // Row p becomes the pivot's upper blocks A_pj (the lists trade places, no block
+            // is copied); each A_jp leaves row j (p is gone from the remaining matrix), its
+            // block overwritten by the multiplier A_jp P.
             pivot.upper.clear();
             std::mem::swap(&mut pivot.upper, &mut rows[p]);
             pivot.lower.clear();
+            let column = narrow(p);
             for &(j, _) in &pivot.upper {
-                let at = rows[j]
+                let row = &mut rows[j as usize];
+                let at = row
                     .iter()
-                    .position(|(c, _)| *c == p)
+                    .position(|(c, _)| *c == column)
                     .expect("the pattern is symmetric");
-                pivot
-                    .lower
-                    .push((j, product(&rows[j][at].1, &pivot.inverse)));
-                rows[j].swap_remove(at);
+                let block = row[at].1;
+                pool[block as usize] = product(&pool[block as usize], &pivot.inverse);
+                pivot.lower.push((j, block));
+                row.swap_remove(at);
             }
             // Schur complement: A_ij −= (A_ip P) A_pj over all remaining neighbours i, j of p.
-            for (i, l_ip) in &pivot.lower {
-                let row = &mut rows[*i];
+            for &(i, l_ip) in &pivot.lower {
+                let row = &mut rows[i as usize];
                 for (at, (j, _)) in row.iter().enumerate() {
-                    slot[*j] = at;
+                    slot[*j as usize] = at;
                 }
-                for (j, a_pj) in &pivot.upper {
+                for &(j, a_pj) in &pivot.upper {
+                    let (l_ip, a_pj) = (l_ip as usize, a_pj as usize);
                     if i == j {
-                        subtract_product(&mut diagonal[*i], l_ip, a_pj);
-                    } else if slot[*j] != usize::MAX {
-                        subtract_product(&mut row[slot[*j]].1, l_ip, a_pj);
-                    } else {
-                        slot[*j] = row.len();
-                        row.push((*j, [[0.0; 6]; 6]));
-                        subtract_product(&mut row.last_mut().expect("pushed").1, l_ip, a_pj);
+                        subtract_product(&mut diagonal[i as usize], &pool[l_ip], &pool[a_pj]);
+                        continue;
                     }
+                    let target = if slot[j as usize] != usize::MAX {
+                        row[slot[j as usize]].1
+                    } else {
+                        pool.push([[0.0; 6]; 6]);
+                        let block = narrow(pool.len() - 1);
+                        slot[j as usize] = row.len();
+                        row.push((j, block));
+                        block
+                    };
+                    let [c, a, b] = pool
+                        .get_disjoint_mut([target as usize, l_ip, a_pj])
+                        .expect("a remaining block is neither a multiplier nor a pivot's");
+                    subtract_product(c, a, b);
                 }
                 for (j, _) in row.iter() {
-                    slot[*j] = usize::MAX;
+                    slot[*j as usize] = usize::MAX;
                 }
             }
         }
@@ -246,8 +292,9 @@ impl BlockLu {
         for pivot in &self.pivots[..self.pivot_count] {
             let p = pivot.body;
             let yp: [f64; 6] = y[6 * p..6 * p + 6].try_into().expect("six entries");
-            for (i, l) in &pivot.lower {
-                let d = block_mul(l, &yp);
+            for &(i, l) in &pivot.lower {
+                let i = i as usize;
+                let d = block_mul(&self.pool[l as usize], &yp);
                 for (a, b) in y[6 * i..6 * i + 6].iter_mut().zip(d) {
                     *a -= b;
                 }
@@ -256,8 +303,9 @@ impl BlockLu {
         for pivot in self.pivots[..self.pivot_count].iter().rev() {
             let p = pivot.body;
             let mut r: [f64; 6] = y[6 * p..6 * p + 6].try_into().expect("six entries");
-            for (j, a) in &pivot.upper {
-                let d = block_mul(a, &out[6 * j..6 * j + 6]);
+            for &(j, a) in &pivot.upper {
+                let j = j as usize;
+                let d = block_mul(&self.pool[a as usize], &out[6 * j..6 * j + 6]);
                 for (x, b) in r.iter_mut().zip(d) {
                     *x -= b;
                 }
@@ -324,6 +372,8 @@ mod tests {
             }
             lu.analyze();
             lu.factor().expect("diagonally dominant");
+            // `analyze` counted the fill exactly: the pool was sized once.
+            assert_eq!(lu.pool.len(), lu.pool.capacity(), "{width}×{height}");
             let u: Vec<f64> = (0..6 * n).map(|k| (k as f64 * 0.37).sin()).collect();
             let mut x = vec![0.0; 6 * n];
             lu.solve(&u, &mut x);
@@ -344,6 +394,39 @@ mod tests {
                 .map(|(a, b)| (a - b).abs())
                 .fold(0.0, f64::max);
             assert!(error < 1e-12, "{width}×{height}: |A x − u| = {error:e}");
+        }
+    }
+
+    /// A chain's elimination (leaves first) makes no fill: its factorization holds the two
+    /// blocks of each link and nothing else, and a second factorization of the same pattern
+    /// reuses that storage.
+    #[test]
+    fn a_chain_is_factored_without_fill_in_its_own_blocks() {
+        let n = 50;
+        let diagonal: Vec<Block> = (0..n).map(|i| block(i as u64, true)).collect();
+        let mut lu = BlockLu::default();
+        for round in 0..2 {
+            lu.reset(&diagonal);
+            for i in 1..n {
+                lu.add(i - 1, i, &block(1000 + i as u64, false));
+                lu.add(i, i - 1, &block(2000 + i as u64, false));
+            }
+            if round == 0 {
+                lu.analyze();
+            }
+            let capacity = lu.pool.capacity();
+            lu.factor().expect("diagonally dominant");
+            assert_eq!(lu.pool.len(), 2 * (n - 1), "round {round}: fill on a chain");
+            assert_eq!(
+                lu.pool.capacity(),
+                capacity,
+                "round {round}: the factorization grew"
+            );
+            let entries: usize = lu.pivots[..lu.pivot_count]
+                .iter()
+                .map(|p| p.lower.len() + p.upper.len())
+                .sum();
+            assert_eq!(entries, 2 * (n - 1), "round {round}");
         }
     }
 

@@ -345,6 +345,12 @@ pub fn solve_implicit_springs(
     let half_substep = 0.5 * span.substep;
     let switch = ExactSwitch::new(settings.integrator, settings.free_flow, span.substep);
     let judged = classification_span(&settings);
+    // Exact sizes (see `ImplicitSpringSolver`'s buffers): a group may hold every body.
+    let count = bodies.iter().len();
+    s.entities.reserve_exact(count);
+    s.parent.reserve_exact(count);
+    s.all.reserve_exact(count);
+    s.index.reserve(count);
     for ((entity, t, mut v, m, mut acc, damping, turn), mut implicit) in &mut bodies {
         // `Damping` is a flow of its own, half a substep before the substep and half after (see
         // `tumble_core::damping`), as on the explicit path.

@@ -220,6 +220,9 @@ impl ImplicitSpringSolver {
     ) -> Result<(), ImplicitSpringError> {
         self.analyzed = false;
         self.starts.clear();
+        // Exact sizes: grown by doubling, a group of a million bodies would hold up to twice
+        // its starts, three times while a doubling copies them.
+        self.starts.reserve_exact(bodies.len());
         for body in bodies {
             let m = &body.mass;
             let q = (body.state.rotation.widen() * m.principal_frame().widen()).normalize();
@@ -250,6 +253,7 @@ impl ImplicitSpringSolver {
             });
         }
         self.links.clear();
+        self.links.reserve_exact(springs.len());
         let len = bodies.len();
         for spring in springs {
             let end_of = |index: usize, anchor: Vec3| -> Result<End, ImplicitSpringError> {
