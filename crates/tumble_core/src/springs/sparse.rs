@@ -86,6 +86,9 @@ pub(crate) struct BlockLu {
     slot: Vec<usize>,
     /// The symbolic graph of `analyze`.
     graph: Vec<Vec<usize>>,
+    /// The blocks `A_pj` of the pivot being eliminated, side by side: the Schur updates read
+    /// them once per remaining neighbour, and write only to other blocks of the pool.
+    upper_blocks: Vec<Block>,
     queue: BinaryHeap<Reverse<(usize, usize)>>,
 }
 
@@ -220,6 +223,7 @@ impl BlockLu {
             pivot_count,
             order,
             slot,
+            upper_blocks,
             ..
         } = self;
         *pivot_count = 0;
@@ -251,15 +255,17 @@ impl BlockLu {
                 row.swap_remove(at);
             }
             // Schur complement: A_ij −= (A_ip P) A_pj over all remaining neighbours i, j of p.
+            upper_blocks.clear();
+            upper_blocks.extend(pivot.upper.iter().map(|&(_, a)| pool[a as usize]));
             for &(i, l_ip) in &pivot.lower {
+                let l_ip = pool[l_ip as usize];
                 let row = &mut rows[i as usize];
                 for (at, (j, _)) in row.iter().enumerate() {
                     slot[*j as usize] = at;
                 }
-                for &(j, a_pj) in &pivot.upper {
-                    let (l_ip, a_pj) = (l_ip as usize, a_pj as usize);
+                for (&(j, _), a_pj) in pivot.upper.iter().zip(upper_blocks.iter()) {
                     if i == j {
-                        subtract_product(&mut diagonal[i as usize], &pool[l_ip], &pool[a_pj]);
+                        subtract_product(&mut diagonal[i as usize], &l_ip, a_pj);
                         continue;
                     }
                     let target = if slot[j as usize] != usize::MAX {
@@ -271,10 +277,7 @@ impl BlockLu {
                         row.push((j, block));
                         block
                     };
-                    let [c, a, b] = pool
-                        .get_disjoint_mut([target as usize, l_ip, a_pj])
-                        .expect("a remaining block is neither a multiplier nor a pivot's");
-                    subtract_product(c, a, b);
+                    subtract_product(&mut pool[target as usize], &l_ip, a_pj);
                 }
                 for (j, _) in row.iter() {
                     slot[*j as usize] = usize::MAX;
