@@ -220,10 +220,36 @@ const PINNED_F64: &[(&str, &str)] = &[
     ),
     ("lclamp", "04e38e84b4683986577a1e84a54b3336"),
     ("implicit-gyroscopic", "575d1d8020fdddeb7d1612b54e845d5d"),
-    ("splitting", "a8d1376e2b430d735eec7e06cf1248cb"),
-    ("splitting-xyz", "7dcbf27444c7f2c0f01edf74e7de998e"),
+    ("splitting", "f50696a3013a88d4f583a155ea12c1b0"),
+    ("splitting-xyz", "fe634de7f704e71f6caef79fea00601c"),
     ("yoshida4", "7fe2f6c503ece11d652ab72ea66c6776"),
-    ("rk4", "b63321dc7b95cd1221b832b533400334"),
-    ("exact", "ce1aa0920880c4a17a7b985b14348622"),
+    ("rk4", "5eba9ec32457e8e29d51b3e221e766de"),
+    ("exact", "094a7dcf5af2d0a78e607b9ef577b353"),
     ("exact4", "1babf66e140375a74f7b561db2b2b869"),
 ];
+
+/// The bits do not depend on what else the world held when the step was planned: a resource
+/// and an entity of another kind made before planning give every archetype a different id,
+/// which reorders the tables a system's query visits (bevy matches the tables that exist when
+/// a query is created in the order of a hash of their archetype ids). The reference scene's
+/// implicit group sums over bodies of several tables.
+#[test]
+fn what_else_the_world_holds_does_not_change_the_bits() {
+    #[derive(Resource, Default)]
+    struct GameClock;
+    #[derive(Component)]
+    struct Tree;
+    for integrator in [Integrator::Splitting, Integrator::Exact, Integrator::Rk4] {
+        let mut plain = reference_world(integrator);
+        let mut busy = reference_world(integrator);
+        busy.init_resource::<GameClock>();
+        busy.spawn(Tree);
+        run(&mut plain, 60);
+        run(&mut busy, 60);
+        assert_eq!(
+            world_checksum(&plain),
+            world_checksum(&busy),
+            "{integrator}"
+        );
+    }
+}

@@ -4,8 +4,9 @@ use bevy_ecs::prelude::*;
 use tumble_core::damping::decrement;
 use tumble_core::math::{Real, Vec3};
 
+use super::order::{SpringOrder, SpringQuery};
+use crate::components::Rejected;
 use crate::components::{Kinematic, MassProps, PhysicsSettings, Pose, RigidBody, Static, Velocity};
-use crate::components::{Rejected, dense};
 use crate::components::{Spring, SpringEnd};
 use crate::integrate::StageCursor;
 
@@ -26,49 +27,40 @@ type DamperEnds<'w, 's> = Query<
 
 /// First half of the spring dampers' flow over a substep `h` (the whole step without substeps),
 /// `D(h/2)`, before anything else moves the bodies: every [`Spring`] with `damping > 0`, in
-/// query order, in the first stage of each substep. Only in the plan when such a spring exists.
+/// entity order, in the first stage of each substep. Only in the plan when such a spring exists.
 pub fn damp_springs_start(
     settings: Res<PhysicsSettings>,
     cursor: Res<StageCursor>,
-    springs: Query<&Spring>,
+    springs: SpringQuery<()>,
     mut bodies: DamperEnds,
+    mut order: Local<SpringOrder>,
 ) {
     let span = cursor.span(&settings);
     if !span.opens_substep {
         return;
     }
     let tau = 0.5 * span.substep;
-    for spring in &springs {
-        damp_spring(spring, tau, &mut bodies);
-    }
+    order.refresh(&springs);
+    order.for_each(&springs, |spring| damp_spring(spring, tau, &mut bodies));
 }
 
 /// Second half of the spring dampers' flow, `D(h/2)`, after the integration, in the last stage
 /// of each substep: the springs of [`damp_springs_start`] in the reverse order (the adjoint
-/// sweep, so the step is symmetric): the springs' tables from the last, each from its last row.
-/// (No copy of the springs: a world of a million springs would hold them twice.)
+/// sweep, so the step is symmetric).
 pub fn damp_springs_end(
     settings: Res<PhysicsSettings>,
     cursor: Res<StageCursor>,
-    springs: Query<&Spring>,
+    springs: SpringQuery<()>,
     mut bodies: DamperEnds,
+    mut order: Local<SpringOrder>,
 ) {
     let span = cursor.span(&settings);
     if !span.closes_substep {
         return;
     }
     let tau = 0.5 * span.substep;
-    // Springs live in a handful of tables; finding each from the front keeps this free of
-    // allocations.
-    let tables = dense(springs.contiguous_iter()).count();
-    for t in (0..tables).rev() {
-        let Some(table) = dense(springs.contiguous_iter()).nth(t) else {
-            continue;
-        };
-        for spring in table.iter().rev() {
-            damp_spring(spring, tau, &mut bodies);
-        }
-    }
+    order.refresh(&springs);
+    order.for_each_rev(&springs, |spring| damp_spring(spring, tau, &mut bodies));
 }
 
 /// Whether a spring has a damper (`c > 0`; NaN and negative coefficients have none).

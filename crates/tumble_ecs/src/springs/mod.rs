@@ -105,13 +105,15 @@
 //! `O(x⁴)`, never above 1, no platform `exp`). The kinetic energy changes by `½ m_eff u² (f² − 1) ≤ 0`, `f ∈ [0, 1]` the
 //! decay factor: a damper never adds energy, however large `cΔt`.
 //!
-//! Springs that share a body are swept one after another: at the start of the step in query
+//! Springs that share a body are swept one after another: at the start of the step in entity
 //! order ([`damp_springs_start`]), at the end in the reverse order ([`damp_springs_end`]), so the
-//! end sweep is the adjoint of the start sweep and the whole step stays symmetric. Query order is
-//! the order of the springs' tables, the same on every run of the same world (as for the forces
-//! of [`apply_springs`](crate::forces::apply_springs)).
+//! end sweep is the adjoint of the start sweep and the whole step stays symmetric. Entity order
+//! (the order the springs were spawned in) rather than the order a query visits the tables in,
+//! which depends on what else the world made before the system's query (as do the sums of an
+//! implicit group, over its bodies and springs in entity order).
 
 mod damping;
+mod order;
 mod stiff;
 
 pub use damping::{damp_springs_end, damp_springs_start};
@@ -124,6 +126,9 @@ pub(crate) use stiff::classification_span;
 
 pub(crate) use damping::is_damped;
 
-// Scratch memory of `solve_implicit_springs`, in its signature; not for game code.
+// Scratch memory of `solve_implicit_springs` and of the damper sweeps, in their signatures; not
+// for game code.
+#[doc(hidden)]
+pub use order::SpringOrder;
 #[doc(hidden)]
 pub use stiff::ImplicitScratch;

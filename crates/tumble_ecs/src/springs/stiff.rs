@@ -18,6 +18,8 @@ use crate::components::{
 };
 use crate::integrate::damp;
 
+use super::order::{SpringOrder, SpringQuery};
+
 /// What the classification was made for; a change re-classifies.
 #[derive(Resource, Debug, Clone, Copy, PartialEq)]
 pub struct SpringClassification {
@@ -94,11 +96,14 @@ pub fn classify_springs(world: &mut World) {
         .copied()
         .unwrap_or_default();
     let dt = classification_span(&settings);
-    let springs: Vec<(Entity, Spring)> = world
+    // In entity order: a body's sums over its springs must not follow the order a query
+    // visits the spring tables in (see `ImplicitScratch::sort_by_entity`).
+    let mut springs: Vec<(Entity, Spring)> = world
         .query::<(Entity, &Spring)>()
         .iter(world)
         .map(|(e, s)| (e, *s))
         .collect();
+    springs.sort_unstable_by_key(|(e, _)| e.index_u32());
     let mut dynamic = world.query_filtered::<(Entity, &MassProps), Dynamic>();
     let mut index = EntityHashMap::default();
     let mut masses = Vec::new();
@@ -191,7 +196,7 @@ pub fn classify_springs(world: &mut World) {
     }
     mark_stiff(world, &springs, implicit_spring, &index, &implicit_body);
     // After the implicit markers, in a pass of its own: the order components are added in
-    // decides the tables' order, and with it the order an implicit group's solve sums in.
+    // decides which bodies share a table.
     mark_turn_rates(world, &index, &rates);
     let springs = spring_count(world);
     world.insert_resource(SpringClassification {
@@ -302,22 +307,26 @@ pub struct ImplicitScratch {
     /// Per root body, its group's number (groups numbered in order of their roots).
     rank: Vec<usize>,
     /// Body indices grouped: group `g`'s are `members[member_start[g]..member_start[g + 1]]`,
-    /// in index order.
+    /// in index (entity) order.
     members: Vec<usize>,
     member_start: Vec<usize>,
-    /// Springs grouped the same way, in query order within a group, their ends as indices
+    /// Springs grouped the same way, in entity order within a group, their ends as indices
     /// local to the group.
     springs: Vec<GroupSpring>,
     spring_start: Vec<usize>,
-    /// Each spring's group, in query order, before the springs are grouped.
+    /// Each spring's group, in entity order, before the springs are grouped.
     pending: Vec<u32>,
     cursor: Vec<usize>,
     /// Per body, its index within its group.
     local: Vec<usize>,
     /// The current group's bodies, handed to the solver.
     bodies: Vec<GroupBody>,
-    /// Every implicit body of the world, in query order.
+    /// Every implicit body of the world, in entity order.
     all: Vec<GroupBody>,
+    /// Scratch of the sort into entity order.
+    order: Vec<u32>,
+    /// The implicit springs in entity order.
+    spring_order: SpringOrder,
 }
 
 /// Steps every implicit spring group with the energy-conserving implicit step (see
@@ -328,7 +337,7 @@ pub fn solve_implicit_springs(
     cursor: Res<crate::integrate::StageCursor>,
     mut scratch: Local<ImplicitScratch>,
     mut commands: Commands,
-    springs: Query<&Spring, With<ImplicitSpring>>,
+    springs: ImplicitSprings,
     mut bodies: Query<
         (Stepped<&mut ForceAccumulator>, &mut ImplicitBody),
         (Dynamic, With<ImplicitBody>),
@@ -360,7 +369,6 @@ pub fn solve_implicit_springs(
             let v = &mut *v;
             damp(d, half_substep, &mut v.linear, &mut v.angular);
         }
-        s.index.insert(entity, s.entities.len());
         s.parent.push(s.entities.len());
         s.entities.push(entity);
         let state = body_state(&t, &v, m);
@@ -374,8 +382,12 @@ pub fn solve_implicit_springs(
             rotation,
         });
     }
-    let groups = s.group_bodies(&springs);
-    s.group_springs(&springs, &others, groups);
+    s.sort_by_entity();
+    let mut spring_order = std::mem::take(&mut s.spring_order);
+    spring_order.refresh(&springs);
+    let groups = s.group_bodies(&springs, &spring_order);
+    s.group_springs(&springs, &spring_order, &others, groups);
+    s.spring_order = spring_order;
     for g in 0..groups {
         let members = s.member_start[g]..s.member_start[g + 1];
         s.bodies.clear();
@@ -447,17 +459,42 @@ fn group_rotation(
 }
 
 impl ImplicitScratch {
+    /// Puts the bodies read into `entities` and `all` in entity order and indexes them.
+    ///
+    /// A group's sums run over its bodies and springs in order, so the order must be a fact of
+    /// the world, not of its storage (see [`SpringOrder`]): entity index order, the order the
+    /// bodies were spawned in (unless an index was reused), the same however the world's
+    /// tables came about.
+    fn sort_by_entity(&mut self) {
+        if !self.entities.is_sorted_by_key(|e| e.index_u32()) {
+            let entities = &self.entities;
+            self.order.clear();
+            self.order.extend(0..narrow(entities.len()));
+            self.order
+                .sort_unstable_by_key(|&i| entities[i as usize].index_u32());
+            self.bodies.clear();
+            self.bodies
+                .extend(self.order.iter().map(|&i| self.all[i as usize]));
+            std::mem::swap(&mut self.all, &mut self.bodies);
+            self.entities.sort_unstable_by_key(|e| e.index_u32());
+        }
+        self.index.clear();
+        for (i, &entity) in self.entities.iter().enumerate() {
+            self.index.insert(entity, i);
+        }
+    }
+
     /// Forms the spring groups of the bodies read into `all` (union–find over `springs`) and
-    /// lays them out group by group: `members` in order of their roots, members in index order
-    /// (query order: deterministic), by counting sort, one pass over the bodies and one over
-    /// the springs whatever the number of groups. Returns the number of groups.
-    fn group_bodies(&mut self, springs: &Query<&Spring, With<ImplicitSpring>>) -> usize {
-        for spring in springs {
+    /// lays them out group by group: `members` in order of their roots, members in index
+    /// order (entity order), by counting sort, one pass over the bodies and one over the
+    /// springs whatever the number of groups. Returns the number of groups.
+    fn group_bodies(&mut self, springs: &ImplicitSprings, order: &SpringOrder) -> usize {
+        order.for_each(springs, |spring| {
             if let (Some(i), Some(j)) = ends_in(&self.index, spring) {
                 let (ri, rj) = (find(&mut self.parent, i), find(&mut self.parent, j));
                 self.parent[ri] = rj;
             }
-        }
+        });
         let n = self.entities.len();
         self.group_of.clear();
         for i in 0..n {
@@ -498,7 +535,8 @@ impl ImplicitScratch {
     /// body indices.
     fn group_springs(
         &mut self,
-        springs: &Query<&Spring, With<ImplicitSpring>>,
+        springs: &ImplicitSprings,
+        order: &SpringOrder,
         others: &Query<&Pose, (With<RigidBody>, Without<ImplicitBody>)>,
         groups: usize,
     ) {
@@ -506,11 +544,11 @@ impl ImplicitScratch {
         // its group's slot. Resolving a spring twice is cheaper than keeping every resolved spring
         // twice (a group of a million springs).
         self.pending.clear();
-        for spring in springs {
+        order.for_each(springs, |spring| {
             if let Some((first, _)) = group_spring(&self.index, &self.local, others, spring) {
                 self.pending.push(self.rank[self.group_of[first]] as u32);
             }
-        }
+        });
         counting_starts(
             &mut self.spring_start,
             groups,
@@ -530,15 +568,23 @@ impl ImplicitScratch {
         self.cursor.clear();
         self.cursor.extend_from_slice(&self.spring_start[..groups]);
         let mut k = 0;
-        for spring in springs {
+        order.for_each(springs, |spring| {
             if let Some((_, link)) = group_spring(&self.index, &self.local, others, spring) {
                 let g = self.pending[k] as usize;
                 k += 1;
                 self.springs[self.cursor[g]] = link;
                 self.cursor[g] += 1;
             }
-        }
+        });
     }
+}
+
+/// The springs the implicit step solves.
+type ImplicitSprings<'w, 's> = SpringQuery<'w, 's, With<ImplicitSpring>>;
+
+/// A body or spring count as the scratch's `u32` indices store it.
+fn narrow(n: usize) -> u32 {
+    u32::try_from(n).expect("fewer than 2³² implicit bodies")
 }
 
 /// A spring of an implicit group as the solver takes it, with the index of its first end (an
