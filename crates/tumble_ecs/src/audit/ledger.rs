@@ -21,8 +21,11 @@ pub(super) const ROUND_OFF_ULPS: f64 = 64.0;
 pub(super) struct Audited {
     pub(super) entity: Entity,
     pub(super) start: (Pose, Velocity),
-    /// Pose at the end of the step (for the springs' energy).
+    /// Pose at the end of the step (for the springs' energy; after the end pass, the pose
+    /// `memo` was measured at).
     pub(super) end: Pose,
+    /// What the last end pass measured of this entry's entity, for the next start ([`memo`]).
+    pub(super) memo: BodyMemo,
     /// Every load except the springs: force and torque (world frame).
     pub(super) load: (Vec3, Vec3),
     /// Mass (kg), for the springs' reduced mass.
@@ -153,8 +156,6 @@ pub struct EnergyLedger {
     pub(super) restored: bool,
     /// End passes so far: what the last one measured carries its number.
     pub(super) end_passes: u64,
-    /// The last end pass's kinetic energies, by body index, with their inputs ([`memo`]).
-    pub(super) measured_bodies: Vec<Option<BodyMemo>>,
     /// The groups were closed by an end pass since the last start: their end sums are the
     /// energies the bodies stand at now, if nothing changed ([`EnergyLedger::restart`]).
     pub(super) closed: bool,
@@ -356,6 +357,7 @@ impl EnergyLedger {
             let body = &mut self.bodies[n];
             body.start = (*t, *v);
             body.end = *t;
+            body.memo = BodyMemo::NONE;
             body.load = (Vec3::ZERO, Vec3::ZERO);
             (body.start_energy, body.still) = (energy, still);
             all_still &= still;
@@ -407,9 +409,12 @@ impl EnergyLedger {
         i: usize,
         (entity, t, v, m): (Entity, &Pose, &Velocity, &MassProps),
     ) -> (f64, bool) {
-        match self.measured_bodies.get(i) {
-            Some(Some(memo)) if memo.pass == self.end_passes && memo.still(entity, t, v, m) => {
-                (memo.kinetic(), true)
+        match self.bodies.get(i) {
+            Some(last)
+                if last.entity == entity
+                    && last.memo.still(self.end_passes, &last.end, t, v, m) =>
+            {
+                (last.memo.kinetic(), true)
             }
             _ => (kinetic_energy_f64(t, v, m), false),
         }
@@ -450,7 +455,9 @@ impl EnergyLedger {
     /// (For tests that compare the reuse with fresh measurements.)
     #[cfg(test)]
     pub(crate) fn forget_measurements(&mut self) {
-        self.measured_bodies.clear();
+        for body in &mut self.bodies {
+            body.memo = BodyMemo::NONE;
+        }
         for link in &mut self.links {
             link.measured = 0;
         }

@@ -8,7 +8,6 @@
 //! involved; whatever changed a body (game code, a quarantine putting it back, a rollback) shows
 //! in its bits.
 
-use bevy_ecs::entity::Entity;
 use tumble_core::math::Real;
 
 use crate::components::{MassProps, Pose, Velocity, kinetic_energy_f64};
@@ -21,25 +20,14 @@ fn same_bits<const N: usize>(a: [Real; N], b: [Real; N]) -> bool {
 }
 
 /// Every input of a body's kinetic energy ([`kinetic_energy_f64`]: rotation, velocities,
-/// mass, principal moments and frame) and of its springs' anchors (translation, rotation).
+/// mass, principal moments and frame) and of its springs' anchors (translation, rotation) but
+/// its pose, which the ledger keeps anyway (the end pose its springs' energies are measured at).
 /// The inverse mass stands for the mass: one decides the other.
 #[inline(always)]
-fn body_inputs(pose: &Pose, velocity: &Velocity, mass: &MassProps) -> [Real; 21] {
-    let (t, q, v, w) = (
-        pose.translation,
-        pose.rotation,
-        velocity.linear,
-        velocity.angular,
-    );
+fn rest_inputs(velocity: &Velocity, mass: &MassProps) -> [Real; 14] {
+    let (v, w) = (velocity.linear, velocity.angular);
     let (i, f) = (mass.principal_inertia(), mass.principal_frame());
     [
-        t.x,
-        t.y,
-        t.z,
-        q.x,
-        q.y,
-        q.z,
-        q.w,
         v.x,
         v.y,
         v.z,
@@ -57,31 +45,38 @@ fn body_inputs(pose: &Pose, velocity: &Velocity, mass: &MassProps) -> [Real; 21]
     ]
 }
 
-/// A body as the end of the last step measured it.
+/// The pose's inputs.
+#[inline(always)]
+fn pose_inputs(pose: &Pose) -> [Real; 7] {
+    let (t, q) = (pose.translation, pose.rotation);
+    [t.x, t.y, t.z, q.x, q.y, q.z, q.w]
+}
+
+/// A body as the end of the last step measured it, beside the pose it was measured at (the
+/// ledger's end pose) and the entity it was measured for (the ledger entry's).
 #[derive(Debug, Clone, Copy)]
 pub(super) struct BodyMemo {
-    /// The end pass that measured it.
-    pub(super) pass: u64,
-    entity: Entity,
-    /// [`body_inputs`] at the measurement.
-    inputs: [Real; 21],
+    /// The end pass that measured it (0: none).
+    pass: u64,
+    /// [`rest_inputs`] at the measurement.
+    inputs: [Real; 14],
     kinetic: f64,
 }
 
 impl BodyMemo {
-    /// The body `entity` at `pose`, moving at `velocity`, and its kinetic energy, measured by
-    /// end pass `pass`.
-    pub(super) fn measure(
-        pass: u64,
-        entity: Entity,
-        pose: &Pose,
-        velocity: &Velocity,
-        mass: &MassProps,
-    ) -> Self {
+    /// No measurement.
+    pub(super) const NONE: Self = Self {
+        pass: 0,
+        inputs: [0.0; 14],
+        kinetic: 0.0,
+    };
+
+    /// The body at `pose`, moving at `velocity`, and its kinetic energy, measured by end pass
+    /// `pass` (≥ 1).
+    pub(super) fn measure(pass: u64, pose: &Pose, velocity: &Velocity, mass: &MassProps) -> Self {
         Self {
             pass,
-            entity,
-            inputs: body_inputs(pose, velocity, mass),
+            inputs: rest_inputs(velocity, mass),
             kinetic: kinetic_energy_f64(pose, velocity, mass),
         }
     }
@@ -91,16 +86,21 @@ impl BodyMemo {
         self.kinetic
     }
 
-    /// True when `entity` is this body and `pose`, `velocity` and `mass` are what it was
-    /// measured with, bit for bit: its kinetic energy and its springs' anchors are unchanged.
+    /// True when end pass `pass` measured this body at `measured_pose`, and `pose`, `velocity`
+    /// and `mass` are what it was measured with, bit for bit: its kinetic energy and its
+    /// springs' anchors are unchanged. (The caller checks that the entity is the one measured.)
     #[inline]
     pub(super) fn still(
         &self,
-        entity: Entity,
+        pass: u64,
+        measured_pose: &Pose,
         pose: &Pose,
         velocity: &Velocity,
         mass: &MassProps,
     ) -> bool {
-        self.entity == entity && same_bits(self.inputs, body_inputs(pose, velocity, mass))
+        self.pass != 0
+            && self.pass == pass
+            && same_bits(pose_inputs(measured_pose), pose_inputs(pose))
+            && same_bits(self.inputs, rest_inputs(velocity, mass))
     }
 }

@@ -36,30 +36,41 @@ pub fn audit_energy_start(
     if std::mem::take(&mut ledger.closed) && same_span && ledger.restart(&bodies, &ends, &springs) {
         return;
     }
-    ledger.bodies.clear();
     ledger.groups.clear();
     // Exact sizes: grown by doubling, a vector of a million entries would briefly be held
     // twice, and this pass is the audit's peak.
-    ledger.bodies.reserve_exact(bodies.iter().len());
+    let old = ledger.bodies.len();
+    ledger
+        .bodies
+        .reserve_exact(bodies.iter().len().saturating_sub(old));
     ledger
         .links
         .reserve_exact(springs.iter().len().saturating_sub(ledger.links.len()));
+    // Each entry is written over the last step's at its index, after its memo is read.
+    let mut i = 0;
     for (entity, t, v, m) in &bodies {
-        let i = ledger.bodies.len();
         let (energy, still) = ledger.start_kinetic(i, (entity, t, v, m));
         ledger.set_slot(entity, i);
-        ledger.bodies.push(Audited {
+        let body = Audited {
             entity,
             start: (*t, *v),
             end: *t,
+            memo: BodyMemo::NONE,
             load: (Vec3::ZERO, Vec3::ZERO),
             mass: m.mass().widen(),
             parent: i,
             group: 0,
             still,
             start_energy: energy,
-        });
+        };
+        if i < old {
+            ledger.bodies[i] = body;
+        } else {
+            ledger.bodies.push(body);
+        }
+        i += 1;
     }
+    ledger.bodies.truncate(i);
     // Each link is written over the last step's link at its index, keeping that one's
     // measurement when the inputs are the same ([`memo`]).
     let old = ledger.links.len();
@@ -169,7 +180,6 @@ pub fn audit_energy(
     // measured in the same pass.
     ledger.end_passes += 1;
     let pass = ledger.end_passes;
-    ledger.measured_bodies.resize(ledger.bodies.len(), None);
     for (entity, t, v, m, scale, has_accumulator) in &bodies {
         let Some(i) = ledger.slot(entity) else {
             continue;
@@ -186,9 +196,8 @@ pub fn audit_energy(
         let v_mean = 0.5 * (v0.linear.widen() + v.linear.widen());
         let w_mean = 0.5 * (v0.angular.widen() + v.angular.widen());
         let work = dt * (force.widen().dot(v_mean) + torque.widen().dot(w_mean));
-        let measured = BodyMemo::measure(pass, entity, t, v, m);
-        let energy = measured.kinetic();
-        ledger.measured_bodies[i] = Some(measured);
+        body.memo = BodyMemo::measure(pass, t, v, m);
+        let energy = body.memo.kinetic();
         let g = &mut ledger.groups[group];
         g.end += energy;
         g.work += work;
