@@ -39,6 +39,7 @@ mod body;
 mod errors;
 mod generators;
 mod markers;
+mod order;
 mod settings;
 
 pub use body::{
@@ -57,3 +58,8 @@ pub use settings::{Gravity, PhysicsSettings, SpringSolver};
 pub(crate) use body::{RemovedBodies, reject};
 pub(crate) use generators::{Generator, ensure_accumulators, reject_generator};
 pub(crate) use markers::{Stepped, dense};
+pub(crate) use order::IndexedQuery;
+// Scratch memory of the systems that visit generators in entity order, in their signatures;
+// not for game code.
+#[doc(hidden)]
+pub use order::IndexOrder;

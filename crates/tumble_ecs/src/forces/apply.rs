@@ -1,5 +1,6 @@
 //! The systems of the force stage: gravity, constant forces and torques, explicit springs.
 
+use crate::components::{IndexOrder, IndexedQuery};
 use bevy_ecs::prelude::*;
 use tumble_core::math::{Vec3, quat_rotate};
 
@@ -57,23 +58,19 @@ pub fn apply_gravity(
 /// the centre of mass (for a body of an implicit spring group, the point goes to the implicit
 /// solve instead, which takes that torque at mid-step: see [`ImplicitBody`]).
 pub fn apply_constant_forces(
-    generators: Query<&ConstantForce>,
-    local_generators: Query<&ConstantLocalForce>,
+    generators: IndexedQuery<ConstantForce, ()>,
+    local_generators: IndexedQuery<ConstantLocalForce, ()>,
     mut bodies: ForceTargets,
     mut rows: Local<TargetRows>,
     mut implicit: Query<&mut ImplicitBody>,
+    mut orders: Local<[IndexOrder; 2]>,
 ) {
     let mut targets = Targets::of(&mut bodies, &mut rows);
     // Looked up only where some body is in an implicit group: a lookup per force otherwise.
     let any_implicit = !implicit.is_empty();
-    // World-frame forces first, then body-frame ones (`None`: already in the world frame).
-    let world_frame = generators
-        .iter()
-        .map(|g| (g.body, g.force, false, g.local_point));
-    let body_frame = (local_generators.iter()).map(|g| (g.body, g.force, true, g.local_point));
-    for (body, force, in_body_frame, local_point) in world_frame.chain(body_frame) {
+    let mut apply = |body: Entity, force: Vec3, in_body_frame: bool, local_point: Option<Vec3>| {
         let Some((transform, mass)) = targets.body(body) else {
-            continue;
+            return;
         };
         let force = if in_body_frame {
             quat_rotate(transform.rotation, force)
@@ -82,33 +79,46 @@ pub fn apply_constant_forces(
         };
         let Some(local) = local_point else {
             targets.push(body, |acc| acc.add_force(force));
-            continue;
+            return;
         };
         if any_implicit && let Ok(mut implicit) = implicit.get_mut(body) {
             // The implicit step takes the torque of a force at a point at mid-step (it turns
             // with the body): the force goes to the accumulator, its point to the solve.
             implicit.add_point_force(local - mass.local_center_of_mass(), force);
             targets.push(body, |acc| acc.add_force(force));
-            continue;
+            return;
         }
         let (point, center) = (
             transform.transform_point(local),
             transform.center_of_mass(mass),
         );
         targets.push(body, |acc| acc.add_force_at_point(force, point, center));
-    }
+    };
+    // World-frame forces first, then body-frame ones, each in entity order (see
+    // [`IndexOrder`]: a body's sum must not follow the order a query visits tables in).
+    let [world_frame, body_frame] = &mut *orders;
+    world_frame.refresh(&generators);
+    world_frame.for_each(&generators, |g| {
+        apply(g.body, g.force, false, g.local_point)
+    });
+    body_frame.refresh(&local_generators);
+    body_frame.for_each(&local_generators, |g| {
+        apply(g.body, g.force, true, g.local_point);
+    });
 }
 
-/// Applies every [`ConstantTorque`].
+/// Applies every [`ConstantTorque`], in entity order.
 pub fn apply_constant_torques(
-    generators: Query<&ConstantTorque>,
+    generators: IndexedQuery<ConstantTorque, ()>,
     mut bodies: ForceTargets,
     mut rows: Local<TargetRows>,
+    mut order: Local<IndexOrder>,
 ) {
     let mut targets = Targets::of(&mut bodies, &mut rows);
-    for gen_torque in &generators {
-        targets.push(gen_torque.body, |acc| acc.add_torque(gen_torque.torque));
-    }
+    order.refresh(&generators);
+    order.for_each(&generators, |g| {
+        targets.push(g.body, |acc| acc.add_torque(g.torque));
+    });
 }
 
 /// World anchor point and the centre of mass, for a body-local anchor.
@@ -230,28 +240,32 @@ pub struct SpringPushes(Vec<SpringPush>);
 /// order, and this keeps the threads busy without letting two of them add to one accumulator.
 /// The sums are the same bits for any thread count.
 pub fn apply_springs(
-    springs: Query<&Spring, Without<crate::components::ImplicitSpring>>,
+    springs: IndexedQuery<Spring, Without<crate::components::ImplicitSpring>>,
     mut bodies: ForceTargets,
     mut rows: Local<TargetRows>,
     mut pushes: Local<SpringPushes>,
+    mut order: Local<IndexOrder>,
     parallelism: Option<Res<Parallelism>>,
 ) {
     let mut targets = Targets::of(&mut bodies, &mut rows);
     let parallelism = parallelism.map_or_else(Parallelism::default, |p| *p);
     let count = springs.iter().len();
+    order.refresh(&springs);
     let threads = match targets {
+        // Springs in several tables, out of entity order: added one by one in that order.
+        _ if !order.is_query_order() => 1,
         Targets::Tables { .. } => parallelism.threads_for(count),
         // The query's own lookups are not shared between threads.
         Targets::Query(_) => 1,
     };
     if threads <= 1 {
-        for spring in &springs {
+        order.for_each(&springs, |spring| {
             SpringPush::of(spring, &targets).apply(spring, &mut targets);
-        }
+        });
         return;
     }
     let pushes = &mut pushes.0;
-    for table in dense(springs.contiguous_iter()) {
+    for (_, table) in dense(springs.contiguous_iter()) {
         for block in table.chunks(PUSH_BLOCK) {
             pushes.clear();
             pushes.resize(block.len(), SpringPush::Nothing);

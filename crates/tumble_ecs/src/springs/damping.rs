@@ -4,8 +4,8 @@ use bevy_ecs::prelude::*;
 use tumble_core::damping::decrement;
 use tumble_core::math::{Real, Vec3};
 
-use super::order::{SpringOrder, SpringQuery};
 use crate::components::Rejected;
+use crate::components::{IndexOrder, IndexedQuery};
 use crate::components::{Kinematic, MassProps, PhysicsSettings, Pose, RigidBody, Static, Velocity};
 use crate::components::{Spring, SpringEnd};
 use crate::integrate::StageCursor;
@@ -31,9 +31,9 @@ type DamperEnds<'w, 's> = Query<
 pub fn damp_springs_start(
     settings: Res<PhysicsSettings>,
     cursor: Res<StageCursor>,
-    springs: SpringQuery<()>,
+    springs: IndexedQuery<Spring, ()>,
     mut bodies: DamperEnds,
-    mut order: Local<SpringOrder>,
+    mut order: Local<IndexOrder>,
 ) {
     let span = cursor.span(&settings);
     if !span.opens_substep {
@@ -50,9 +50,9 @@ pub fn damp_springs_start(
 pub fn damp_springs_end(
     settings: Res<PhysicsSettings>,
     cursor: Res<StageCursor>,
-    springs: SpringQuery<()>,
+    springs: IndexedQuery<Spring, ()>,
     mut bodies: DamperEnds,
-    mut order: Local<SpringOrder>,
+    mut order: Local<IndexOrder>,
 ) {
     let span = cursor.span(&settings);
     if !span.closes_substep {

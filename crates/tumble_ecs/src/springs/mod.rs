@@ -113,7 +113,6 @@
 //! implicit group, over its bodies and springs in entity order).
 
 mod damping;
-mod order;
 mod stiff;
 
 pub use damping::{damp_springs_end, damp_springs_start};
@@ -126,9 +125,6 @@ pub(crate) use stiff::classification_span;
 
 pub(crate) use damping::is_damped;
 
-// Scratch memory of `solve_implicit_springs` and of the damper sweeps, in their signatures; not
-// for game code.
-#[doc(hidden)]
-pub use order::SpringOrder;
+// Scratch memory of `solve_implicit_springs`, in its signature; not for game code.
 #[doc(hidden)]
 pub use stiff::ImplicitScratch;

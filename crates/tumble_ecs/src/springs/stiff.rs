@@ -18,7 +18,7 @@ use crate::components::{
 };
 use crate::integrate::damp;
 
-use super::order::{SpringOrder, SpringQuery};
+use crate::components::{IndexOrder, IndexedQuery};
 
 /// What the classification was made for; a change re-classifies.
 #[derive(Resource, Debug, Clone, Copy, PartialEq)]
@@ -326,7 +326,7 @@ pub struct ImplicitScratch {
     /// Scratch of the sort into entity order.
     order: Vec<u32>,
     /// The implicit springs in entity order.
-    spring_order: SpringOrder,
+    spring_order: IndexOrder,
 }
 
 /// Steps every implicit spring group with the energy-conserving implicit step (see
@@ -462,7 +462,7 @@ impl ImplicitScratch {
     /// Puts the bodies read into `entities` and `all` in entity order and indexes them.
     ///
     /// A group's sums run over its bodies and springs in order, so the order must be a fact of
-    /// the world, not of its storage (see [`SpringOrder`]): entity index order, the order the
+    /// the world, not of its storage (see [`IndexOrder`]): entity index order, the order the
     /// bodies were spawned in (unless an index was reused), the same however the world's
     /// tables came about.
     fn sort_by_entity(&mut self) {
@@ -488,7 +488,7 @@ impl ImplicitScratch {
     /// lays them out group by group: `members` in order of their roots, members in index
     /// order (entity order), by counting sort, one pass over the bodies and one over the
     /// springs whatever the number of groups. Returns the number of groups.
-    fn group_bodies(&mut self, springs: &ImplicitSprings, order: &SpringOrder) -> usize {
+    fn group_bodies(&mut self, springs: &ImplicitSprings, order: &IndexOrder) -> usize {
         order.for_each(springs, |spring| {
             if let (Some(i), Some(j)) = ends_in(&self.index, spring) {
                 let (ri, rj) = (find(&mut self.parent, i), find(&mut self.parent, j));
@@ -536,7 +536,7 @@ impl ImplicitScratch {
     fn group_springs(
         &mut self,
         springs: &ImplicitSprings,
-        order: &SpringOrder,
+        order: &IndexOrder,
         others: &Query<&Pose, (With<RigidBody>, Without<ImplicitBody>)>,
         groups: usize,
     ) {
@@ -580,7 +580,7 @@ impl ImplicitScratch {
 }
 
 /// The springs the implicit step solves.
-type ImplicitSprings<'w, 's> = SpringQuery<'w, 's, With<ImplicitSpring>>;
+type ImplicitSprings<'w, 's> = IndexedQuery<'w, 's, Spring, With<ImplicitSpring>>;
 
 /// A body or spring count as the scratch's `u32` indices store it.
 fn narrow(n: usize) -> u32 {
