@@ -6,8 +6,9 @@ use tumble_core::math::{Real, Vec3};
 use bevy_ecs::prelude::*;
 
 use tumble_core::{Integrator, MassProperties};
-use tumble_ecs::components::SpringTurn;
+use tumble_ecs::components::ImplicitSpring;
 use tumble_ecs::prelude::*;
+use tumble_ecs::springs::{Classification, ClassifiedSpring, classify};
 
 use crate::error::{SaveError, SceneError};
 use crate::format::{SceneFile, WorldDef};
@@ -338,18 +339,14 @@ impl Scene {
     pub fn build(&self) -> BuiltScene {
         let mut world = self.world_for_bodies();
         let loaded = self.loaded_bodies();
-        let turns = self.spring_turns();
-        let kinds = self.body_kinds(&loaded, &turns);
+        let classified = self.classification();
+        let kinds = self.body_kinds(&loaded, &classified);
         let mut bodies: Vec<(String, Entity)> = Vec::with_capacity(kinds.len());
         let mut valid = self.valid_bodies().zip(&self.file.bodies).enumerate();
         for (start, len) in runs(&kinds) {
             let run = (&mut valid).take(len).map(|(i, (body, def))| {
                 bodies.push((def.name.clone(), Entity::PLACEHOLDER));
-                BodySpawn {
-                    body,
-                    loaded: loaded[i],
-                    turn: turns.get(i).copied().flatten(),
-                }
+                body_spawn(body, i, &loaded, &classified)
             });
             let mut spawned = Vec::with_capacity(len);
             spawn_bodies(&mut world, kinds[start], ExactLen(run, len), |e| {
@@ -357,7 +354,7 @@ impl Scene {
             });
             fill_entities(&mut bodies[start..], spawned);
         }
-        self.finish_build(world, bodies)
+        self.finish_build(world, bodies, &classified.implicit_springs)
     }
 
     /// [`build`](Self::build), consuming the scene as the world fills: each body's file model
@@ -365,12 +362,12 @@ impl Scene {
     /// their sum (a million bodies: ≈ 250 MB of file model, ≈ 200 MB of world).
     pub fn into_built(mut self) -> BuiltScene {
         let mut world = self.world_for_bodies();
-        let loaded = self.loaded_bodies();
-        let turns = self.spring_turns();
-        let kinds = self.body_kinds(&loaded, &turns);
         // The forces' file model (names as strings) is not needed once checked: `self.forces`
-        // holds them by index. Dropped before the world grows.
+        // holds them by index. Dropped before anything else is built.
         drop(std::mem::take(&mut self.file.forces));
+        let loaded = self.loaded_bodies();
+        let classified = self.classification();
+        let kinds = self.body_kinds(&loaded, &classified);
         let mut defs = std::mem::take(&mut self.file.bodies);
         let n = defs.len();
         // Popped from the back in file order; the vector is shrunk as it empties, which hands
@@ -387,18 +384,14 @@ impl Scene {
                 if (i + 1) % release_every == 0 {
                     defs.shrink_to_fit();
                 }
-                BodySpawn {
-                    body,
-                    loaded: loaded[i],
-                    turn: turns.get(i).copied().flatten(),
-                }
+                body_spawn(body, i, &loaded, &classified)
             });
             let mut spawned = Vec::with_capacity(len);
             spawn_bodies(&mut world, kinds[start], run, |e| spawned.push(e));
             fill_entities(&mut bodies[start..], spawned);
         }
         drop(defs);
-        self.finish_build(world, bodies)
+        self.finish_build(world, bodies, &classified.implicit_springs)
     }
 
     /// Per body, whether a force generator names it. Such a body is spawned with its
@@ -424,16 +417,17 @@ impl Scene {
     }
 
     /// Per body, the optional components it is spawned with (see [`crate::spawn`]).
-    fn body_kinds(&self, loaded: &[bool], turns: &[Option<SpringTurn>]) -> Vec<BodyKind> {
+    fn body_kinds(&self, loaded: &[bool], classified: &Classification) -> Vec<BodyKind> {
         self.valid_bodies()
             .enumerate()
-            .map(|(i, b)| BodyKind::of(&b, loaded[i], turns.get(i).copied().flatten()))
+            .map(|(i, b)| BodyKind::of(&body_spawn(b, i, loaded, classified)))
             .collect()
     }
 
-    /// Per body, the [`SpringTurn`] the spring classification will put on it (see
-    /// [`Extras`]); empty when the scene has no springs.
-    fn spring_turns(&self) -> Vec<Option<SpringTurn>> {
+    /// The spring classification of the scene's world (see
+    /// [`tumble_ecs::springs::classify`]), so that its bodies and springs are spawned with the
+    /// markers it gives them; empty when the scene has no springs.
+    fn classification(&self) -> Classification {
         let springs = self.forces.iter().filter_map(|f| match *f {
             SceneForce::Spring {
                 a,
@@ -442,17 +436,20 @@ impl Scene {
                 anchor_b,
                 k,
                 ..
-            } => Some([(Some(a), anchor_a, k), (b, anchor_b, k)]),
+            } => Some(ClassifiedSpring {
+                a: Some(a),
+                anchor_a,
+                b,
+                anchor_b,
+                stiffness: k,
+            }),
             _ => None,
         });
         if springs.clone().next().is_none() {
-            return Vec::new();
+            return Classification::default();
         }
         let masses: Vec<MassProps> = self.valid_bodies().map(|b| MassProps(b.mass)).collect();
-        let ends = springs
-            .flatten()
-            .filter_map(|(body, anchor, k)| Some((body?, anchor, k)));
-        tumble_ecs::springs::spring_turns(&masses, ends)
+        classify(&self.settings, &masses, springs)
     }
 
     /// A world with the scene's resources, ready for its bodies.
@@ -466,7 +463,12 @@ impl Scene {
     }
 
     /// Spawns the force generators between the spawned `bodies` and plans the schedule.
-    fn finish_build(&self, mut world: World, bodies: Vec<(String, Entity)>) -> BuiltScene {
+    fn finish_build(
+        &self,
+        mut world: World,
+        bodies: Vec<(String, Entity)>,
+        implicit_springs: &[bool],
+    ) -> BuiltScene {
         let entity = |i: usize| bodies[i].1;
         let constant = |f: &SceneForce| match *f {
             SceneForce::Constant { body, force, point } => Some(ConstantForce {
@@ -483,7 +485,7 @@ impl Scene {
             }),
             _ => None,
         };
-        let spring = |f: &SceneForce| match *f {
+        let spring_of = |f: &SceneForce| match *f {
             SceneForce::Spring {
                 a,
                 anchor_a,
@@ -508,7 +510,18 @@ impl Scene {
             }),
             _ => None,
         };
-        let kinds: Vec<_> = self.forces.iter().map(std::mem::discriminant).collect();
+        // Runs of one kind: of one generator type, springs also of one solve (the
+        // classification's, so that no spring moves to another table when it is planned).
+        let mut spring = 0;
+        let kinds: Vec<_> = (self.forces.iter())
+            .map(|f| {
+                let implicit = matches!(f, SceneForce::Spring { .. }) && {
+                    spring += 1;
+                    implicit_springs.get(spring - 1).copied().unwrap_or(false)
+                };
+                (std::mem::discriminant(f), implicit)
+            })
+            .collect();
         const ONE_KIND: &str = "a run holds one kind of force";
         for (start, len) in runs(&kinds) {
             let run = self.forces[start..start + len].iter();
@@ -519,8 +532,12 @@ impl Scene {
                 SceneForce::Torque { .. } => {
                     batch(&mut world, run.map(|f| torque(f).expect(ONE_KIND)), drop);
                 }
+                SceneForce::Spring { .. } if kinds[start].1 => {
+                    let run = run.map(|f| (spring_of(f).expect(ONE_KIND), ImplicitSpring));
+                    batch(&mut world, run, drop);
+                }
                 SceneForce::Spring { .. } => {
-                    batch(&mut world, run.map(|f| spring(f).expect(ONE_KIND)), drop);
+                    batch(&mut world, run.map(|f| spring_of(f).expect(ONE_KIND)), drop);
                 }
             }
         }
@@ -530,6 +547,22 @@ impl Scene {
             physics,
             bodies,
         }
+    }
+}
+
+/// Body `i` (`body`) as it is spawned: with its accumulator when a generator names it
+/// (`loaded`) and the markers the spring classification gives it.
+fn body_spawn(
+    body: ValidBody,
+    i: usize,
+    loaded: &[bool],
+    classified: &Classification,
+) -> BodySpawn {
+    BodySpawn {
+        body,
+        loaded: loaded[i],
+        turn: classified.turns.get(i).copied().flatten(),
+        implicit: classified.implicit_bodies.get(i).copied().unwrap_or(false),
     }
 }
 

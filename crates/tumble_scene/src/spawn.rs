@@ -4,14 +4,14 @@
 //! spawn) leaves its old table at its size, so a world whose bodies all moved would hold them
 //! twice; and a table grown one spawn at a time doubles, up to twice what it holds. So each
 //! body is spawned with every component it will carry (a [`ForceAccumulator`] when a force
-//! generator names it, its [`GravityScale`], [`Damping`] and the [`SpringTurn`] the spring
-//! classification would give it), and each run of bodies (or of force generators) of one
-//! kind by one `spawn_batch`, which reserves the table once for the whole run. Entities are
-//! spawned in file order, as one `spawn` each would.
+//! generator names it, its [`GravityScale`], [`Damping`], and the [`SpringTurn`] and
+//! [`ImplicitBody`] the spring classification gives it; a spring its `ImplicitSpring`), and each
+//! run of bodies (or of force generators) of one kind by one `spawn_batch`, which reserves the
+//! table once for the whole run. Entities are spawned in file order, as one `spawn` each would.
 
 use bevy_ecs::bundle::NoBundleEffect;
 use bevy_ecs::prelude::*;
-use tumble_ecs::components::SpringTurn;
+use tumble_ecs::components::{ImplicitBody, SpringTurn};
 use tumble_ecs::prelude::*;
 
 use crate::build::ValidBody;
@@ -23,6 +23,8 @@ pub(crate) struct BodySpawn {
     /// generator's hook would otherwise add).
     pub(crate) loaded: bool,
     pub(crate) turn: Option<SpringTurn>,
+    /// In a stiff spring group: spawned with its [`ImplicitBody`].
+    pub(crate) implicit: bool,
 }
 
 /// Which optional components a body carries: bodies of one kind share a table.
@@ -32,16 +34,18 @@ pub(crate) struct BodyKind {
     gravity: bool,
     damping: bool,
     turn: bool,
+    implicit: bool,
 }
 
 impl BodyKind {
-    /// The kind of `body`.
-    pub(crate) fn of(body: &ValidBody, loaded: bool, turn: Option<SpringTurn>) -> Self {
+    /// The kind of `b`.
+    pub(crate) fn of(b: &BodySpawn) -> Self {
         Self {
-            loaded,
-            gravity: body.gravity_scale != 1.0,
-            damping: body.damping != Damping::default(),
-            turn: turn.is_some(),
+            loaded: b.loaded,
+            gravity: b.body.gravity_scale != 1.0,
+            damping: b.body.damping != Damping::default(),
+            turn: b.turn.is_some(),
+            implicit: b.implicit,
         }
     }
 }
@@ -64,7 +68,7 @@ pub(crate) fn spawn_bodies(
         )
     };
     let run = run.inspect(move |b| {
-        debug_assert_eq!(BodyKind::of(&b.body, b.loaded, b.turn), kind);
+        debug_assert_eq!(BodyKind::of(b), kind);
     });
     if kind.loaded {
         with_gravity(
@@ -117,7 +121,25 @@ fn with_turn<B: Bundle<Effect: NoBundleEffect>>(
 ) {
     if kind.turn {
         let turn = |b: &BodySpawn| b.turn.unwrap_or_default();
-        batch(world, run.map(move |b| (bundle(&b), turn(&b))), out);
+        with_implicit(world, kind, run, move |b| (bundle(b), turn(b)), out);
+    } else {
+        with_implicit(world, kind, run, bundle, out);
+    }
+}
+
+fn with_implicit<B: Bundle<Effect: NoBundleEffect>>(
+    world: &mut World,
+    kind: BodyKind,
+    run: impl ExactSizeIterator<Item = BodySpawn>,
+    bundle: impl Fn(&BodySpawn) -> B,
+    out: impl FnMut(Entity),
+) {
+    if kind.implicit {
+        batch(
+            world,
+            run.map(move |b| (bundle(&b), ImplicitBody::default())),
+            out,
+        );
     } else {
         batch(world, run.map(move |b| bundle(&b)), out);
     }

@@ -3,7 +3,7 @@
 //! spring classification changes nothing the spawn decided.
 
 use bevy_ecs::prelude::*;
-use tumble_ecs::components::SpringTurn;
+use tumble_ecs::components::{ImplicitBody, ImplicitSpring, SpringTurn};
 use tumble_ecs::prelude::*;
 use tumble_ecs::springs::classify_springs;
 use tumble_scene::{BuiltScene, Scene};
@@ -11,7 +11,8 @@ use tumble_scene::{BuiltScene, Scene};
 /// `n` bodies of every kind the spawn distinguishes, interleaved (free, damped, scaled, held at
 /// the centre by a spring, turned by springs off-centre), chained by springs off-centre
 /// between the bodies `i ≡ 0 mod 5`, a centred spring on `i ≡ 3`, a world spring on `i ≡ 4`,
-/// a force on `i ≡ 1` and a torque. `grouped`: the bodies in the file sorted by `i mod 5` (each
+/// stiff pairs `(i, i + 5)` for `i ≡ 2 mod 10` (implicit groups), a force on `i ≡ 1` and a
+/// torque. `grouped`: the bodies in the file sorted by `i mod 5` (each
 /// kind one run), else in order (kinds interleaved).
 fn mixed_scene(n: usize, grouped: bool) -> String {
     let mut text = String::from(
@@ -53,6 +54,14 @@ fn mixed_scene(n: usize, grouped: bool) -> String {
         text.push_str(&format!(
             "[[forces]]\ntype = \"spring\"\na = \"b{i}\"\nanchor_a = [0.0, 0.1, 0.0]\n\
              anchor_b = [0.0, 1.0, 0.0]\nstiffness = 7.0\ndamping = 0.2\n"
+        ));
+    }
+    // Stiff pairs (ωΔt ≈ 10: implicit groups) of the gravity-scaled bodies.
+    for i in (2..n.saturating_sub(5)).step_by(10) {
+        text.push_str(&format!(
+            "[[forces]]\ntype = \"spring\"\na = \"b{i}\"\nb = \"b{}\"\nanchor_a = [0.1, 0.0, 0.0]\n\
+             anchor_b = [0.0, 0.1, 0.0]\nstiffness = 1.0e6\nrest_length = 2.4\n",
+            i + 5
         ));
     }
     for i in (1..n).step_by(5) {
@@ -119,21 +128,34 @@ fn a_scene_is_spawned_where_its_rows_stay() {
     }
 }
 
+/// The entities of `world` with `T`, sorted.
+fn with<T: Component>(world: &mut World) -> Vec<Entity> {
+    let mut entities: Vec<Entity> = world
+        .query_filtered::<Entity, With<T>>()
+        .iter(world)
+        .collect();
+    entities.sort_unstable();
+    entities
+}
+
 #[test]
-fn the_spawned_spring_turns_are_the_classifications() {
+fn the_spawned_markers_are_the_classifications() {
     let [mut built, _] = built_both_ways(&mixed_scene(40, false));
     let world = &mut built.world;
-    let spawned: Vec<(Entity, SpringTurn)> = world
+    let mut spawned: Vec<(Entity, SpringTurn)> = world
         .query::<(Entity, &SpringTurn)>()
         .iter(world)
         .map(|(e, t)| (e, *t))
         .collect();
-    let bodies: Vec<Entity> = world
-        .query_filtered::<Entity, With<SpringTurn>>()
-        .iter(world)
-        .collect();
-    for e in bodies {
-        world.entity_mut(e).remove::<SpringTurn>();
+    let (implicit_bodies, implicit_springs) =
+        (with::<ImplicitBody>(world), with::<ImplicitSpring>(world));
+    assert!(implicit_bodies.len() >= 6, "{implicit_bodies:?}");
+    assert_eq!(implicit_springs.len(), implicit_bodies.len() / 2);
+    for e in with::<RigidBody>(world) {
+        world.entity_mut(e).remove::<(SpringTurn, ImplicitBody)>();
+    }
+    for e in with::<Spring>(world) {
+        world.entity_mut(e).remove::<ImplicitSpring>();
     }
     world.remove_resource::<tumble_ecs::springs::SpringClassification>();
     classify_springs(world);
@@ -142,10 +164,11 @@ fn the_spawned_spring_turns_are_the_classifications() {
         .iter(world)
         .map(|(e, t)| (e, *t))
         .collect();
-    let mut spawned = spawned;
     spawned.sort_unstable_by_key(|(e, _)| *e);
     classified.sort_unstable_by_key(|(e, _)| *e);
     assert_eq!(spawned, classified);
+    assert_eq!(implicit_bodies, with::<ImplicitBody>(world));
+    assert_eq!(implicit_springs, with::<ImplicitSpring>(world));
 }
 
 #[test]

@@ -117,8 +117,8 @@ mod stiff;
 
 pub use damping::{damp_springs_end, damp_springs_start};
 pub use stiff::{
-    SpringClassification, classification_is_stale, classify_springs, solve_implicit_springs,
-    spring_turns,
+    Classification, ClassifiedSpring, SpringClassification, classification_is_stale, classify,
+    classify_springs, solve_implicit_springs,
 };
 
 pub(crate) use stiff::classification_span;

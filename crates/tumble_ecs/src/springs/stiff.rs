@@ -89,7 +89,125 @@ fn find(parent: &mut [usize], mut i: usize) -> usize {
     i
 }
 
-/// Decides which spring groups are stepped implicitly and marks them (see the module docs).
+/// A spring as the classification sees it: its ends as indices into the dynamic bodies' masses
+/// (`None`: a world anchor, or a body that is not dynamic), its body-local anchors and its
+/// stiffness.
+#[derive(Debug, Clone, Copy)]
+pub struct ClassifiedSpring {
+    /// The index of end `a`'s body.
+    pub a: Option<usize>,
+    /// End `a`'s anchor, body-local.
+    pub anchor_a: Vec3,
+    /// The index of end `b`'s body.
+    pub b: Option<usize>,
+    /// End `b`'s anchor, body-local (unused for a world anchor).
+    pub anchor_b: Vec3,
+    /// `k` (N/m).
+    pub stiffness: Real,
+}
+
+/// What [`classify`] decides: per spring, whether the implicit step solves it; per body,
+/// whether it is in an implicit group and the [`SpringTurn`] it carries.
+#[derive(Debug, Clone, Default)]
+pub struct Classification {
+    /// Per spring, stepped implicitly.
+    pub implicit_springs: Vec<bool>,
+    /// Per body, in an implicit group.
+    pub implicit_bodies: Vec<bool>,
+    /// Per body, how fast its springs turn it (`None`: they cannot).
+    pub turns: Vec<Option<SpringTurn>>,
+}
+
+/// The spring classification of dynamic bodies of mass `masses` joined by `springs` (given in
+/// entity index order: a body's sums over its springs follow it) under `settings` (see the
+/// module docs). [`classify_springs`] applies it to a world; code that spawns a world whose
+/// springs it knows (a scene file) can spawn each body and spring with the markers it will
+/// carry, so that none moves to another table when the world is planned (a move leaves the
+/// table it left at its size).
+pub fn classify<I>(settings: &PhysicsSettings, masses: &[MassProps], springs: I) -> Classification
+where
+    I: IntoIterator<Item = ClassifiedSpring>,
+    I::IntoIter: Clone,
+{
+    // Walked three times rather than collected: a million springs would be held twice.
+    let springs = springs.into_iter();
+    let dt = classification_span(settings);
+    let mut parent: Vec<usize> = (0..masses.len()).collect();
+    let mut stiff_group = vec![false; masses.len()];
+    let mut spring_root: Vec<Option<u32>> = Vec::new();
+    // Per spring, its inverse effective mass bounds `ι`; per body, `Σ k (ι_a + ι_b)` over its
+    // springs (see the module docs).
+    let bound = |end: Option<usize>, anchor| {
+        end.map_or(0.0, |i| inverse_effective_mass_bound(&masses[i], anchor))
+    };
+    let iotas: Vec<[Real; 2]> = springs
+        .clone()
+        .map(|s| [bound(s.a, s.anchor_a), bound(s.b, s.anchor_b)])
+        .collect();
+    spring_root.reserve_exact(iotas.len());
+    let mut pull: Vec<Real> = vec![0.0; masses.len()];
+    for (spring, iota) in springs.clone().zip(&iotas) {
+        for i in [spring.a, spring.b].into_iter().flatten() {
+            pull[i] += spring.stiffness * (iota[0] + iota[1]);
+        }
+    }
+    let rates = turn_rates(
+        masses,
+        springs.clone().flat_map(|s| {
+            [(s.a, s.anchor_a), (s.b, s.anchor_b)]
+                .into_iter()
+                .filter_map(move |(end, anchor)| Some((end?, anchor, s.stiffness)))
+        }),
+    );
+    for (spring, &iota) in springs.zip(&iotas) {
+        // A body's pull includes this spring's own `k (ι_a + ι_b)`; a spring without a dynamic
+        // end joins no group, and its own bound is all there is.
+        let own = omega_dt_bound(spring.stiffness, iota, dt);
+        let omega_dt = [spring.a, spring.b]
+            .into_iter()
+            .flatten()
+            .map(|i| pull[i].sqrt() * dt)
+            .fold(own, Real::max);
+        let stiff = match settings.springs {
+            SpringSolver::Auto => omega_dt >= IMPLICIT_OMEGA_DT,
+            SpringSolver::Implicit => true,
+            SpringSolver::Explicit => false,
+        };
+        let root = match (spring.a, spring.b) {
+            (Some(i), Some(j)) => {
+                let (ri, rj) = (find(&mut parent, i), find(&mut parent, j));
+                let merged = stiff_group[ri] || stiff_group[rj];
+                parent[ri] = rj;
+                stiff_group[rj] = merged;
+                Some(rj)
+            }
+            (Some(i), None) | (None, Some(i)) => Some(find(&mut parent, i)),
+            (None, None) => None,
+        };
+        if let Some(r) = root {
+            stiff_group[r] |= stiff;
+        }
+        spring_root.push(root.map(|r| r as u32));
+    }
+    let implicit_springs = spring_root
+        .into_iter()
+        .map(|root| root.is_some_and(|r| stiff_group[find(&mut parent, r as usize)]))
+        .collect();
+    let implicit_bodies = (0..masses.len())
+        .map(|i| stiff_group[find(&mut parent, i)])
+        .collect();
+    Classification {
+        implicit_springs,
+        implicit_bodies,
+        turns: rates
+            .into_iter()
+            .map(|rate| (rate > 0.0).then(|| SpringTurn::new(rate)))
+            .collect(),
+    }
+}
+
+/// Decides which spring groups are stepped implicitly and marks them (see the module docs and
+/// [`classify`]).
 pub fn classify_springs(world: &mut World) {
     let settings = world
         .get_resource::<PhysicsSettings>()
@@ -111,89 +229,25 @@ pub fn classify_springs(world: &mut World) {
         index.insert(entity, masses.len());
         masses.push(*mass);
     }
-    let mut parent: Vec<usize> = (0..masses.len()).collect();
-    let mut stiff_group = vec![false; masses.len()];
-    let mut spring_root = Vec::with_capacity(springs.len());
-    // Per spring, its ends (indices in `masses`) and their inverse effective mass bounds `ι`;
-    // per body, `Σ k (ι_a + ι_b)` over its springs (see the module docs).
-    let ends: Vec<(Option<usize>, Option<usize>, [Real; 2])> = springs
-        .iter()
-        .map(|(_, spring)| {
-            let (a, b) = ends_in(&index, spring);
-            let bound = |end: Option<usize>, anchor| {
-                end.map_or(0.0, |i| inverse_effective_mass_bound(&masses[i], anchor))
-            };
-            let anchor_b = match spring.b {
+    let classified = springs.iter().map(|(_, spring)| {
+        let (a, b) = ends_in(&index, spring);
+        ClassifiedSpring {
+            a,
+            anchor_a: spring.anchor_a,
+            b,
+            anchor_b: match spring.b {
                 SpringEnd::Body { anchor, .. } => anchor,
-                SpringEnd::World(_) => tumble_core::math::Vec3::ZERO,
-            };
-            (a, b, [bound(a, spring.anchor_a), bound(b, anchor_b)])
-        })
-        .collect();
-    let mut pull: Vec<Real> = vec![0.0; masses.len()];
-    for ((_, spring), &(a, b, iota)) in springs.iter().zip(&ends) {
-        for i in [a, b].into_iter().flatten() {
-            pull[i] += spring.stiffness * (iota[0] + iota[1]);
+                SpringEnd::World(_) => Vec3::ZERO,
+            },
+            stiffness: spring.stiffness,
         }
-    }
-    let rates = turn_rates(
-        &masses,
-        springs
-            .iter()
-            .zip(&ends)
-            .flat_map(|((_, spring), &(a, b, _))| {
-                let anchor_b = match spring.b {
-                    SpringEnd::Body { anchor, .. } => anchor,
-                    SpringEnd::World(_) => Vec3::ZERO,
-                };
-                [(a, spring.anchor_a), (b, anchor_b)]
-                    .into_iter()
-                    .filter_map(move |(end, anchor)| Some((end?, anchor, spring.stiffness)))
-            }),
-    );
-    for ((_, spring), &(a, b, iota)) in springs.iter().zip(&ends) {
-        // A body's pull includes this spring's own `k (ι_a + ι_b)`; a spring without a dynamic
-        // end joins no group, and its own bound is all there is.
-        let own = omega_dt_bound(spring.stiffness, iota, dt);
-        let omega_dt = [a, b]
-            .into_iter()
-            .flatten()
-            .map(|i| pull[i].sqrt() * dt)
-            .fold(own, Real::max);
-        let stiff = match settings.springs {
-            SpringSolver::Auto => omega_dt >= IMPLICIT_OMEGA_DT,
-            SpringSolver::Implicit => true,
-            SpringSolver::Explicit => false,
-        };
-        let root = match (a, b) {
-            (Some(i), Some(j)) => {
-                let (ri, rj) = (find(&mut parent, i), find(&mut parent, j));
-                let merged = stiff_group[ri] || stiff_group[rj];
-                parent[ri] = rj;
-                stiff_group[rj] = merged;
-                Some(rj)
-            }
-            (Some(i), None) | (None, Some(i)) => Some(find(&mut parent, i)),
-            (None, None) => None,
-        };
-        if let Some(r) = root {
-            stiff_group[r] |= stiff;
-        }
-        spring_root.push(root);
-    }
-    let mut implicit_spring = Vec::with_capacity(springs.len());
-    for root in spring_root {
-        let stiff = root.is_some_and(|r| {
-            let r = find(&mut parent, r);
-            stiff_group[r]
-        });
-        implicit_spring.push(stiff);
-    }
-    let mut implicit_body = vec![false; masses.len()];
-    for (i, flag) in implicit_body.iter_mut().enumerate() {
-        let r = find(&mut parent, i);
-        *flag = stiff_group[r];
-    }
+    });
+    let Classification {
+        implicit_springs: implicit_spring,
+        implicit_bodies: implicit_body,
+        turns,
+    } = classify(&settings, &masses, classified);
+    let rates: Vec<Real> = turns.iter().map(|t| t.map_or(0.0, |t| t.rate())).collect();
     mark_stiff(world, &springs, implicit_spring, &index, &implicit_body);
     // After the implicit markers, in a pass of its own: the order components are added in
     // decides which bodies share a table.
@@ -221,24 +275,6 @@ fn turn_rates(
         *t = t.sqrt();
     }
     turn
-}
-
-/// Per body of `masses` (all dynamic), the [`SpringTurn`] the spring classification puts on
-/// it, given the spring ends `(body, body-local anchor, stiffness)` in the order the springs
-/// will be spawned: `None` where its springs cannot turn it.
-///
-/// For code that spawns a world whose springs it knows (a scene file): a body spawned with
-/// the component it will carry is never moved to another table by the classification (a
-/// move leaves the table it left at its size, so a world whose bodies all moved would hold
-/// their memory twice). The classification computes the same rates and changes nothing.
-pub fn spring_turns(
-    masses: &[MassProps],
-    ends: impl IntoIterator<Item = (usize, Vec3, Real)>,
-) -> Vec<Option<SpringTurn>> {
-    turn_rates(masses, ends)
-        .into_iter()
-        .map(|rate| (rate > 0.0).then(|| SpringTurn::new(rate)))
-        .collect()
 }
 
 /// Puts [`ImplicitSpring`] on the springs and [`ImplicitBody`] on the bodies the classification
