@@ -18,8 +18,8 @@ use crate::text::terminal_safe;
 use crate::validate::{Checker, Locate, NoText, TomlText};
 
 use crate::checks::{
-    bad_name, bad_text, checked_body, compose_names, unknown_name, validate_body, validate_forces,
-    validate_world, wrong_length,
+    bad_name, bad_text, checked_body, checked_extras, compose_names, unknown_name, validate_body,
+    validate_forces, validate_world, wrong_length,
 };
 
 /// A scene that passed every check: it builds a world without failing.
@@ -341,19 +341,11 @@ impl Scene {
         let loaded = self.loaded_bodies();
         let classified = self.classification();
         let kinds = self.body_kinds(&loaded, &classified);
-        let mut bodies: Vec<(String, Entity)> = Vec::with_capacity(kinds.len());
-        let mut valid = self.valid_bodies().zip(&self.file.bodies).enumerate();
-        for (start, len) in runs(&kinds) {
-            let run = (&mut valid).take(len).map(|(i, (body, def))| {
-                bodies.push((def.name.clone(), Entity::PLACEHOLDER));
-                body_spawn(body, i, &loaded, &classified)
-            });
-            let mut spawned = Vec::with_capacity(len);
-            spawn_bodies(&mut world, kinds[start], ExactLen(run, len), |e| {
-                spawned.push(e)
-            });
-            fill_entities(&mut bodies[start..], spawned);
-        }
+        let file = &self.file.name;
+        let bodies = spawn_in_runs(&mut world, &kinds, &loaded, &classified, |i| {
+            let def = &self.file.bodies[i];
+            (def.name.clone(), checked_body(file, i, def))
+        });
         self.finish_build(world, bodies, &classified.implicit_springs)
     }
 
@@ -375,21 +367,14 @@ impl Scene {
         defs.reverse();
         let release_every = (n / 8).max(1 << 16);
         let file = &self.file.name;
-        let mut bodies: Vec<(String, Entity)> = Vec::with_capacity(n);
-        for (start, len) in runs(&kinds) {
-            let run = (start..start + len).map(|i| {
-                let def = defs.pop().expect("one definition per body");
-                let body = checked_body(file, i, &def);
-                bodies.push((def.name, Entity::PLACEHOLDER));
-                if (i + 1) % release_every == 0 {
-                    defs.shrink_to_fit();
-                }
-                body_spawn(body, i, &loaded, &classified)
-            });
-            let mut spawned = Vec::with_capacity(len);
-            spawn_bodies(&mut world, kinds[start], run, |e| spawned.push(e));
-            fill_entities(&mut bodies[start..], spawned);
-        }
+        let bodies = spawn_in_runs(&mut world, &kinds, &loaded, &classified, |i| {
+            let def = defs.pop().expect("one definition per body");
+            let body = checked_body(file, i, &def);
+            if (i + 1) % release_every == 0 {
+                defs.shrink_to_fit();
+            }
+            (def.name, body)
+        });
         drop(defs);
         self.finish_build(world, bodies, &classified.implicit_springs)
     }
@@ -416,11 +401,18 @@ impl Scene {
         loaded
     }
 
-    /// Per body, the optional components it is spawned with (see [`crate::spawn`]).
+    /// Per body, the optional components it is spawned with (see [`crate::spawn`]), from the
+    /// two fields that decide them (not the whole check of each body).
     fn body_kinds(&self, loaded: &[bool], classified: &Classification) -> Vec<BodyKind> {
-        self.valid_bodies()
-            .enumerate()
-            .map(|(i, b)| BodyKind::of(&body_spawn(b, i, loaded, classified)))
+        (self.file.bodies.iter().enumerate())
+            .map(|(i, def)| {
+                BodyKind::new(
+                    loaded[i],
+                    checked_extras(&self.file.name, i, def),
+                    classified.turns.get(i).copied().flatten(),
+                    classified.implicit_bodies.get(i).copied().unwrap_or(false),
+                )
+            })
             .collect()
     }
 
@@ -577,30 +569,30 @@ fn runs<K: PartialEq>(kinds: &[K]) -> impl Iterator<Item = (usize, usize)> + '_ 
     })
 }
 
-/// Writes the entities of a run, spawned in order, beside the names pushed for it.
-fn fill_entities(bodies: &mut [(String, Entity)], spawned: Vec<Entity>) {
-    debug_assert!(spawned.len() <= bodies.len());
-    for (slot, entity) in bodies.iter_mut().zip(spawned) {
-        slot.1 = entity;
+/// Spawns the bodies in file order, each run of one kind (`kinds`, per body) by one batch;
+/// `next(i)` gives body `i`'s name and checked body, once per body, in order.
+fn spawn_in_runs(
+    world: &mut World,
+    kinds: &[BodyKind],
+    loaded: &[bool],
+    classified: &Classification,
+    mut next: impl FnMut(usize) -> (String, ValidBody),
+) -> Vec<(String, Entity)> {
+    let mut bodies: Vec<(String, Entity)> = Vec::with_capacity(kinds.len());
+    for (start, len) in runs(kinds) {
+        let run = (start..start + len).map(|i| {
+            let (name, body) = next(i);
+            bodies.push((name, Entity::PLACEHOLDER));
+            body_spawn(body, i, loaded, classified)
+        });
+        let mut spawned = Vec::with_capacity(len);
+        spawn_bodies(world, kinds[start], run, |e| spawned.push(e));
+        for (slot, entity) in bodies[start..].iter_mut().zip(spawned) {
+            slot.1 = entity;
+        }
     }
+    bodies
 }
-
-/// An iterator whose length is known (`len` items) but whose adapters do not say so.
-struct ExactLen<I>(I, usize);
-
-impl<I: Iterator> Iterator for ExactLen<I> {
-    type Item = I::Item;
-    fn next(&mut self) -> Option<I::Item> {
-        let item = self.0.next()?;
-        self.1 = self.1.saturating_sub(1);
-        Some(item)
-    }
-    fn size_hint(&self) -> (usize, Option<usize>) {
-        (self.1, Some(self.1))
-    }
-}
-
-impl<I: Iterator> ExactSizeIterator for ExactLen<I> {}
 
 impl BuiltScene {
     /// Advances the world by one step (the schedule once per stage, re-planned first if the

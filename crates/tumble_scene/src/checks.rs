@@ -209,8 +209,7 @@ pub(crate) fn validate_body(
     let velocity = Velocity { linear, angular };
     check_kinetic_energy(ck, i, &mass, rotation, &velocity)?;
     check_locked_axis_rates(ck, i, &mass, rotation, angular)?;
-    let gravity_scale = ck.scalar(t, Some(i), "gravity_scale", b.gravity_scale)?;
-    let damping = body_damping(ck, i, b)?;
+    let (gravity_scale, damping) = body_extras(ck, i, b)?;
     Ok(ValidBody {
         mass,
         transform: Pose {
@@ -220,6 +219,28 @@ pub(crate) fn validate_body(
         velocity,
         gravity_scale,
         damping,
+    })
+}
+
+/// The body's gravity scale and damping, checked: the part of [`validate_body`] that decides
+/// which optional components the body is spawned with.
+pub(crate) fn body_extras(
+    ck: &Checker<'_>,
+    i: usize,
+    b: &BodyDef,
+) -> Result<(Real, Damping), SceneError> {
+    let gravity_scale = ck.scalar("bodies", Some(i), "gravity_scale", b.gravity_scale)?;
+    Ok((gravity_scale, body_damping(ck, i, b)?))
+}
+
+/// [`body_extras`] of a body that passed [`validate_body`] when the scene was parsed.
+pub(crate) fn checked_extras(file: &str, i: usize, def: &BodyDef) -> (Real, Damping) {
+    let ck = Checker {
+        file,
+        locate: &NoText,
+    };
+    body_extras(&ck, i, def).unwrap_or_else(|e| {
+        unreachable!("body {i} passed this check when the scene was parsed: {e}")
     })
 }
 

@@ -11,6 +11,7 @@
 
 use bevy_ecs::bundle::NoBundleEffect;
 use bevy_ecs::prelude::*;
+use tumble_core::math::Real;
 use tumble_ecs::components::{ImplicitBody, SpringTurn};
 use tumble_ecs::prelude::*;
 
@@ -38,15 +39,30 @@ pub(crate) struct BodyKind {
 }
 
 impl BodyKind {
-    /// The kind of `b`.
-    pub(crate) fn of(b: &BodySpawn) -> Self {
+    /// The kind of a body with these components (`loaded`: with an accumulator).
+    pub(crate) fn new(
+        loaded: bool,
+        (gravity_scale, damping): (Real, Damping),
+        turn: Option<SpringTurn>,
+        implicit: bool,
+    ) -> Self {
         Self {
-            loaded: b.loaded,
-            gravity: b.body.gravity_scale != 1.0,
-            damping: b.body.damping != Damping::default(),
-            turn: b.turn.is_some(),
-            implicit: b.implicit,
+            loaded,
+            gravity: gravity_scale != 1.0,
+            damping: damping != Damping::default(),
+            turn: turn.is_some(),
+            implicit,
         }
+    }
+
+    /// The kind of `b`.
+    fn of(b: &BodySpawn) -> Self {
+        Self::new(
+            b.loaded,
+            (b.body.gravity_scale, b.body.damping),
+            b.turn,
+            b.implicit,
+        )
     }
 }
 

@@ -247,11 +247,10 @@ pub fn classify_springs(world: &mut World) {
         implicit_bodies: implicit_body,
         turns,
     } = classify(&settings, &masses, classified);
-    let rates: Vec<Real> = turns.iter().map(|t| t.map_or(0.0, |t| t.rate())).collect();
     mark_stiff(world, &springs, implicit_spring, &index, &implicit_body);
     // After the implicit markers, in a pass of its own: the order components are added in
     // decides which bodies share a table.
-    mark_turn_rates(world, &index, &rates);
+    mark_turn_rates(world, &index, &turns);
     let springs = spring_count(world);
     world.insert_resource(SpringClassification {
         dt,
@@ -306,20 +305,20 @@ fn mark_stiff(
     }
 }
 
-/// Puts a [`SpringTurn`] with its rate on every dynamic body of `index` whose springs can turn
-/// it (`rates` per body, 0 for none), and takes it off the others.
-fn mark_turn_rates(world: &mut World, index: &EntityHashMap<usize>, rates: &[Real]) {
+/// Puts its [`SpringTurn`] on every dynamic body of `index` whose springs can turn it (`turns`
+/// per body), and takes it off the others.
+fn mark_turn_rates(world: &mut World, index: &EntityHashMap<usize>, turns: &[Option<SpringTurn>]) {
     for entity in rigid_bodies(world) {
-        let rate = index.get(&entity).map_or(0.0, |&i| rates[i]);
-        match (rate > 0.0, world.get::<SpringTurn>(entity).copied()) {
-            (true, Some(turn)) if turn.rate() == rate => {}
-            (true, _) => {
-                world.entity_mut(entity).insert(SpringTurn::new(rate));
+        let turn = index.get(&entity).and_then(|&i| turns[i]);
+        match (turn, world.get::<SpringTurn>(entity).copied()) {
+            (Some(turn), Some(has)) if has == turn => {}
+            (Some(turn), _) => {
+                world.entity_mut(entity).insert(turn);
             }
-            (false, Some(_)) => {
+            (None, Some(_)) => {
                 world.entity_mut(entity).remove::<SpringTurn>();
             }
-            (false, None) => {}
+            (None, None) => {}
         }
     }
 }
