@@ -204,11 +204,11 @@ const PINNED_F32: &[(&str, &str)] = &[
     ),
     ("lclamp", "33a8d5341c85fc24c4bfaa47948d3a80"),
     ("implicit-gyroscopic", "42d27c6e4bdeebca8938e054393d0102"),
-    ("splitting", "eeb058f6046b0250a9c2196d0a8f8f6c"),
-    ("splitting-xyz", "16c8135b2e93689eeb2b58f040adfe40"),
+    ("splitting", "2c0a57d3fee03b6ffd1b9d50ad299210"),
+    ("splitting-xyz", "4a5ce3a690b80d269e43170e4eb54df2"),
     ("yoshida4", "ea227359d32e9094363db7a11b72e5f9"),
-    ("rk4", "e24f60f5f31faa6ae826fbaf9a985f3e"),
-    ("exact", "b288e9da6775bed14a971a5a097ae68d"),
+    ("rk4", "8b5c53f9c1c47ffb9de573941458206c"),
+    ("exact", "70251f93a28d3d254f71bd5ba7797f8b"),
     ("exact4", "2bcecce17b7e2aeb0ea173aacb683fbd"),
 ];
 /// `f64` build (with or without `enhanced-determinism`).
@@ -220,11 +220,11 @@ const PINNED_F64: &[(&str, &str)] = &[
     ),
     ("lclamp", "04e38e84b4683986577a1e84a54b3336"),
     ("implicit-gyroscopic", "575d1d8020fdddeb7d1612b54e845d5d"),
-    ("splitting", "f50696a3013a88d4f583a155ea12c1b0"),
-    ("splitting-xyz", "fe634de7f704e71f6caef79fea00601c"),
+    ("splitting", "6337705cbda60bdaa0afc714bc49f031"),
+    ("splitting-xyz", "525f6ecca8cd3c0120dc50d37b61b62f"),
     ("yoshida4", "7fe2f6c503ece11d652ab72ea66c6776"),
-    ("rk4", "5eba9ec32457e8e29d51b3e221e766de"),
-    ("exact", "094a7dcf5af2d0a78e607b9ef577b353"),
+    ("rk4", "0eaf6e9d34be52bcb301a1b7ab77672d"),
+    ("exact", "2c695cd50aaae5c4d63cc192057bd1e5"),
     ("exact4", "1babf66e140375a74f7b561db2b2b869"),
 ];
 

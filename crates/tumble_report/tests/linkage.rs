@@ -4,7 +4,7 @@
 //! bit for bit.
 
 use bevy_ecs::prelude::*;
-use tumble_core::math::{Real, Vec3, Widen, to_f64};
+use tumble_core::math::{DOUBLE_PRECISION, Real, Vec3, Widen, to_f64};
 use tumble_core::{Integrator, Mass, MassProperties};
 use tumble_ecs::prelude::*;
 use tumble_report::linkage::{HORIZON, REFERENCE_STEPS, Ref, error, reference, world};
@@ -259,7 +259,16 @@ fn implicit_springs_keep_the_order_with_forces_at_points() {
     };
     let slopes = |e: &[f64]| -> Vec<f64> { e.windows(2).map(|w| (w[0] / w[1]).log2()).collect() };
     let s = errors(Integrator::Splitting, &[20, 40, 80, 160]);
-    let y = errors(Integrator::Yoshida4, &[20, 40, 80]);
+    // In `f32` the error at 80 steps (1.2e-4 in `f64`) is at the floor of the state's rounding,
+    // which the linkage's motion amplifies: ε-level variants of the implicit step's rounding
+    // correction (none, or scaling the motion relative to the centre's translation or to the
+    // whole rigid motion) give 1.1e-4–1.7e-4 there, so the slope is taken above it (at 10
+    // steps the error is not yet asymptotic: slope 3.0 from 10 to 20 steps).
+    let y = if DOUBLE_PRECISION {
+        errors(Integrator::Yoshida4, &[20, 40, 80])
+    } else {
+        errors(Integrator::Yoshida4, &[20, 40])
+    };
     eprintln!("implicit splitting {s:?} {:?}", slopes(&s));
     eprintln!("implicit yoshida4 {y:?} {:?}", slopes(&y));
     for slope in slopes(&s) {
