@@ -28,9 +28,7 @@ use super::lclamp::clamped_kick;
 use super::symplectic_euler::explicit_kick;
 use crate::mass::MassProperties;
 use crate::math::{Quat, Real, Vec3, Widen};
-#[cfg(target_arch = "x86_64")]
-use crate::simd::{Avx2, Avx4, Avx8, Avx512};
-use crate::simd::{F64x4, Kernel, LANES, Lane, Pair, Portable, sin_cos};
+use crate::simd::{Kernel, LANES, Lane, LaneKernel, run_on, sin_cos};
 use crate::state::{BodyState, Wrench};
 
 /// Which of the four kick–drift methods a kernel runs.
@@ -210,10 +208,12 @@ pub(super) fn kick_drift_lanes(
     // One compilation of the kernel per method, its method a constant (as for the symmetric
     // kernel's flows).
     match method {
-        KickDrift::Explicit => lanes_of::<EXPLICIT>(kernel, inputs, h),
-        KickDrift::ExplicitLinear => lanes_of::<EXPLICIT_LINEAR>(kernel, inputs, h),
-        KickDrift::Clamped => lanes_of::<CLAMPED>(kernel, inputs, h),
-        KickDrift::Implicit => lanes_of::<IMPLICIT>(kernel, inputs, h),
+        KickDrift::Explicit => run_on(kernel, KickDriftLanes::<EXPLICIT> { inputs, h }),
+        KickDrift::ExplicitLinear => {
+            run_on(kernel, KickDriftLanes::<EXPLICIT_LINEAR> { inputs, h })
+        }
+        KickDrift::Clamped => run_on(kernel, KickDriftLanes::<CLAMPED> { inputs, h }),
+        KickDrift::Implicit => run_on(kernel, KickDriftLanes::<IMPLICIT> { inputs, h }),
     }
 }
 
@@ -234,73 +234,30 @@ fn method_of<const METHOD: u8>() -> KickDrift {
     }
 }
 
-/// [`kick_drift_lanes`] for the method `METHOD`.
-#[inline(always)]
-fn lanes_of<const METHOD: u8>(
-    kernel: Kernel,
-    inputs: &LaneInputs,
+/// The batch of [`kick_drift_lanes`] for the method `METHOD`.
+struct KickDriftLanes<'a, const METHOD: u8> {
+    inputs: &'a LaneInputs,
     h: [Real; LANES],
-) -> RotatedLanes {
-    match kernel {
-        Kernel::Portable => kick_drift_lanes_in::<F64x4, METHOD>(Portable, inputs, h),
-        #[cfg(target_arch = "x86_64")]
-        #[expect(
-            unsafe_code,
-            reason = "a call into code compiled for AVX2, proven by the token"
-        )]
-        // SAFETY: the `Avx2` token exists, so the CPU has AVX2, the only requirement of calling
-        // a function compiled with `#[target_feature(enable = "avx2")]`.
-        Kernel::Avx2(cpu) => unsafe { kick_drift_lanes_avx2::<METHOD>(cpu, inputs, h) },
-        #[cfg(target_arch = "x86_64")]
-        #[expect(
-            unsafe_code,
-            reason = "a call into code compiled for AVX-512F, proven by the token"
-        )]
-        // SAFETY: the `Avx512` token exists, so the CPU has AVX-512F, the only requirement of
-        // calling a function compiled with `#[target_feature(enable = "avx512f")]`.
-        Kernel::Avx512(cpu) => unsafe { kick_drift_lanes_avx512::<METHOD>(cpu, inputs, h) },
+}
+
+impl<const METHOD: u8> LaneKernel for KickDriftLanes<'_, METHOD> {
+    type Output = RotatedLanes;
+
+    /// Runs the kernel over the batch in runs of `T::WIDTH` bodies.
+    #[inline(always)]
+    fn run<T: Lane>(self, cpu: T::Cpu) -> RotatedLanes {
+        let method = method_of::<METHOD>();
+        let mut out = RotatedLanes::new();
+        let mut start = 0;
+        while start < LANES {
+            let input = self.inputs.load::<T>(cpu, start, false, true, true);
+            let h = T::load_real(cpu, &self.h[start..]);
+            let (q, w) = kick_drift_rotation::<T>(&input, h, method);
+            out.store(start, q, w);
+            start += T::WIDTH;
+        }
+        out
     }
-}
-
-/// The kernel compiled with AVX-512F enabled, on one 512-bit register ([`Avx8`]).
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f")]
-fn kick_drift_lanes_avx512<const METHOD: u8>(
-    cpu: Avx512,
-    inputs: &LaneInputs,
-    h: [Real; LANES],
-) -> RotatedLanes {
-    kick_drift_lanes_in::<Avx8, METHOD>(cpu, inputs, h)
-}
-
-/// The kernel compiled with AVX2 enabled: eight bodies as two 256-bit registers side by side.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-fn kick_drift_lanes_avx2<const METHOD: u8>(
-    cpu: Avx2,
-    inputs: &LaneInputs,
-    h: [Real; LANES],
-) -> RotatedLanes {
-    kick_drift_lanes_in::<Pair<Avx4>, METHOD>(cpu, inputs, h)
-}
-
-/// Runs the kernel over the batch in runs of `T::WIDTH` bodies.
-#[inline(always)]
-fn kick_drift_lanes_in<T: Lane, const METHOD: u8>(
-    cpu: T::Cpu,
-    inputs: &LaneInputs,
-    h: [Real; LANES],
-) -> RotatedLanes {
-    let method = method_of::<METHOD>();
-    let mut out = RotatedLanes::new();
-    let mut start = 0;
-    while start < LANES {
-        let input = inputs.load::<T>(cpu, start, false, true, true);
-        let (q, w) = kick_drift_rotation::<T>(&input, T::load_real(cpu, &h[start..]), method);
-        out.store(start, q, w);
-        start += T::WIDTH;
-    }
-    out
 }
 
 #[cfg(test)]

@@ -27,11 +27,7 @@ use super::lanes::{Quat4, Rotor, Vec3L, conjugate, mul, rotate};
 use super::rk4::rk4_flow;
 use crate::mass::MassProperties;
 use crate::math::{Quat, Real, Vec3, Widen};
-#[cfg(target_arch = "x86_64")]
-use crate::simd::{Avx2, Avx4, Avx8, Avx512};
-use crate::simd::{
-    Counted, F64x4, Kernel, LANES, Lane, OpCounts, Pair, Portable, counted, sin_cos,
-};
+use crate::simd::{Counted, Kernel, LANES, Lane, LaneKernel, OpCounts, counted, run_on, sin_cos};
 
 /// `(sin θ/2, cos θ/2)` of `angle` θ, and `(cos θ, sin θ)` from them by the double-angle
 /// formulas.
@@ -349,10 +345,16 @@ pub(super) fn rotate_symmetric_lanes(
     // rows of `tumble bench`).
     let kicks = flow.kicks();
     match flow {
-        LaneFlow::Symmetric { .. } => lanes_of::<SYMMETRIC>(kernel, inputs, h, kicks, &[]),
-        LaneFlow::Composed(weights) => lanes_of::<COMPOSED>(kernel, inputs, h, kicks, weights),
-        LaneFlow::Xyz { .. } => lanes_of::<XYZ>(kernel, inputs, h, kicks, &[]),
-        LaneFlow::Rk4 { .. } => lanes_of::<RK4>(kernel, inputs, h, kicks, &[]),
+        LaneFlow::Symmetric { .. } => run_on(
+            kernel,
+            SymmetricLanes::<SYMMETRIC>::new(inputs, h, kicks, &[]),
+        ),
+        LaneFlow::Composed(weights) => run_on(
+            kernel,
+            SymmetricLanes::<COMPOSED>::new(inputs, h, kicks, weights),
+        ),
+        LaneFlow::Xyz { .. } => run_on(kernel, SymmetricLanes::<XYZ>::new(inputs, h, kicks, &[])),
+        LaneFlow::Rk4 { .. } => run_on(kernel, SymmetricLanes::<RK4>::new(inputs, h, kicks, &[])),
     }
 }
 
@@ -373,92 +375,47 @@ fn flow_of<const KIND: u8>(kicks: bool, weights: &'static [Real]) -> LaneFlow {
     }
 }
 
-/// [`rotate_symmetric_lanes`] for the flows of kind `KIND`.
-#[inline(always)]
-fn lanes_of<const KIND: u8>(
-    kernel: Kernel,
-    inputs: &LaneInputs,
+/// The batch of [`rotate_symmetric_lanes`] for the flows of kind `KIND`.
+struct SymmetricLanes<'a, const KIND: u8> {
+    inputs: &'a LaneInputs,
     h: [Real; LANES],
     kicks: bool,
     weights: &'static [Real],
-) -> RotatedLanes {
-    match kernel {
-        // Not paired: `wide`'s `f64x4` is already two SSE2 registers side by side, and a pair of
-        // them spills so many values to the stack that it loses to one run of four (the
-        // kernel rows of `tumble bench`).
-        Kernel::Portable => {
-            rotate_symmetric_lanes_in::<F64x4, KIND>(Portable, inputs, h, kicks, weights)
+}
+
+impl<'a, const KIND: u8> SymmetricLanes<'a, KIND> {
+    #[inline(always)]
+    fn new(
+        inputs: &'a LaneInputs,
+        h: [Real; LANES],
+        kicks: bool,
+        weights: &'static [Real],
+    ) -> Self {
+        Self {
+            inputs,
+            h,
+            kicks,
+            weights,
         }
-        #[cfg(target_arch = "x86_64")]
-        #[expect(
-            unsafe_code,
-            reason = "a call into code compiled for AVX2, proven by the token"
-        )]
-        // SAFETY: the `Avx2` token exists, so the CPU has AVX2, the only requirement of calling
-        // a function compiled with `#[target_feature(enable = "avx2")]`.
-        Kernel::Avx2(cpu) => unsafe {
-            rotate_symmetric_lanes_avx2::<KIND>(cpu, inputs, h, kicks, weights)
-        },
-        #[cfg(target_arch = "x86_64")]
-        #[expect(
-            unsafe_code,
-            reason = "a call into code compiled for AVX-512F, proven by the token"
-        )]
-        // SAFETY: the `Avx512` token exists, so the CPU has AVX-512F, the only requirement of
-        // calling a function compiled with `#[target_feature(enable = "avx512f")]`.
-        Kernel::Avx512(cpu) => unsafe {
-            rotate_symmetric_lanes_avx512::<KIND>(cpu, inputs, h, kicks, weights)
-        },
     }
 }
 
-/// The kernel compiled with AVX-512F enabled, on one 512-bit register ([`Avx8`]).
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f")]
-fn rotate_symmetric_lanes_avx512<const KIND: u8>(
-    cpu: Avx512,
-    inputs: &LaneInputs,
-    h: [Real; LANES],
-    kicks: bool,
-    weights: &'static [Real],
-) -> RotatedLanes {
-    rotate_symmetric_lanes_in::<Avx8, KIND>(cpu, inputs, h, kicks, weights)
-}
+impl<const KIND: u8> LaneKernel for SymmetricLanes<'_, KIND> {
+    type Output = RotatedLanes;
 
-/// The kernel compiled with AVX2 enabled: eight bodies as two 256-bit registers side by side
-/// ([`Pair`] of [`Avx4`]). The pair spills some values to the stack, yet it beats two runs of
-/// four one after the other per body-step (the kernel rows of `tumble bench`): each run's chain
-/// of four dependent rotations leaves the core idle, and the other run fills it.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-fn rotate_symmetric_lanes_avx2<const KIND: u8>(
-    cpu: Avx2,
-    inputs: &LaneInputs,
-    h: [Real; LANES],
-    kicks: bool,
-    weights: &'static [Real],
-) -> RotatedLanes {
-    rotate_symmetric_lanes_in::<Pair<Avx4>, KIND>(cpu, inputs, h, kicks, weights)
-}
-
-/// Runs the kernel over the batch in runs of `T::WIDTH` bodies: loads each input component of a
-/// run with one vector load, rotates, rounds the results to the engine precision.
-#[inline(always)]
-fn rotate_symmetric_lanes_in<T: Lane, const KIND: u8>(
-    cpu: T::Cpu,
-    inputs: &LaneInputs,
-    h: [Real; LANES],
-    kicks: bool,
-    weights: &'static [Real],
-) -> RotatedLanes {
-    let flow = flow_of::<KIND>(kicks, weights);
-    let mut out = RotatedLanes::new();
-    let mut start = 0;
-    while start < LANES {
-        rotate_run::<T>(cpu, inputs, &h, start, flow, &mut out);
-        start += T::WIDTH;
+    /// Runs the kernel over the batch in runs of `T::WIDTH` bodies: loads each input component
+    /// of a run with one vector load, rotates, rounds the results to the engine precision.
+    #[inline(always)]
+    fn run<T: Lane>(self, cpu: T::Cpu) -> RotatedLanes {
+        let flow = flow_of::<KIND>(self.kicks, self.weights);
+        let mut out = RotatedLanes::new();
+        let mut start = 0;
+        while start < LANES {
+            rotate_run::<T>(cpu, self.inputs, &self.h, start, flow, &mut out);
+            start += T::WIDTH;
+        }
+        out
     }
-    out
 }
 
 /// The kernel on bodies `start .. start + T::WIDTH` of the batch.

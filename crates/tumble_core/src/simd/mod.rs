@@ -30,6 +30,7 @@ mod avx2;
 #[cfg(target_arch = "x86_64")]
 mod avx512;
 mod counting;
+mod dispatch;
 mod pair;
 mod path;
 mod portable;
@@ -41,6 +42,7 @@ pub(crate) use avx2::{Avx2, Avx4};
 pub(crate) use avx512::{Avx8, Avx512};
 pub use counting::OpCounts;
 pub(crate) use counting::{Counted, counted};
+pub(crate) use dispatch::{LaneKernel, run_on};
 pub(crate) use pair::Pair;
 pub(crate) use path::Kernel;
 pub use path::{KERNEL_ENV, KernelError, KernelPath, kernel_path};
