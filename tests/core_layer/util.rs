@@ -1,4 +1,4 @@
-//! Helpers shared by the core-layer tests.
+//! Helpers shared by the cross-crate tests.
 
 use tumble::bevy_ecs::prelude::*;
 use tumble::math::Real;
@@ -40,9 +40,4 @@ pub(crate) fn spawn_body(
     extra: impl Bundle,
 ) -> Entity {
     world.spawn((RigidBody, mass_props(m, inertia), extra)).id()
-}
-
-/// Relative difference `|a − b| / |b|` in f64.
-pub(crate) fn rel(a: f64, b: f64) -> f64 {
-    (a - b).abs() / b.abs()
 }

@@ -1,9 +1,9 @@
-//! The engine's precision (`tumble::math::Real`): the feature `f64` switches every component,
+//! The engine's precision (`tumble_core::math::Real`): the feature `f64` switches every component,
 //! resource and state to double precision, and far from the origin that is what keeps a body
 //! moving at all.
 
-use tumble::math::{DOUBLE_PRECISION, Quat, Real, Vec3, to_f64};
-use tumble::prelude::*;
+use tumble_core::math::{DOUBLE_PRECISION, Quat, Real, Vec3, to_f64};
+use tumble_ecs::prelude::*;
 
 use super::util::{mass_props, run, world_with};
 

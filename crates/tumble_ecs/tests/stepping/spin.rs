@@ -1,17 +1,17 @@
 //! A spin about a principal axis stays a spin about that axis, at constant rate, and the pose
 //! follows the exact rotation `q(t) = exp(½ t ω) q₀`.
 
-use tumble::glam::{DQuat, DVec3};
-use tumble::math::{Quat, Real, Vec3, Widen, to_f64};
-use tumble::prelude::*;
+use glam::{DQuat, DVec3};
+use tumble_core::math::{Quat, Real, Vec3, Widen, to_f64};
+use tumble_ecs::prelude::*;
 
 use super::util::{run, world_with};
 
 /// Spins a body (rotated, with a rotated principal frame) about principal axis `axis` and checks
 /// rate and pose after `steps` steps.
 fn check_principal_spin(integrator: Integrator, axis: Vec3, rate: Real, dt: Real, steps: usize) {
-    let principal_frame = Quat::from_euler(tumble::glam::EulerRot::XYZ, 0.3, -0.7, 1.1);
-    let q0 = Quat::from_euler(tumble::glam::EulerRot::ZYX, -0.4, 0.2, 0.9);
+    let principal_frame = Quat::from_euler(glam::EulerRot::XYZ, 0.3, -0.7, 1.1);
+    let q0 = Quat::from_euler(glam::EulerRot::ZYX, -0.4, 0.2, 0.9);
     let mass = MassProperties::new(Mass::new(3.0).unwrap(), Vec3::new(1.0, 2.0, 3.0))
         .unwrap()
         .with_principal_frame(principal_frame)
@@ -38,7 +38,7 @@ fn check_principal_spin(integrator: Integrator, axis: Vec3, rate: Real, dt: Real
         (w - omega).length()
     );
     let q = world
-        .get::<tumble::ecs::components::Pose>(id)
+        .get::<tumble_ecs::components::Pose>(id)
         .unwrap()
         .rotation;
     let omega64 = omega.widen();

@@ -1,9 +1,9 @@
 //! Bad data is rejected with a typed error naming the entity, and never harms another body.
 
-use tumble::bevy_ecs::prelude::*;
-use tumble::math::{Quat, Real, Vec3};
+use bevy_ecs::prelude::*;
+use tumble_core::math::{Quat, Real, Vec3};
 
-use tumble::prelude::*;
+use tumble_ecs::prelude::*;
 
 use super::util::{mass_props, run_steps, spawn_body, world_with};
 
@@ -166,7 +166,7 @@ fn non_unit_and_zero_quaternions_on_insert() {
                     k,
                     BodyErrorKind::Invalid {
                         component: "Pose",
-                        source: tumble::core::InvalidInput::NonUnitQuaternion { .. }
+                        source: tumble_core::InvalidInput::NonUnitQuaternion { .. }
                     }
                 )
             },
@@ -274,7 +274,7 @@ fn bad_time_steps_are_rejected() {
     for dt in [0.0, -0.01, Real::NAN, Real::INFINITY, Real::NEG_INFINITY] {
         let err = PhysicsSettings::new(dt, Integrator::SymplecticEuler).unwrap_err();
         assert!(
-            matches!(err, tumble::core::InvalidInput::NonPositiveTimeStep(_)),
+            matches!(err, tumble_core::InvalidInput::NonPositiveTimeStep(_)),
             "{dt}"
         );
         let mut settings = PhysicsSettings::default();
@@ -289,7 +289,7 @@ fn bad_time_steps_are_rejected() {
 
 #[test]
 fn bad_mass_data_cannot_be_constructed() {
-    use tumble::core::InvalidInput;
+    use tumble_core::InvalidInput;
     assert_eq!(Mass::new(-2.0), Err(InvalidInput::NonPositiveMass(-2.0)));
     assert!(matches!(
         Mass::new(0.0),

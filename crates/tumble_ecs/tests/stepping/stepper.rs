@@ -1,7 +1,7 @@
 //! Fixed step for variable frame times: accumulator, step cap, interpolation factor.
 
-use tumble::math::{Quat, Real, Vec3, to_f64};
-use tumble::prelude::*;
+use tumble_core::math::{Quat, Real, Vec3, to_f64};
+use tumble_ecs::prelude::*;
 
 #[test]
 fn accumulates_partial_frames() {

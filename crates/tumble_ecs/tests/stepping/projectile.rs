@@ -1,10 +1,10 @@
 //! Symplectic Euler under constant gravity follows the discrete formula
 //! `x_n = x₀ + v₀ nΔt + g Δt² n(n+1)/2` (kick before drift), to f32 round-off.
 
-use tumble::bevy_ecs::prelude::*;
-use tumble::glam::DVec3;
-use tumble::math::{Real, Vec3, Widen, to_f64};
-use tumble::prelude::*;
+use bevy_ecs::prelude::*;
+use glam::DVec3;
+use tumble_core::math::{Real, Vec3, Widen, to_f64};
+use tumble_ecs::prelude::*;
 
 use super::util::{mass_props, rel, run, world_with};
 

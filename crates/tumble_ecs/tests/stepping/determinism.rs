@@ -1,8 +1,8 @@
 //! The same inputs give bit-identical results, run after run.
 
-use tumble::core::integrate::{ExactSwitch, FreeFlow};
-use tumble::math::{DOUBLE_PRECISION, Quat, Real, Vec3, Widen};
-use tumble::prelude::*;
+use tumble_core::integrate::{ExactSwitch, FreeFlow};
+use tumble_core::math::{DOUBLE_PRECISION, Quat, Real, Vec3, Widen};
+use tumble_ecs::prelude::*;
 
 use super::util::{mass_props, run, world_with};
 
@@ -68,7 +68,7 @@ fn two_runs_are_bit_identical() {
 
 #[test]
 fn ecs_matches_the_raw_loop_bit_for_bit() {
-    use tumble::prelude::{BodyState, Wrench};
+    use tumble_core::{BodyState, Wrench};
     // A torque driven tumbling body and a free one, through the ECS and through the core API.
     for integrator in Integrator::ALL.iter().copied() {
         let dt = 1.0 / 120.0;
@@ -195,7 +195,7 @@ fn one_and_several_threads_give_identical_bits() {
         min_batch: 64,
     };
     if std::thread::available_parallelism().map_or(1, |n| n.get()) >= 2 {
-        assert!(tumble::ecs::parallel::pool_threads() >= 2 || !cfg!(feature = "parallel"));
+        assert!(tumble_ecs::parallel::pool_threads() >= 2 || !cfg!(feature = "parallel"));
     }
     for integrator in [Integrator::Splitting, Integrator::SymplecticEuler] {
         let single = big_world_bits(Parallelism::SINGLE_THREAD, integrator);

@@ -3,9 +3,9 @@
 //! `x' = x + Δt v'`, `v' ← decay(cΔt/2m) v'` — iterated here in f64.
 //! Two bodies on one spring exchange equal and opposite forces.
 
-use tumble::bevy_ecs::prelude::{Bundle, Entity, World};
-use tumble::math::{Real, Vec3, to_f64};
-use tumble::prelude::*;
+use bevy_ecs::prelude::{Bundle, Entity, World};
+use tumble_core::math::{Real, Vec3, to_f64};
+use tumble_ecs::prelude::*;
 
 use super::util::{run, spawn_body, world_with};
 

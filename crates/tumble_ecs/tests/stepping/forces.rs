@@ -1,9 +1,9 @@
 //! Forces at points produce the torque `(p − x) × F` about the centre of mass, and generators
 //! deliver their load in the step they run, exactly once.
 
-use tumble::glam::DMat3;
-use tumble::math::{Quat, Real, Vec3, Widen, to_f64};
-use tumble::prelude::*;
+use glam::DMat3;
+use tumble_core::math::{Quat, Real, Vec3, Widen, to_f64};
+use tumble_ecs::prelude::*;
 
 use super::util::{run, world_with};
 

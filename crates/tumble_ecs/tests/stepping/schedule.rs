@@ -1,9 +1,9 @@
 //! The schedule holds only the systems a world needs.
 
-use tumble::bevy_ecs::prelude::*;
-use tumble::math::Vec3;
+use bevy_ecs::prelude::*;
+use tumble_core::math::Vec3;
 
-use tumble::prelude::*;
+use tumble_ecs::prelude::*;
 
 use super::util::world_with;
 

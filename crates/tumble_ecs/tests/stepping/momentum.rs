@@ -6,8 +6,9 @@
 //! and over `n` steps by at most `n ½ (Δt |ω|)²` (first order). Energy and `|L|` drift must
 //! therefore shrink about 2× per halving of Δt.
 
-use tumble::math::{Real, Vec3, to_f64};
-use tumble::prelude::*;
+use tumble_core::BodyState;
+use tumble_core::math::{Real, Vec3, to_f64};
+use tumble_ecs::prelude::*;
 
 use super::util::{mass_props, run, world_with};
 
@@ -31,7 +32,7 @@ fn angular_momentum_drift(dt: Real, seconds: Real) -> (f64, f64) {
             },
         ))
         .id();
-    let l0 = tumble::core::invariants::angular_momentum(
+    let l0 = tumble_core::invariants::angular_momentum(
         &state(&Pose::IDENTITY, world.get::<Velocity>(id).unwrap()),
         &mass,
     );
@@ -43,10 +44,8 @@ fn angular_momentum_drift(dt: Real, seconds: Real) -> (f64, f64) {
         Vec3::new(1.0, -2.0, 0.5),
         "linear momentum must be exact"
     );
-    let l = tumble::core::invariants::angular_momentum(
-        &state(world.get::<Pose>(id).unwrap(), v),
-        &mass,
-    );
+    let l =
+        tumble_core::invariants::angular_momentum(&state(world.get::<Pose>(id).unwrap(), v), &mass);
     let bound = steps as f64 * 0.5 * to_f64(dt * omega0.length()).powi(2);
     let drift = to_f64((l.length() - l0.length()) / l0.length());
     (drift, bound)
