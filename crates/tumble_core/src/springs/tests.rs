@@ -415,6 +415,33 @@ fn momenta(bodies: &[GroupBody]) -> (DVec3, DVec3, f64) {
     (p, l, scale)
 }
 
+/// The worst drift of the momenta over a run, each relative to the largest size so far of the
+/// terms it sums (`Σ m |v|`, and the scale `momenta` gives for `L`): a sum's rounding is
+/// relative to them, not to the sum.
+#[derive(Debug, Default)]
+struct MomentumDrift {
+    p_scale: f64,
+    l_scale: f64,
+    /// Worst `|ΔP|` relative.
+    p: f64,
+    /// Worst `|ΔL|` relative.
+    l: f64,
+}
+
+impl MomentumDrift {
+    /// Records the momenta's errors `dp`, `dl` after a step, `l_scale` the size of `L`'s terms.
+    fn record(&mut self, bodies: &[GroupBody], dp: DVec3, dl: DVec3, l_scale: f64) {
+        let p_scale: f64 = bodies
+            .iter()
+            .map(|b| b.mass.mass().widen() * b.state.linear_velocity.widen().length())
+            .sum();
+        self.p_scale = self.p_scale.max(p_scale);
+        self.l_scale = self.l_scale.max(l_scale);
+        self.p = self.p.max(dp.length() / self.p_scale);
+        self.l = self.l.max(dl.length() / self.l_scale);
+    }
+}
+
 /// An isolated net (no world anchor, no loads) of five asymmetric bodies joined at
 /// off-centre anchors, with cross springs that close loops, spinning and drifting. `relaxed`:
 /// every spring at its rest length at the start, so the momenta in play stay of the size of the
@@ -486,26 +513,21 @@ fn isolated_net_keeps_its_momenta(
     let (p0, l0, _) = momenta(&bodies);
     let e0 = energy(&bodies, &springs);
     let mut solver = ImplicitSpringSolver::default();
-    let (mut worst_p, mut worst_l, mut worst_e) = (0.0_f64, 0.0_f64, 0.0_f64);
-    // The sizes of the terms the momenta sum, `Σ m |v|` and `Σ (|x × m v| + |I ω|)`, at their
-    // largest so far: a sum's rounding is relative to them, not to the sum.
-    let (mut p_scale, mut l_scale) = (0.0_f64, 0.0_f64);
+    let mut drift = MomentumDrift::default();
+    let mut worst_e = 0.0_f64;
     for _ in 0..steps {
         solver
             .step(&mut bodies, &springs, dt)
             .unwrap_or_else(|e| panic!("ωΔt {omega_dt}: {e}"));
         let (p, l, scale) = momenta(&bodies);
-        p_scale = p_scale.max(
-            bodies
-                .iter()
-                .map(|b| b.mass.mass().widen() * b.state.linear_velocity.widen().length())
-                .sum(),
-        );
-        l_scale = l_scale.max(scale);
-        worst_p = worst_p.max((p - p0).length() / p_scale);
-        worst_l = worst_l.max((l - l0).length() / l_scale);
+        drift.record(&bodies, p - p0, l - l0, scale);
         worst_e = worst_e.max((energy(&bodies, &springs) - e0).abs() / e0);
     }
+    let MomentumDrift {
+        p: worst_p,
+        l: worst_l,
+        ..
+    } = drift;
     eprintln!(
         "{rotation:?} ωΔt {omega_dt} relaxed {relaxed}: momentum {worst_p:.2e}, angular \
          momentum {worst_l:.2e} (of |L₀| {:.2e}), energy {worst_e:.2e}",
@@ -591,8 +613,7 @@ fn loads_change_the_momenta_by_their_impulses() {
         let (mut p_expected, mut l_expected, _) = momenta_about_centre(&bodies);
         let mut solver = ImplicitSpringSolver::default();
         let steps = 2000;
-        let (mut worst_p, mut worst_l) = (0.0_f64, 0.0_f64);
-        let (mut p_scale, mut l_scale) = (0.0_f64, 0.0_f64);
+        let mut drift = MomentumDrift::default();
         let mut splits = 0;
         for _ in 0..steps {
             splits += solver.step(&mut bodies, &springs, dt).unwrap().splits;
@@ -601,16 +622,13 @@ fn loads_change_the_momenta_by_their_impulses() {
                 l_expected += dt.widen() * b.load.torque.widen();
             }
             let (p, l, scale) = momenta_about_centre(&bodies);
-            p_scale = p_scale.max(
-                bodies
-                    .iter()
-                    .map(|b| b.mass.mass().widen() * b.state.linear_velocity.widen().length())
-                    .sum(),
-            );
-            l_scale = l_scale.max(scale);
-            worst_p = worst_p.max((p - p_expected).length() / p_scale);
-            worst_l = worst_l.max((l - l_expected).length() / l_scale);
+            drift.record(&bodies, p - p_expected, l - l_expected, scale);
         }
+        let MomentumDrift {
+            p: worst_p,
+            l: worst_l,
+            ..
+        } = drift;
         eprintln!(
             "ωΔt {omega_dt}: momentum {worst_p:.2e}, angular momentum {worst_l:.2e}, splits {splits}"
         );
