@@ -13,5 +13,9 @@ mod core_layer {
     // Scene files through the reader: the reader is the feature `scene`.
     #[cfg(feature = "scene")]
     pub(crate) mod scene_bits;
+    // The helpers of the ECS crate's stepping tests (the facade's crates are this package's
+    // dependencies too), one file for both test binaries.
+    #[path = "../../crates/tumble_ecs/tests/stepping/util.rs"]
+    #[allow(dead_code, reason = "helpers the stepping tests use and these do not")]
     pub(crate) mod util;
 }

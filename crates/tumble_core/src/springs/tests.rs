@@ -390,23 +390,27 @@ fn forces_at_body_points_do_exactly_their_work() {
     );
 }
 
-/// World linear and angular momentum of the bodies, `Σ m v` and `Σ (x × m v + I_world ω)`, and
+/// A body's own angular momentum `I_world ω` (world frame, f64).
+fn spin(b: &GroupBody) -> DVec3 {
+    b.mass
+        .world_inertia_mul(
+            b.state.rotation.widen().normalize().narrow(),
+            b.state.angular_velocity,
+        )
+        .widen()
+}
+
+/// World linear and angular momentum of the bodies, `Σ m v` and `Σ (x × m v + I_world ω)` (`x` the
+/// state's position, the centre of mass), and
 /// a scale for `L`, `Σ (|x| m |v| + |I_world ω|)` (the size of the products its rounding is relative
 /// to), in f64.
 fn momenta(bodies: &[GroupBody]) -> (DVec3, DVec3, f64) {
     let (mut p, mut l, mut scale) = (DVec3::ZERO, DVec3::ZERO, 0.0);
     for b in bodies {
         let m = b.mass.mass().widen();
-        let x = b.state.position.widen()
-            + b.state.rotation.widen().normalize() * b.mass.local_center_of_mass().widen();
+        let x = b.state.position.widen();
         let v = b.state.linear_velocity.widen();
-        let spin = b
-            .mass
-            .world_inertia_mul(
-                b.state.rotation.widen().normalize().narrow(),
-                b.state.angular_velocity,
-            )
-            .widen();
+        let spin = spin(b);
         let orbital = x.cross(m * v);
         p += m * v;
         l += orbital + spin;
@@ -581,13 +585,7 @@ fn momenta_about_centre(bodies: &[GroupBody]) -> (DVec3, DVec3, f64) {
         let m = b.mass.mass().widen();
         let r = b.state.position.widen() - centre;
         let v = b.state.linear_velocity.widen() - p / mass;
-        let spin = b
-            .mass
-            .world_inertia_mul(
-                b.state.rotation.widen().normalize().narrow(),
-                b.state.angular_velocity,
-            )
-            .widen();
+        let spin = spin(b);
         l += r.cross(m * v) + spin;
         scale += r.length() * m * b.state.linear_velocity.widen().length() + spin.length();
     }

@@ -1,4 +1,5 @@
-//! Helpers shared by the stepping tests.
+//! Helpers shared by the stepping tests (and the root crate's cross-crate tests, which include
+//! this file).
 
 use bevy_ecs::prelude::*;
 use tumble_core::math::Real;
