@@ -6,8 +6,8 @@ use tumble_core::math::{Real, Vec3, Widen};
 
 use super::memo::BodyMemo;
 use crate::components::{
-    Dynamic, Kinematic, MassProps, Pose, Rejected, RigidBody, Spring, SpringEnd, Static, Velocity,
-    kinetic_energy_f64,
+    Dynamic, IndexOrder, IndexedQuery, Kinematic, MassProps, Pose, Rejected, RigidBody, Spring,
+    SpringEnd, Static, Velocity, kinetic_energy_f64,
 };
 
 /// beyond it the spring is unstable and grows geometrically past any finite bound anyway.
@@ -28,6 +28,8 @@ pub(super) struct Audited {
     pub(super) memo: BodyMemo,
     /// Every load except the springs: force and torque (world frame).
     pub(super) load: (Vec3, Vec3),
+    /// The work of `load` over the step (J), once the end pass has measured it.
+    pub(super) work: f64,
     /// Mass (kg), for the springs' reduced mass.
     pub(super) mass: f64,
     /// Union–find parent.
@@ -159,6 +161,11 @@ pub struct EnergyLedger {
     /// The groups were closed by an end pass since the last start: their end sums are the
     /// energies the bodies stand at now, if nothing changed ([`EnergyLedger::restart`]).
     pub(super) closed: bool,
+    /// The audited bodies in entity index order, when their query visits them otherwise
+    /// (scratch, see [`for_each_audited`]).
+    pub(super) body_order: Vec<Entity>,
+    /// The springs in entity index order (scratch).
+    pub(super) spring_order: IndexOrder,
     /// Starts that took the unchanged world's shortcut (for tests).
     #[cfg(test)]
     pub(super) restarts: usize,
@@ -338,21 +345,23 @@ impl EnergyLedger {
         &mut self,
         bodies: &AuditedBodies,
         ends: &Ends,
-        springs: &Query<&Spring>,
+        springs: &AuditedSprings,
     ) -> bool {
         let mut n = 0;
         let mut all_still = true;
-        for (entity, t, v, m) in bodies {
-            let Some(body) = self.bodies.get(n) else {
-                return false;
+        let mut same = true;
+        let mut order = std::mem::take(&mut self.body_order);
+        for_each_audited(&mut order, bodies, |(entity, t, v, m)| {
+            let Some(body) = self.bodies.get(n).filter(|b| same && b.entity == entity) else {
+                same = false;
+                return;
             };
-            if body.entity != entity {
-                return false;
-            }
+            let mass = body.mass;
             let (energy, still) = self.start_kinetic(n, (entity, t, v, m));
             // A new mass changes the springs' reduced masses, so their stiffness bound: regroup.
-            if !still && m.mass().widen().to_bits() != body.mass.to_bits() {
-                return false;
+            if !still && m.mass().widen().to_bits() != mass.to_bits() {
+                same = false;
+                return;
             }
             let body = &mut self.bodies[n];
             body.start = (*t, *v);
@@ -362,24 +371,26 @@ impl EnergyLedger {
             (body.start_energy, body.still) = (energy, still);
             all_still &= still;
             n += 1;
-        }
-        if n != self.bodies.len() {
+        });
+        self.body_order = order;
+        if !same || n != self.bodies.len() {
             return false;
         }
         let mut k = 0;
-        for spring in springs {
-            let Some(link) = self.links.get(k) else {
-                return false;
+        let spring_order = std::mem::take(&mut self.spring_order);
+        spring_order.for_each(springs, |spring| {
+            let Some(link) = self.links.get(k).filter(|_| same) else {
+                same = false;
+                return;
             };
             // Resolved again: an end that is not an audited body may have moved (a static
             // body) or changed kind since.
             let (a, b) = resolve_ends(self, ends, spring);
-            if !link.same_inputs(&Link::new(spring, a, b)) {
-                return false;
-            }
+            same &= link.same_inputs(&Link::new(spring, a, b));
             k += 1;
-        }
-        if k != self.links.len() {
+        });
+        self.spring_order = spring_order;
+        if !same || k != self.links.len() {
             return false;
         }
         if all_still {
@@ -509,3 +520,28 @@ pub(super) fn same_end(a: End, b: End) -> bool {
 /// The bodies the audit watches, as its start pass reads them.
 pub(super) type AuditedBodies<'w, 's> =
     Query<'w, 's, (Entity, &'static Pose, &'static Velocity, &'static MassProps), Dynamic>;
+
+/// The springs the audit measures, with their entities (visited in entity index order).
+pub(super) type AuditedSprings<'w, 's> = IndexedQuery<'w, 's, Spring, ()>;
+
+/// Calls `f` on every audited body in entity index order: the order of the ledger's table of
+/// bodies, and with it of every sum over a group's bodies, whatever order the query visits its
+/// tables in (see [`IndexOrder`]). `order` is scratch, kept between steps.
+pub(super) fn for_each_audited(
+    order: &mut Vec<Entity>,
+    bodies: &AuditedBodies,
+    mut f: impl FnMut((Entity, &Pose, &Velocity, &MassProps)),
+) {
+    order.clear();
+    if bodies.iter().map(|(e, ..)| e.index_u32()).is_sorted() {
+        bodies.iter().for_each(f);
+        return;
+    }
+    order.extend(bodies.iter().map(|(e, ..)| e));
+    order.sort_unstable_by_key(|e| e.index_u32());
+    for &entity in order.iter() {
+        if let Ok(item) = bodies.get(entity) {
+            f(item);
+        }
+    }
+}

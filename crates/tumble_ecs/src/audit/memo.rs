@@ -81,6 +81,11 @@ impl BodyMemo {
         }
     }
 
+    /// True when end pass `pass` (≥ 1) measured it.
+    pub(super) fn measured_by(&self, pass: u64) -> bool {
+        self.pass != 0 && self.pass == pass
+    }
+
     /// The kinetic energy.
     pub(super) fn kinetic(&self) -> f64 {
         self.kinetic
@@ -98,8 +103,7 @@ impl BodyMemo {
         velocity: &Velocity,
         mass: &MassProps,
     ) -> bool {
-        self.pass != 0
-            && self.pass == pass
+        self.measured_by(pass)
             && same_bits(pose_inputs(measured_pose), pose_inputs(pose))
             && same_bits(self.inputs, rest_inputs(velocity, mass))
     }

@@ -78,7 +78,9 @@
 //! loaded spring world it is the largest single part of the step
 //! (`cargo bench --bench audit` measures the ratio on a 10⁴-body chain). Bodies are found by
 //! entity index in a table the ledger keeps, not by hashing; it allocates only when the world
-//! grows.
+//! grows. The ledger's bodies and springs are in entity index order, and every sum over a group
+//! follows it: which tables game code's own components spread the bodies over, and in which
+//! order a query visits them, does not change a bit of an account.
 //!
 //! Not audited: a group holding a [`Kinematic`](crate::components::Kinematic) body (game code moves it and does work the
 //! audit cannot see). [`Static`](crate::components::Static) bodies are fixed anchors.

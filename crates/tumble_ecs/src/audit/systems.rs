@@ -4,13 +4,13 @@ use bevy_ecs::prelude::*;
 use tumble_core::math::{Real, Vec3, Widen};
 
 use super::ledger::{
-    Account, Audited, AuditedBodies, End, Ends, EnergyLedger, GroupStep, Link, OMEGA_DT_CAP,
-    ROUND_OFF_ULPS, resolve_ends,
+    Account, Audited, AuditedBodies, AuditedSprings, End, Ends, EnergyLedger, GroupStep, Link,
+    OMEGA_DT_CAP, ROUND_OFF_ULPS, for_each_audited, resolve_ends,
 };
 use super::memo::BodyMemo;
 use crate::components::{
     BodyError, BodyErrorKind, Dynamic, ForceAccumulator, Gravity, GravityScale, MassProps,
-    PhysicsSettings, Pose, Spring, Velocity, reject,
+    PhysicsSettings, Pose, Velocity, reject,
 };
 use crate::integrate::StageCursor;
 
@@ -22,12 +22,14 @@ pub fn audit_energy_start(
     mut ledger: ResMut<EnergyLedger>,
     bodies: AuditedBodies,
     ends: Ends,
-    springs: Query<&Spring>,
+    springs: AuditedSprings,
 ) {
     let ledger = &mut *ledger;
     if !cursor.span(&settings).opens_step {
         return;
     }
+    // Bodies and springs in entity index order, so that every sum over a group follows it.
+    ledger.spring_order.refresh(&springs);
     ledger.dt = settings.dt().widen();
     let stability_span = settings.stages().stability_span(settings.dt()).widen();
     let same_span = stability_span.to_bits() == ledger.stability_span.to_bits();
@@ -48,7 +50,8 @@ pub fn audit_energy_start(
         .reserve_exact(springs.iter().len().saturating_sub(ledger.links.len()));
     // Each entry is written over the last step's at its index, after its memo is read.
     let mut i = 0;
-    for (entity, t, v, m) in &bodies {
+    let mut order = std::mem::take(&mut ledger.body_order);
+    for_each_audited(&mut order, &bodies, |(entity, t, v, m)| {
         let (energy, still) = ledger.start_kinetic(i, (entity, t, v, m));
         ledger.set_slot(entity, i);
         let body = Audited {
@@ -57,6 +60,7 @@ pub fn audit_energy_start(
             end: *t,
             memo: BodyMemo::NONE,
             load: (Vec3::ZERO, Vec3::ZERO),
+            work: 0.0,
             mass: m.mass().widen(),
             parent: i,
             group: 0,
@@ -69,13 +73,15 @@ pub fn audit_energy_start(
             ledger.bodies.push(body);
         }
         i += 1;
-    }
+    });
+    ledger.body_order = order;
     ledger.bodies.truncate(i);
     // Each link is written over the last step's link at its index, keeping that one's
     // measurement when the inputs are the same ([`memo`]).
     let old = ledger.links.len();
     let mut k = 0;
-    for spring in &springs {
+    let spring_order = std::mem::take(&mut ledger.spring_order);
+    spring_order.for_each(&springs, |spring| {
         let (a, b) = resolve_ends(ledger, &ends, spring);
         if let (End::Audited(i, _), End::Audited(j, _)) = (a, b) {
             ledger.union(i as usize, j as usize);
@@ -91,7 +97,8 @@ pub fn audit_energy_start(
             ledger.links.push(link);
         }
         k += 1;
-    }
+    });
+    ledger.spring_order = spring_order;
     ledger.links.truncate(k);
     ledger.number_groups();
     ledger.count_group_springs();
@@ -185,7 +192,6 @@ pub fn audit_energy(
             continue;
         };
         let body = &mut ledger.bodies[i];
-        let group = body.group;
         body.end = *t;
         let (force, torque) = match gravity {
             // Bodies without an accumulator take gravity inside the integration.
@@ -195,10 +201,16 @@ pub fn audit_energy(
         let v0 = body.start.1;
         let v_mean = 0.5 * (v0.linear.widen() + v.linear.widen());
         let w_mean = 0.5 * (v0.angular.widen() + v.angular.widen());
-        let work = dt * (force.widen().dot(v_mean) + torque.widen().dot(w_mean));
+        body.work = dt * (force.widen().dot(v_mean) + torque.widen().dot(w_mean));
         body.memo = BodyMemo::measure(pass, t, v, m);
-        let energy = body.memo.kinetic();
-        let g = &mut ledger.groups[group];
+    }
+    // Summed in the ledger's order (entity index order), not the query's.
+    for body in &ledger.bodies {
+        if !body.memo.measured_by(pass) {
+            continue;
+        }
+        let (energy, work) = (body.memo.kinetic(), body.work);
+        let g = &mut ledger.groups[body.group];
         g.end += energy;
         g.work += work;
         g.magnitude += energy + work.abs();
