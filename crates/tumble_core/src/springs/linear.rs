@@ -13,43 +13,19 @@ pub(crate) type Block = [[f64; 6]; 6];
 /// In place: the column of the identity that a step would fill is the column it empties, so
 /// the pivot row is scaled and subtracted over six entries instead of twelve (half the work
 /// of eliminating on `[m | 1]`), and the row exchanges become column exchanges of the result,
-/// undone at the end. Every row operation is one fixed-length loop the compiler unrolls and
-/// vectorizes (the Newton solve of a spring group inverts one block per body and iteration).
+/// undone at the end. Each column's step is compiled with the column a constant
+/// ([`eliminate`]), so the compiler unrolls and vectorizes every row operation and skips the
+/// pivot row without a branch, which a loop over the columns (the column a variable) does not
+/// (the Newton solve of a spring group inverts one block per body and factorization).
 pub(crate) fn invert(m: &Block) -> Option<Block> {
     let mut a = *m;
     let mut swapped = [0usize; 6];
-    for col in 0..6 {
-        let mut pivot = col;
-        let mut best = a[col][col].abs();
-        for (r, row) in a.iter().enumerate().skip(col + 1) {
-            if row[col].abs() > best {
-                best = row[col].abs();
-                pivot = r;
-            }
-        }
-        if !(best > 0.0 && best.is_finite()) {
-            return None;
-        }
-        a.swap(col, pivot);
-        swapped[col] = pivot;
-        let scale = 1.0 / a[col][col];
-        let mut pivot_row = a[col];
-        pivot_row[col] = 1.0;
-        for x in &mut pivot_row {
-            *x *= scale;
-        }
-        for (r, row) in a.iter_mut().enumerate() {
-            if r == col {
-                continue;
-            }
-            let f = row[col];
-            row[col] = 0.0;
-            for (x, p) in row.iter_mut().zip(&pivot_row) {
-                *x -= f * p;
-            }
-        }
-        a[col] = pivot_row;
-    }
+    eliminate::<0>(&mut a, &mut swapped)?;
+    eliminate::<1>(&mut a, &mut swapped)?;
+    eliminate::<2>(&mut a, &mut swapped)?;
+    eliminate::<3>(&mut a, &mut swapped)?;
+    eliminate::<4>(&mut a, &mut swapped)?;
+    eliminate::<5>(&mut a, &mut swapped)?;
     for col in (0..6).rev() {
         let other = swapped[col];
         if other != col {
@@ -59,6 +35,44 @@ pub(crate) fn invert(m: &Block) -> Option<Block> {
         }
     }
     Some(a)
+}
+
+/// Step `COL` of [`invert`]: picks the pivot of column `COL` (the largest of its rows from
+/// `COL` on), moves it to row `COL`, scales that row and subtracts it from the other five;
+/// `None` if the column has no usable pivot.
+#[inline(always)]
+fn eliminate<const COL: usize>(a: &mut Block, swapped: &mut [usize; 6]) -> Option<()> {
+    let mut pivot = COL;
+    let mut best = a[COL][COL].abs();
+    for (r, row) in a.iter().enumerate().skip(COL + 1) {
+        if row[COL].abs() > best {
+            best = row[COL].abs();
+            pivot = r;
+        }
+    }
+    if !(best > 0.0 && best.is_finite()) {
+        return None;
+    }
+    a.swap(COL, pivot);
+    swapped[COL] = pivot;
+    let scale = 1.0 / a[COL][COL];
+    let mut pivot_row = a[COL];
+    pivot_row[COL] = 1.0;
+    for x in &mut pivot_row {
+        *x *= scale;
+    }
+    for (r, row) in a.iter_mut().enumerate() {
+        if r == COL {
+            continue;
+        }
+        let f = row[COL];
+        row[COL] = 0.0;
+        for (x, p) in row.iter_mut().zip(&pivot_row) {
+            *x -= f * p;
+        }
+    }
+    a[COL] = pivot_row;
+    Some(())
 }
 
 /// `m x` for a 6×6 block.
