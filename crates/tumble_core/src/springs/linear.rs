@@ -18,23 +18,34 @@ pub(crate) type Block = [[f64; 6]; 6];
 /// pivot row without a branch, which a loop over the columns (the column a variable) does not
 /// (the Newton solve of a spring group inverts one block per body and factorization).
 pub(crate) fn invert(m: &Block) -> Option<Block> {
-    let mut a = *m;
+    let mut inverse = [[0.0; 6]; 6];
+    invert_into(m, &mut inverse).then_some(inverse)
+}
+
+/// [`invert`] into `inverse` (the factorization's pivots, written where they are kept rather
+/// than moved there); false, `inverse` unspecified, if `m` is singular.
+pub(crate) fn invert_into(m: &Block, inverse: &mut Block) -> bool {
+    let a = inverse;
+    *a = *m;
     let mut swapped = [0usize; 6];
-    eliminate::<0>(&mut a, &mut swapped)?;
-    eliminate::<1>(&mut a, &mut swapped)?;
-    eliminate::<2>(&mut a, &mut swapped)?;
-    eliminate::<3>(&mut a, &mut swapped)?;
-    eliminate::<4>(&mut a, &mut swapped)?;
-    eliminate::<5>(&mut a, &mut swapped)?;
+    let eliminated = eliminate::<0>(a, &mut swapped).is_some()
+        && eliminate::<1>(a, &mut swapped).is_some()
+        && eliminate::<2>(a, &mut swapped).is_some()
+        && eliminate::<3>(a, &mut swapped).is_some()
+        && eliminate::<4>(a, &mut swapped).is_some()
+        && eliminate::<5>(a, &mut swapped).is_some();
+    if !eliminated {
+        return false;
+    }
     for col in (0..6).rev() {
         let other = swapped[col];
         if other != col {
-            for row in &mut a {
+            for row in a.iter_mut() {
                 row.swap(col, other);
             }
         }
     }
-    Some(a)
+    true
 }
 
 /// Step `COL` of [`invert`]: picks the pivot of column `COL` (the largest of its rows from

@@ -19,7 +19,7 @@
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 
-use super::linear::{Block, block_mul, invert};
+use super::linear::{Block, block_mul, invert_into};
 
 /// `c −= a b` for 6×6 blocks, in place.
 #[inline]
@@ -35,17 +35,17 @@ fn subtract_product(c: &mut Block, a: &Block, b: &Block) {
     }
 }
 
-/// `a b` for 6×6 blocks.
-fn product(a: &Block, b: &Block) -> Block {
-    let mut c = [[0.0; 6]; 6];
-    for (ci, ai) in c.iter_mut().zip(a) {
+/// `a ← a b` for 6×6 blocks, in place: row `i` of the product needs only row `i` of `a`.
+fn multiply_right(a: &mut Block, b: &Block) {
+    for ai in a.iter_mut() {
+        let mut ci = [0.0; 6];
         for (k, &aik) in ai.iter().enumerate() {
             for (cij, bkj) in ci.iter_mut().zip(&b[k]) {
                 *cij += aik * bkj;
             }
         }
+        *ai = ci;
     }
-    c
 }
 
 /// An entry of a row or of a pivot: the column (or row) body and where its block sits in
@@ -235,7 +235,9 @@ impl BlockLu {
             let pivot = &mut pivots[*pivot_count];
             *pivot_count += 1;
             pivot.body = p;
-            pivot.inverse = invert(&diagonal[p]).ok_or(SingularPivot)?;
+            if !invert_into(&diagonal[p], &mut pivot.inverse) {
+                return Err(SingularPivot);
+            }
             // Row p becomes the pivot's upper blocks A_pj (the lists trade places, no block
             // is copied); each A_jp leaves row j (p is gone from the remaining matrix), its
             // block overwritten by the multiplier A_jp P.
@@ -250,7 +252,7 @@ impl BlockLu {
                     .position(|(c, _)| *c == column)
                     .expect("the pattern is symmetric");
                 let block = row[at].1;
-                pool[block as usize] = product(&pool[block as usize], &pivot.inverse);
+                multiply_right(&mut pool[block as usize], &pivot.inverse);
                 pivot.lower.push((j, block));
                 row.swap_remove(at);
             }
