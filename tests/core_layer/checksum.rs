@@ -204,11 +204,11 @@ const PINNED_F32: &[(&str, &str)] = &[
     ),
     ("lclamp", "33a8d5341c85fc24c4bfaa47948d3a80"),
     ("implicit-gyroscopic", "42d27c6e4bdeebca8938e054393d0102"),
-    ("splitting", "2c0a57d3fee03b6ffd1b9d50ad299210"),
-    ("splitting-xyz", "4a5ce3a690b80d269e43170e4eb54df2"),
+    ("splitting", "945ef82510b54687d754a6ad607558ed"),
+    ("splitting-xyz", "d9642652e811e3f503321f6ca2c80f08"),
     ("yoshida4", "ea227359d32e9094363db7a11b72e5f9"),
-    ("rk4", "8b5c53f9c1c47ffb9de573941458206c"),
-    ("exact", "70251f93a28d3d254f71bd5ba7797f8b"),
+    ("rk4", "4b30c702adfbfbac897c4ae59093f036"),
+    ("exact", "ffdf17092dcdbb9d063e7a1eaa39d8e4"),
     ("exact4", "2bcecce17b7e2aeb0ea173aacb683fbd"),
 ];
 /// `f64` build (with or without `enhanced-determinism`).
@@ -220,11 +220,11 @@ const PINNED_F64: &[(&str, &str)] = &[
     ),
     ("lclamp", "04e38e84b4683986577a1e84a54b3336"),
     ("implicit-gyroscopic", "575d1d8020fdddeb7d1612b54e845d5d"),
-    ("splitting", "6337705cbda60bdaa0afc714bc49f031"),
-    ("splitting-xyz", "525f6ecca8cd3c0120dc50d37b61b62f"),
+    ("splitting", "9d18ead45780b1aa1ea7f587444160cb"),
+    ("splitting-xyz", "794e98fb2e9211f389bed18d0ac1032c"),
     ("yoshida4", "7fe2f6c503ece11d652ab72ea66c6776"),
-    ("rk4", "0eaf6e9d34be52bcb301a1b7ab77672d"),
-    ("exact", "2c695cd50aaae5c4d63cc192057bd1e5"),
+    ("rk4", "aa4ef81e95196064a80d138e6128fa27"),
+    ("exact", "936d4c798af8826c4c03a181e6a6095f"),
     ("exact4", "1babf66e140375a74f7b561db2b2b869"),
 ];
 

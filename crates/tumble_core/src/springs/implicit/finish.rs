@@ -231,16 +231,22 @@ impl ImplicitSpringSolver {
             return;
         }
         let scale = (1.0 + missing / internal).sqrt();
-        for ((state, p), _) in out
+        for ((state, p), start) in out
             .iter_mut()
             .zip(&rounded)
             .zip(&self.starts)
             .filter(|(_, start)| start.method.is_none())
         {
             let (u, eta) = rigid.internal(p);
+            let mut omega = rigid.spin + scale * eta;
+            if start.free != DVec3::ONE {
+                // A locked axis does not turn (its rate stays 0), whatever the group's spin does
+                // along it; it has no inertia, so neither momentum nor energy changes.
+                omega = p.q * (start.free * (p.q.inverse() * omega));
+            }
             let corrected = BodyState {
                 linear_velocity: (rigid.velocity_at(p.x) + scale * u).narrow(),
-                angular_velocity: (rigid.spin + scale * eta).narrow(),
+                angular_velocity: omega.narrow(),
                 ..*state
             };
             if corrected.is_valid() {
