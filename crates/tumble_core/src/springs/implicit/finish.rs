@@ -68,9 +68,11 @@ impl ImplicitSpringSolver {
     }
 
     /// Gives the end state exactly the momenta the scheme gives it, where they are known
-    /// without the solve: for a group with no spring tied to a fixed point and no force at a
-    /// body point, `P₁ = P₀ + h Σ F` and `L₁ = L₀ + h Σ (x̄ × F + τ)` (`x̄` a body's mean
-    /// position), the momenta of an isolated group kept. The scheme keeps them in exact
+    /// without the solve: for a group with no spring tied to a fixed point, no force at a body
+    /// point and no locked axis, `P₁ = P₀ + h Σ F` and `L₁ = L₀ + h Σ (x̄ × F + τ)` (`x̄` a
+    /// body's mean position), the momenta of an isolated group kept. (A locked axis takes up
+    /// the torques along it, as a fixed point takes up forces: such a group's `L` is not the
+    /// loads' alone, and is left as the solve gives it.) The scheme keeps them in exact
     /// arithmetic, but the solve stops at a tolerance and rounds terms as large as the
     /// springs' impulses, which at `ωΔt ≫ 1` are many times the momenta they change: that
     /// leaves a systematic defect of ~1e-15 of the momenta a step in `f64` at `ωΔt` 100
@@ -79,7 +81,8 @@ impl ImplicitSpringSolver {
     /// `M δV` and `L` by `M X × δV + J δΩ` (`X` the centre of mass, `J` the group's inertia
     /// about it), and nothing else.
     fn restore_momenta(&self, h: f64, exact: &mut [Pose]) {
-        if !self.ends_are_free() || self.starts.iter().any(|s| s.moment != DMat3::ZERO) {
+        let held = |s: &Start| s.moment != DMat3::ZERO || s.free != DVec3::ONE;
+        if !self.ends_are_free() || self.starts.iter().any(held) {
             return;
         }
         let mass: f64 = self.starts.iter().map(|s| s.mass).sum();

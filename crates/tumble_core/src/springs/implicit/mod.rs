@@ -55,8 +55,9 @@
 //! between two bodies `h (p̄_a − p̄_b) × F̄ = h d̄ × F̄ = 0`, since `F̄` is along `d̄`. A group free
 //! of outside loads keeps `L` exactly, up to the solver's tolerance and rounding; where the
 //! momenta the step must end with are known without the solve (no spring tied to a fixed point,
-//! no force at a body point), the end state is given them exactly by one rigid change of the
-//! group's velocities, so that only the rounding of the stored state is left. The scheme is symmetric (swapping the ends of the step and `h → −h` maps it to
+//! no force at a body point, no locked axis, which takes up the torques along it), the end
+//! state is given them exactly by one rigid change of the group's velocities, so that only the
+//! rounding of the stored state is left. The scheme is symmetric (swapping the ends of the step and `h → −h` maps it to
 //! itself: `T`'s world impulse `h (Q₀ b) × F̄` is symmetric in the ends), hence second order. On a linear spring it is the implicit midpoint rule:
 //! unit amplification and the phase `2 atan(ωh/2)` per step, so a spring far too stiff for the
 //! step oscillates slower than it should, bounded, with its energy kept.
