@@ -163,7 +163,7 @@ pub struct EnergyLedger {
     pub(super) closed: bool,
     /// The audited bodies in entity index order, when their query visits them otherwise
     /// (scratch, see [`for_each_audited`]).
-    pub(super) body_order: Vec<Entity>,
+    pub(super) body_order: IndexOrder,
     /// The springs in entity index order (scratch).
     pub(super) spring_order: IndexOrder,
     /// Starts that took the unchanged world's shortcut (for tests).
@@ -528,18 +528,16 @@ pub(super) type AuditedSprings<'w, 's> = IndexedQuery<'w, 's, Spring, ()>;
 /// bodies, and with it of every sum over a group's bodies, whatever order the query visits its
 /// tables in (see [`IndexOrder`]). `order` is scratch, kept between steps.
 pub(super) fn for_each_audited(
-    order: &mut Vec<Entity>,
+    order: &mut IndexOrder,
     bodies: &AuditedBodies,
     mut f: impl FnMut((Entity, &Pose, &Velocity, &MassProps)),
 ) {
-    order.clear();
-    if bodies.iter().map(|(e, ..)| e.index_u32()).is_sorted() {
+    order.refresh_entities(bodies.iter().map(|(e, ..)| e));
+    if order.is_query_order() {
         bodies.iter().for_each(f);
         return;
     }
-    order.extend(bodies.iter().map(|(e, ..)| e));
-    order.sort_unstable_by_key(|e| e.index_u32());
-    for &entity in order.iter() {
+    for &entity in order.entities() {
         if let Ok(item) = bodies.get(entity) {
             f(item);
         }

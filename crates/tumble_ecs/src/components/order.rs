@@ -29,11 +29,23 @@ impl IndexOrder {
         &mut self,
         query: &IndexedQuery<'_, '_, T, F>,
     ) {
+        self.refresh_entities(query.iter().map(|(e, _)| e));
+    }
+
+    /// Takes the order of `entities`, a query's entities in the order it visits them (for a
+    /// query of more than one component; see [`entities`](Self::entities)).
+    pub(crate) fn refresh_entities(&mut self, entities: impl Iterator<Item = Entity> + Clone) {
         self.0.clear();
-        if !query.iter().map(|(e, _)| e.index_u32()).is_sorted() {
-            self.0.extend(query.iter().map(|(e, _)| e));
+        if !entities.clone().map(|e| e.index_u32()).is_sorted() {
+            self.0.extend(entities);
             self.0.sort_unstable_by_key(|e| e.index_u32());
         }
+    }
+
+    /// The entities in index order, as of the last refresh; empty when the query visits them
+    /// in that order itself ([`is_query_order`](Self::is_query_order)).
+    pub(crate) fn entities(&self) -> &[Entity] {
+        &self.0
     }
 
     /// True when the query visits its entities in index order itself (as of the last

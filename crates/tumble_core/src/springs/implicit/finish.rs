@@ -85,10 +85,13 @@ impl ImplicitSpringSolver {
         if !self.ends_are_free() || self.starts.iter().any(held) {
             return;
         }
-        let mass: f64 = self.starts.iter().map(|s| s.mass).sum();
-        if mass <= 0.0 {
+        let pairs = self.starts.iter().zip(exact.iter());
+        let Some((mass, centre)) = mass_and_centre(pairs.clone()) else {
             return;
-        }
+        };
+        let Some(inverse) = inverse_inertia_about(pairs, centre) else {
+            return;
+        };
         // Angular momenta about the start's centre of mass `X₀`, a fixed point: about the world
         // origin, a group far from it would sum terms `|X|/size` times larger, and their
         // rounding would be put into the bodies as a spin.
@@ -103,13 +106,6 @@ impl ImplicitSpringSolver {
                 - (p.x - origin).cross(s.mass * p.v)
                 - p.q * (s.inertia * p.body_rate(s));
         }
-        let all: Vec<(&Start, &Pose)> = self.starts.iter().zip(exact.iter()).collect();
-        let Some((_, centre)) = mass_and_centre(&all) else {
-            return;
-        };
-        let Some(inverse) = inverse_inertia_about(&all, centre) else {
-            return;
-        };
         let dv = p_gap / mass;
         let dw = inverse * (l_gap - (centre - origin).cross(mass * dv));
         for (s, p) in self.starts.iter().zip(exact.iter_mut()) {
@@ -186,8 +182,9 @@ impl ImplicitSpringSolver {
     /// is that of the group as one body (see [`RigidMotion`]): the internal motion carries no
     /// linear momentum, and for a group no spring ties to a fixed point no angular momentum
     /// either, so the correction keeps both (where a fixed point holds the group, the rigid
-    /// motion is its centre's translation alone: a single body's spin would be all of it). Only a correction
-    /// rounding can explain (within four times [`Self::rounding_bound`]) is made. Bodies turned
+    /// motion is its centre's translation alone: a single body's spin would be all of it). Only
+    /// a correction rounding can explain (within four times [`Self::rounding_bound`]) is made.
+    /// Bodies turned
     /// by a method's free flow are left out (the rigid motion and `T_int` are those of the
     /// others): a method's turn keeps the energy to the method's accuracy, not exactly, and
     /// scaling its spin would shift its phase.
@@ -209,17 +206,15 @@ impl ImplicitSpringSolver {
             .collect();
         let target = self.energy(exact);
         let missing = target - self.energy(&rounded);
-        let scaled: Vec<(&Start, &Pose)> = self
+        let scaled = self
             .starts
             .iter()
             .zip(&rounded)
-            .filter(|(s, _)| s.method.is_none())
-            .collect();
-        let Some(rigid) = RigidMotion::of(&scaled, self.ends_are_free()) else {
+            .filter(|(s, _)| s.method.is_none());
+        let Some(rigid) = RigidMotion::of(scaled.clone(), self.ends_are_free()) else {
             return;
         };
         let internal: f64 = scaled
-            .iter()
             .map(|(s, p)| {
                 let (u, eta) = rigid.internal(p);
                 let eta = s.free * (p.q.inverse() * eta);
@@ -278,17 +273,16 @@ impl RigidMotion {
     /// The rigid motion of `bodies` (`None` without mass); with `keep_spin` false, or where `J`
     /// cannot be inverted, a translation only (`Ω = 0`: the internal motion then carries the
     /// set's angular momentum about `X`).
-    fn of(bodies: &[(&Start, &Pose)], keep_spin: bool) -> Option<Self> {
-        let (mass, centre) = mass_and_centre(bodies)?;
-        let velocity = bodies.iter().map(|(s, p)| s.mass * p.v).sum::<DVec3>() / mass;
+    fn of<'a>(bodies: impl Bodies<'a>, keep_spin: bool) -> Option<Self> {
+        let (mass, centre) = mass_and_centre(bodies.clone())?;
+        let velocity = bodies.clone().map(|(s, p)| s.mass * p.v).sum::<DVec3>() / mass;
         let mut motion = Self {
             centre,
             velocity,
             spin: DVec3::ZERO,
         };
-        if keep_spin && let Some(inverse) = inverse_inertia_about(bodies, centre) {
+        if keep_spin && let Some(inverse) = inverse_inertia_about(bodies.clone(), centre) {
             let momentum: DVec3 = bodies
-                .iter()
                 .map(|(s, p)| {
                     (p.x - centre).cross(s.mass * (p.v - velocity)) + own_inertia(s, p) * p.w
                 })
@@ -309,11 +303,18 @@ impl RigidMotion {
     }
 }
 
+/// A set of bodies, each its start and its end pose, walked once per sum (an iterator, not a
+/// collected list: the step runs these sums for every group, and a list would be allocated
+/// each time).
+trait Bodies<'a>: Iterator<Item = (&'a Start, &'a Pose)> + Clone {}
+
+impl<'a, I: Iterator<Item = (&'a Start, &'a Pose)> + Clone> Bodies<'a> for I {}
+
 /// The total mass and the centre of mass of `bodies`; `None` without mass.
-fn mass_and_centre(bodies: &[(&Start, &Pose)]) -> Option<(f64, DVec3)> {
-    let mass: f64 = bodies.iter().map(|(s, _)| s.mass).sum();
+fn mass_and_centre<'a>(bodies: impl Bodies<'a>) -> Option<(f64, DVec3)> {
+    let mass: f64 = bodies.clone().map(|(s, _)| s.mass).sum();
     (mass > 0.0).then(|| {
-        let centre = bodies.iter().map(|(s, p)| s.mass * p.x).sum::<DVec3>() / mass;
+        let centre = bodies.map(|(s, p)| s.mass * p.x).sum::<DVec3>() / mass;
         (mass, centre)
     })
 }
@@ -327,9 +328,8 @@ fn own_inertia(s: &Start, p: &Pose) -> DMat3 {
 /// The inverse of the inertia of `bodies` about `centre` as one rigid body,
 /// `J = Σ m (|r|² 1 − r rᵀ) + Q I Qᵀ` (`r = x − centre`); `None` where `J` is singular to
 /// round-off (point masses on one line).
-fn inverse_inertia_about(bodies: &[(&Start, &Pose)], centre: DVec3) -> Option<DMat3> {
+fn inverse_inertia_about<'a>(bodies: impl Bodies<'a>, centre: DVec3) -> Option<DMat3> {
     let inertia: DMat3 = bodies
-        .iter()
         .map(|(s, p)| {
             let r = p.x - centre;
             s.mass
