@@ -90,6 +90,11 @@ pub(crate) struct BlockLu {
     /// them once per remaining neighbour, and write only to other blocks of the pool.
     upper_blocks: Vec<Block>,
     queue: BinaryHeap<Reverse<(usize, usize)>>,
+    /// The pattern `order` was chosen for: the body count, then each row's length and columns
+    /// (see [`BlockLu::analyze_unless_known`]).
+    analyzed_pattern: Vec<u32>,
+    /// Scratch: the present pattern, in the form of `analyzed_pattern`.
+    pattern: Vec<u32>,
 }
 
 /// A block pivot could not be inverted.
@@ -157,6 +162,24 @@ impl BlockLu {
             }
         };
         &mut self.pool[block as usize]
+    }
+
+    /// [`analyze`](Self::analyze), unless the present pattern is the one the present order was
+    /// chosen for (the same bodies and blocks, listed in the same order): the order is a
+    /// function of the pattern alone, and a group whose springs stay the same keeps its pattern
+    /// from one step to the next. Costs one pass over the pattern.
+    pub(crate) fn analyze_unless_known(&mut self) {
+        let n = self.diagonal.len();
+        self.pattern.clear();
+        self.pattern.push(narrow(n));
+        for row in &self.rows[..n] {
+            self.pattern.push(narrow(row.len()));
+            self.pattern.extend(row.iter().map(|&(j, _)| j));
+        }
+        if self.pattern != self.analyzed_pattern || self.order.len() != n {
+            self.analyze();
+            std::mem::swap(&mut self.pattern, &mut self.analyzed_pattern);
+        }
     }
 
     /// Chooses the elimination order from the present pattern (call after the `add`s; the

@@ -82,6 +82,7 @@ impl ImplicitSpringSolver {
     /// `out = J u`: the Newton matrix (the body blocks of [`Self::build_blocks`] and the
     /// springs' `¼ GᵀKG`, applied spring by spring) times `u`.
     pub(super) fn apply_jacobian(&self, h: f64, u: &[f64], out: &mut [f64]) {
+        debug_assert!(self.linearized, "linearize first");
         for (i, block) in self.blocks.iter().enumerate() {
             let y = block_mul(block, &u[6 * i..6 * i + 6]);
             out[6 * i..6 * i + 6].copy_from_slice(&y);
@@ -111,6 +112,7 @@ impl ImplicitSpringSolver {
     /// The body blocks of the Newton matrix at the current iterate: mass, inertia and
     /// gyroscopic terms, and the turning of the torques' frame and arms with `Ω̄`.
     pub(super) fn build_blocks(&mut self, h: f64) {
+        self.linearize(h);
         let mut blocks = std::mem::take(&mut self.blocks);
         blocks.clear();
         blocks.extend((0..self.starts.len()).map(|i| self.body_block(h, i)));
@@ -141,8 +143,9 @@ impl ImplicitSpringSolver {
         lu.reset(&self.blocks);
         self.assemble_springs(h, &mut lu);
         if !self.analyzed {
-            // The pattern is the group's graph, the same for every Newton iteration of a solve.
-            lu.analyze();
+            // The pattern is the group's graph, the same for every Newton iteration of a solve
+            // (and of the next step's, while the springs stay).
+            lu.analyze_unless_known();
             self.analyzed = true;
         }
         self.factored = lu.factor().is_ok();
@@ -225,6 +228,7 @@ impl ImplicitSpringSolver {
     /// `E_turn = h F (1 − [hΩ̄/2]×) [b]× Rᵀ`, the torque of a world force at the anchor (see
     /// `end_transpose`); `F` masks locked axes, `R` is the start frame.
     pub(super) fn end_factors(&self, h: f64, i: usize, b: DVec3) -> EndFactors {
+        debug_assert!(self.linearized, "linearize first");
         let s = &self.starts[i];
         let free = DMat3::from_diagonal(s.free);
         EndFactors {

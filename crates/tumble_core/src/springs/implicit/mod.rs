@@ -342,8 +342,17 @@ struct Linearized {
     /// anchors' displacement is `h v̄ + Q₀ (hΩ̄ × b)`, and `b` is the torques' lever arm (see
     /// `evaluate`).
     b: [DVec3; 2],
-    /// `−2 ∂F̄/∂d₁ = k ((1 − L₀/ℓ̄) 1 + (L₀/ℓ̄²) d̄ n₁ᵀ)` (world frame).
+    /// `−2 ∂F̄/∂d₁ = k ((1 − L₀/ℓ̄) 1 + (L₀/ℓ̄²) d̄ n₁ᵀ)` (world frame), once
+    /// [`ImplicitSpringSolver::linearize`] has run.
     k: DMat3,
+    /// The mean separation `d̄ = (d₀ + d₁)/2` of the anchors (world frame).
+    dbar: DVec3,
+    /// The separation `d₁` at the end of the step.
+    d1: DVec3,
+    /// `ℓ̄ = (|d₀| + |d₁|)/2`.
+    lbar: f64,
+    /// `|d₁|`.
+    l1: f64,
     /// The force on end `a`, `F̄`.
     force: DVec3,
 }
@@ -379,8 +388,10 @@ pub struct ImplicitSpringSolver {
     /// Per body, `F (1 − [hΩ̄/2]×)` (`F` masking locked axes): what turns the start-frame
     /// torque `b × Q₀ᵀf` into the one the step applies (see `evaluate`).
     unturn: Vec<DMat3>,
-    /// Per body, `(1 − [hΩ̄/2]×)⁻¹`: the derivative of the Cayley rotation (see `evaluate`).
+    /// Per body, `(1 − [hΩ̄/2]×)⁻¹`: the derivative of the Cayley rotation (see `linearize`).
     cayley_derivative: Vec<DMat3>,
+    /// True when `cayley_derivative` and the springs' `k` are those of the last evaluation.
+    linearized: bool,
     krylov: Krylov,
     /// The direct factorization of the Newton matrix (the preconditioner when it exists).
     lu: BlockLu,
@@ -414,6 +425,7 @@ impl Default for ImplicitSpringSolver {
             cursor: Vec::new(),
             unturn: Vec::new(),
             cayley_derivative: Vec::new(),
+            linearized: false,
             krylov: Krylov::default(),
             lu: BlockLu::default(),
             factored: false,

@@ -365,24 +365,20 @@ impl ImplicitSpringSolver {
         sum
     }
 
-    /// Computes the residual at `self.z` into `self.residual` (and the linearization for the
-    /// Jacobian) and returns its norm, scaled per body by `1/√m`, `1/√I`.
+    /// Computes the residual at `self.z` into `self.residual` (and what the linearization at
+    /// `self.z` needs besides, see [`Self::linearize`]) and returns its norm, scaled per body by
+    /// `1/√m`, `1/√I`.
     pub(super) fn evaluate(&mut self, h: f64) -> f64 {
+        self.linearized = false;
         self.cayley.clear();
         self.unturn.clear();
-        self.cayley_derivative.clear();
         for (i, s) in self.starts.iter().enumerate() {
             let z = &self.z[6 * i..6 * i + 6];
             let vbar = v3(&z[..3]);
             let wbar = s.free * v3(&z[3..]);
             let cay = DMat3::from_quat(s.turn(h, wbar));
             self.cayley.push(cay);
-            // From (1 − [w/2]×) cay(w) a = (1 + [w/2]×) a: d(cay(w) a) = −(1 − [w/2]×)⁻¹ [b]× dw,
-            // and (1 − [u]×)⁻¹ = 1 + ([u]× + [u]×²)/(1 + |u|²).
             let u = skew(0.5 * h * wbar);
-            let uu = (0.5 * h * wbar).length_squared();
-            self.cayley_derivative
-                .push(DMat3::IDENTITY + (u + u * u) * (1.0 / (1.0 + uu)));
             // A method's turn keeps the world momentum: the torques act unturned, and there is
             // no gyroscopic term (it is in the turn).
             let midpoint = s.method.is_none();
@@ -425,16 +421,11 @@ impl ImplicitSpringSolver {
             let dbar = 0.5 * (link.d0 + d1);
             let lbar = 0.5 * (link.l0 + l1);
             let force = if lbar > 0.0 {
-                let ratio = (lbar - link.rest) / lbar;
-                lin.k = DMat3::from_diagonal(DVec3::splat(link.k * ratio));
-                if l1 > 0.0 {
-                    lin.k += (link.k * link.rest / (lbar * lbar * l1)) * outer(dbar, d1);
-                }
-                -link.k * ratio * dbar
+                -link.k * ((lbar - link.rest) / lbar) * dbar
             } else {
-                lin.k = DMat3::from_diagonal(DVec3::splat(link.k));
                 DVec3::ZERO
             };
+            (lin.dbar, lin.d1, lin.lbar, lin.l1) = (dbar, d1, lbar, l1);
             lin.force = force;
             for (e, end) in link.ends.iter().enumerate() {
                 if let Some(s) = self.starts.get(end.body) {
@@ -454,5 +445,39 @@ impl ImplicitSpringSolver {
                 v3(&r[..3]).length_squared() / s.mass + v3(&r[3..]).dot(inv_i * v3(&r[3..]))
             })
             .sum::<f64>()
+    }
+    /// The parts of the Newton matrix at the last evaluated iterate that the residual does not
+    /// need: each body's Cayley derivative and each spring's stiffness `−2 ∂F̄/∂d₁`. Only an
+    /// iteration that assembles the matrix needs them, so trial evaluations (the backtracking,
+    /// the chord steps) skip their cost. Computed once per evaluation, from the values the
+    /// evaluation left, so they are the same bits whenever asked for.
+    pub(super) fn linearize(&mut self, h: f64) {
+        if self.linearized {
+            return;
+        }
+        self.linearized = true;
+        self.cayley_derivative.clear();
+        for (i, s) in self.starts.iter().enumerate() {
+            // From (1 − [w/2]×) cay(w) a = (1 + [w/2]×) a: d(cay(w) a) = −(1 − [w/2]×)⁻¹ [b]× dw,
+            // and (1 − [u]×)⁻¹ = 1 + ([u]× + [u]×²)/(1 + |u|²).
+            let wbar = s.free * v3(&self.z[6 * i + 3..6 * i + 6]);
+            let u = skew(0.5 * h * wbar);
+            let uu = (0.5 * h * wbar).length_squared();
+            self.cayley_derivative
+                .push(DMat3::IDENTITY + (u + u * u) * (1.0 / (1.0 + uu)));
+        }
+        for (link, lin) in self.links.iter().zip(self.lin.iter_mut()) {
+            let (dbar, d1, lbar, l1) = (lin.dbar, lin.d1, lin.lbar, lin.l1);
+            lin.k = if lbar > 0.0 {
+                let ratio = (lbar - link.rest) / lbar;
+                let mut k = DMat3::from_diagonal(DVec3::splat(link.k * ratio));
+                if l1 > 0.0 {
+                    k += (link.k * link.rest / (lbar * lbar * l1)) * outer(dbar, d1);
+                }
+                k
+            } else {
+                DMat3::from_diagonal(DVec3::splat(link.k))
+            };
+        }
     }
 }
