@@ -97,3 +97,30 @@ fn compute_pool() -> &'static bevy_tasks::ComputeTaskPool {
 pub fn pool_threads() -> usize {
     1
 }
+
+/// Runs `work` on `items` cut into `threads` runs of nearly equal length, one job per run on
+/// the compute pool (on this thread alone when `threads` is 1), each with the index of its first
+/// item. For passes whose items are independent: each item is worked by the same code in any
+/// cut, so the results do not depend on the number of threads.
+pub(crate) fn in_runs<T: Send>(
+    threads: usize,
+    items: &mut [T],
+    work: impl Fn(usize, &mut [T]) + Sync,
+) {
+    if threads <= 1 {
+        work(0, items);
+        return;
+    }
+    let work = &work;
+    scope(|spawn| {
+        let mut rest = items;
+        let mut first = 0;
+        for k in (1..=threads).rev() {
+            let take = rest.len() / k;
+            let (run, tail) = std::mem::take(&mut rest).split_at_mut(take);
+            spawn(Box::new(move || work(first, run)));
+            first += take;
+            rest = tail;
+        }
+    });
+}

@@ -328,13 +328,22 @@ fn despawned_and_new_bodies_keep_the_groups_right() {
 
 /// The audit's sums over a group follow entity order, not the order its queries visit tables
 /// in: a chain whose bodies and springs game code has spread over several tables (components
-/// of its own) keeps the same account, bit for bit, as the same chain in one table each.
+/// of its own) keeps the same account, bit for bit, as the same chain in one table each; and
+/// so does either with the audit's passes split over the thread pool (each body a run of its
+/// own), table by table where the tables are in entity order, by entity where they are not.
 #[test]
 fn the_account_does_not_depend_on_the_tables_bodies_sit_in() {
     #[derive(Component)]
     struct Tag<const N: usize>;
-    let account = |spread: bool| {
+    let account = |spread: bool, threaded: bool| {
         let mut world = audited_world(Integrator::Splitting);
+        if threaded {
+            world.insert_resource(Parallelism {
+                enabled: true,
+                min_bodies: 0,
+                min_batch: 1,
+            });
+        }
         let bodies = chain(&mut world, 9, 0.0, 0.5);
         if spread {
             for (k, &b) in bodies.iter().enumerate() {
@@ -372,5 +381,8 @@ fn the_account_does_not_depend_on_the_tables_bodies_sit_in() {
         );
         created.to_bits()
     };
-    assert_eq!(account(false), account(true));
+    let alone = account(false, false);
+    assert_eq!(alone, account(true, false));
+    assert_eq!(alone, account(false, true));
+    assert_eq!(alone, account(true, true));
 }

@@ -10,6 +10,7 @@ use crate::components::{
     SpringEnd, Static, Velocity, kinetic_energy_f64,
 };
 
+/// The audit's largest `ωΔt` in the stable-spring factor: at 2 the factor is infinite, and
 /// beyond it the spring is unstable and grows geometrically past any finite bound anyway.
 pub(super) const OMEGA_DT_CAP: f64 = 1.99;
 
@@ -82,6 +83,11 @@ impl Link {
             measured: 0,
             elastic: 0.0,
         }
+    }
+
+    /// True when an end is an audited body (the link belongs to that body's group).
+    pub(super) fn is_audited(&self) -> bool {
+        matches!(self.a, End::Audited(..)) || matches!(self.b, End::Audited(..))
     }
 
     /// The audited bodies at its ends.
@@ -303,24 +309,13 @@ impl EnergyLedger {
         }
     }
 
-    /// World anchor of an end, from the pose `pose` gives an audited body.
-    pub(super) fn anchor(&self, end: End, pose: impl Fn(&Audited) -> Pose) -> Option<Vec3> {
-        match end {
-            End::Audited(i, local) => Some(pose(&self.bodies[i as usize]).transform_point(local)),
-            End::Fixed(p) => Some(p),
-            End::Kinematic | End::Inactive => None,
-        }
-    }
-
     /// Elastic energy of a link with the bodies at the poses `pose` gives.
     pub(super) fn elastic(
         &self,
         link: &Link,
         pose: impl Fn(&Audited) -> Pose + Copy,
     ) -> Option<f64> {
-        let pa = self.anchor(link.a, pose)?;
-        let pb = self.anchor(link.b, pose)?;
-        Some(link.elastic_energy(pa, pb))
+        elastic_among(&self.bodies, link, pose)
     }
 
     /// Link `k`'s elastic energy at the start of the step: the one the last step ended with
@@ -331,85 +326,6 @@ impl EnergyLedger {
             return Some(link.elastic);
         }
         self.elastic(link, |b| b.start.0)
-    }
-
-    /// The start of a step when the world's spring graph is as the last step left it: the
-    /// same audited bodies in the same order with the same masses, the same springs (bit for
-    /// bit) with the same ends. Then the groups, links and union–find of the last step hold,
-    /// and only the energies need measuring, each reused from its [`memo`] where its inputs
-    /// are unchanged; when nothing changed at all, each group's `T + V` is the sum its end pass
-    /// closed with (the start pass would add the same energies in the same order). Either way
-    /// the sums are the full start pass's, bit for bit. Returns false as soon as the graph
-    /// differs, having changed only what the full start pass rebuilds.
-    pub(super) fn restart(
-        &mut self,
-        bodies: &AuditedBodies,
-        ends: &Ends,
-        springs: &AuditedSprings,
-    ) -> bool {
-        let mut n = 0;
-        let mut all_still = true;
-        let mut same = true;
-        let mut order = std::mem::take(&mut self.body_order);
-        for_each_audited(&mut order, bodies, |(entity, t, v, m)| {
-            let Some(body) = self.bodies.get(n).filter(|b| same && b.entity == entity) else {
-                same = false;
-                return;
-            };
-            let mass = body.mass;
-            let (energy, still) = self.start_kinetic(n, (entity, t, v, m));
-            // A new mass changes the springs' reduced masses, so their stiffness bound: regroup.
-            if !still && m.mass().widen().to_bits() != mass.to_bits() {
-                same = false;
-                return;
-            }
-            let body = &mut self.bodies[n];
-            body.start = (*t, *v);
-            body.end = *t;
-            body.memo = BodyMemo::NONE;
-            body.load = (Vec3::ZERO, Vec3::ZERO);
-            (body.start_energy, body.still) = (energy, still);
-            all_still &= still;
-            n += 1;
-        });
-        self.body_order = order;
-        if !same || n != self.bodies.len() {
-            return false;
-        }
-        let mut k = 0;
-        let spring_order = std::mem::take(&mut self.spring_order);
-        spring_order.for_each(springs, |spring| {
-            let Some(link) = self.links.get(k).filter(|_| same) else {
-                same = false;
-                return;
-            };
-            // Resolved again: an end that is not an audited body may have moved (a static
-            // body) or changed kind since.
-            let (a, b) = resolve_ends(self, ends, spring);
-            same &= link.same_inputs(&Link::new(spring, a, b));
-            k += 1;
-        });
-        self.spring_order = spring_order;
-        if !same || k != self.links.len() {
-            return false;
-        }
-        if all_still {
-            for g in &mut self.groups {
-                (g.start, g.magnitude) = (g.end, g.end);
-                (g.end, g.work) = (0.0, 0.0);
-            }
-            #[cfg(test)]
-            {
-                self.restarts += 1;
-            }
-            return true;
-        }
-        self.sum_start_energies();
-        #[cfg(test)]
-        {
-            self.partial_restarts += 1;
-        }
-        true
     }
 
     /// The kinetic energy at the start of the step of the body read at index `i`, and whether
@@ -474,6 +390,28 @@ impl EnergyLedger {
         }
         self.closed = false;
     }
+}
+
+/// World anchor of an end among the audited `bodies`, from the pose `pose` gives an audited
+/// body.
+fn anchor_among(bodies: &[Audited], end: End, pose: impl Fn(&Audited) -> Pose) -> Option<Vec3> {
+    match end {
+        End::Audited(i, local) => Some(pose(&bodies[i as usize]).transform_point(local)),
+        End::Fixed(p) => Some(p),
+        End::Kinematic | End::Inactive => None,
+    }
+}
+
+/// Elastic energy of a link among the audited `bodies`, with the bodies at the poses `pose`
+/// gives; `None` when an end is kinematic or inactive.
+pub(super) fn elastic_among(
+    bodies: &[Audited],
+    link: &Link,
+    pose: impl Fn(&Audited) -> Pose + Copy,
+) -> Option<f64> {
+    let pa = anchor_among(bodies, link.a, pose)?;
+    let pb = anchor_among(bodies, link.b, pose)?;
+    Some(link.elastic_energy(pa, pb))
 }
 
 /// Rigid bodies that are not quarantined, whatever their kind (spring ends may be static or

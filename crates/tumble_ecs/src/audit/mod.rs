@@ -74,9 +74,15 @@
 //! the spring graph is as the last step left it (the same bodies, masses and springs), the
 //! start also keeps the last step's groups (`EnergyLedger::restart`); when nothing changed at
 //! all, it takes each group's `T + V` from the sum its end pass closed with: the same number,
-//! added in the same order. All serial, so in a
-//! loaded spring world it is the largest single part of the step
-//! (`cargo bench --bench audit` measures the ratio on a 10⁴-body chain). Bodies are found by
+//! added in the same order. The per-body and per-spring work of the passes (each body's start,
+//! load, work and kinetic energy, each spring's elastic energy) runs on the compute pool's
+//! threads as [`Parallelism`](crate::parallel::Parallelism) allows, each table of bodies zipped
+//! with the ledger's entries where the tables visit the bodies in entity index order (by entity
+//! lookup, on one thread, where they do not); each item is worked by the same code on any
+//! thread, and the sums over groups are added on one thread in the ledger's order, so the
+//! accounts are the same bits on any number of threads. In a loaded spring world the audit is
+//! still the largest single part of the step (`cargo bench --bench audit` measures the ratio on
+//! a 10⁴-body chain). Bodies are found by
 //! entity index in a table the ledger keeps, not by hashing; it allocates only when the world
 //! grows. The ledger's bodies and springs are in entity index order, and every sum over a group
 //! follows it: which tables game code's own components spread the bodies over, and in which
@@ -87,6 +93,7 @@
 
 mod ledger;
 mod memo;
+mod restart;
 mod systems;
 
 use bevy_ecs::prelude::*;
@@ -119,6 +126,5 @@ impl EnergyAudit {
     }
 }
 
-/// The audit's largest `ωΔt` in the stable-spring factor: at 2 the factor is infinite, and
 #[cfg(test)]
 mod tests;

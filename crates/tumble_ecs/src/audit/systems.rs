@@ -5,14 +5,16 @@ use tumble_core::math::{Real, Vec3, Widen};
 
 use super::ledger::{
     Account, Audited, AuditedBodies, AuditedSprings, End, Ends, EnergyLedger, GroupStep, Link,
-    OMEGA_DT_CAP, ROUND_OFF_ULPS, for_each_audited, resolve_ends,
+    OMEGA_DT_CAP, ROUND_OFF_ULPS, elastic_among, for_each_audited, resolve_ends,
 };
 use super::memo::BodyMemo;
+use crate::components::dense;
 use crate::components::{
-    BodyError, BodyErrorKind, Dynamic, ForceAccumulator, Gravity, GravityScale, MassProps,
-    PhysicsSettings, Pose, Velocity, reject,
+    BodyError, BodyErrorKind, Dynamic, ForceAccumulator, Gravity, GravityScale, ImplicitBody,
+    MassProps, PhysicsSettings, Pose, Velocity, reject,
 };
 use crate::integrate::StageCursor;
+use crate::parallel::{Parallelism, in_runs};
 
 /// Start of an audited step (first in the plan): remembers each dynamic body's state, resolves
 /// the springs' ends, forms the spring groups and measures each group's `T + V`.
@@ -20,6 +22,7 @@ pub fn audit_energy_start(
     settings: Res<PhysicsSettings>,
     cursor: Res<StageCursor>,
     mut ledger: ResMut<EnergyLedger>,
+    parallelism: Option<Res<Parallelism>>,
     bodies: AuditedBodies,
     ends: Ends,
     springs: AuditedSprings,
@@ -35,7 +38,11 @@ pub fn audit_energy_start(
     let same_span = stability_span.to_bits() == ledger.stability_span.to_bits();
     ledger.stability_span = stability_span;
     ledger.midpoint = settings.integrator.samples_forces_at_midpoint();
-    if std::mem::take(&mut ledger.closed) && same_span && ledger.restart(&bodies, &ends, &springs) {
+    let parallelism = parallelism.map_or_else(Parallelism::default, |p| *p);
+    if std::mem::take(&mut ledger.closed)
+        && same_span
+        && ledger.restart(&bodies, &ends, &springs, &parallelism)
+    {
         return;
     }
     ledger.groups.clear();
@@ -115,15 +122,8 @@ pub fn audit_external_loads(
     settings: Res<PhysicsSettings>,
     cursor: Res<StageCursor>,
     mut ledger: ResMut<EnergyLedger>,
-    bodies: Query<
-        (
-            Entity,
-            &Pose,
-            &ForceAccumulator,
-            Option<&crate::components::ImplicitBody>,
-        ),
-        Dynamic,
-    >,
+    parallelism: Option<Res<Parallelism>>,
+    bodies: LoadedBodies,
 ) {
     let ledger = &mut *ledger;
     let span = cursor.span(&settings);
@@ -134,24 +134,105 @@ pub fn audit_external_loads(
     } else {
         Some(span.h / settings.dt())
     };
-    for (entity, t, acc, implicit) in &bodies {
-        let Some(i) = ledger.slot(entity) else {
-            continue;
-        };
+    let record = LoadRecord {
+        share,
+        opens_step: span.opens_step,
+    };
+    let parallelism = parallelism.map_or_else(Parallelism::default, |p| *p);
+    if !record.in_table_order(ledger, &bodies, &parallelism) {
+        for (entity, t, acc, implicit) in &bodies {
+            if let Some(i) = ledger.slot(entity) {
+                record.record(&mut ledger.bodies[i], t, acc, implicit);
+            }
+        }
+    }
+}
+
+/// The bodies whose loads [`audit_external_loads`] records.
+type LoadedBodies<'w, 's> = Query<
+    'w,
+    's,
+    (
+        Entity,
+        &'static Pose,
+        &'static ForceAccumulator,
+        Option<&'static ImplicitBody>,
+    ),
+    Dynamic,
+>;
+
+/// How [`audit_external_loads`] records a stage's loads.
+struct LoadRecord {
+    /// The stage's share `h/Δt` of the step (`None`: the step's only stage).
+    share: Option<Real>,
+    /// The stage opens the step.
+    opens_step: bool,
+}
+
+impl LoadRecord {
+    /// Records one body's load.
+    #[inline]
+    fn record(
+        &self,
+        body: &mut Audited,
+        t: &Pose,
+        acc: &ForceAccumulator,
+        implicit: Option<&ImplicitBody>,
+    ) {
         // The torque of the forces at points an implicit body's solve takes at mid-step,
         // credited here at the pose the forces were sampled at.
         let torque = acc.torque + implicit.map_or(Vec3::ZERO, |b| b.point_torque(t.rotation));
-        let load = &mut ledger.bodies[i].load;
-        match share {
+        let load = &mut body.load;
+        match self.share {
             None => *load = (acc.force, torque),
             Some(w) => {
-                if span.opens_step {
+                if self.opens_step {
                     *load = (Vec3::ZERO, Vec3::ZERO);
                 }
                 load.0 += w * acc.force;
                 load.1 += w * torque;
             }
         }
+    }
+
+    /// Records every body's load table by table, zipped with the ledger's entries and split over
+    /// the compute pool's threads (as [`EndPass::measure_in_table_order`]). Returns false,
+    /// having recorded nothing, where a table's bodies are not the ledger's next entries: a
+    /// stage's share adds to the load, so the tables are matched with the entries before any
+    /// is recorded, and the caller's lookup by entity records each load once.
+    fn in_table_order(
+        &self,
+        ledger: &mut EnergyLedger,
+        bodies: &LoadedBodies,
+        parallelism: &Parallelism,
+    ) -> bool {
+        let mut first = 0;
+        for (entities, ..) in dense(bodies.contiguous_iter()) {
+            let Some(entries) = ledger.bodies.get(first..first + entities.len()) else {
+                return false;
+            };
+            if entries.iter().zip(entities).any(|(b, e)| b.entity != *e) {
+                return false;
+            }
+            first += entities.len();
+        }
+        let mut first = 0;
+        for (entities, poses, accumulators, implicit) in dense(bodies.contiguous_iter()) {
+            let entries = &mut ledger.bodies[first..first + entities.len()];
+            in_runs(
+                parallelism.threads_for(entries.len()),
+                entries,
+                |at, run| {
+                    for (k, body) in run.iter_mut().enumerate() {
+                        let j = at + k;
+                        let implicit = implicit.map(|b| &b[j]);
+                        self.record(body, &poses[j], &accumulators[j], implicit);
+                    }
+                },
+            );
+            first += entities.len();
+        }
+        true
     }
 }
 
@@ -163,17 +244,8 @@ pub fn audit_energy(
     cursor: Res<StageCursor>,
     mut ledger: ResMut<EnergyLedger>,
     gravity: Option<Res<Gravity>>,
-    bodies: Query<
-        (
-            Entity,
-            &Pose,
-            &Velocity,
-            &MassProps,
-            Option<&GravityScale>,
-            Has<ForceAccumulator>,
-        ),
-        Dynamic,
-    >,
+    parallelism: Option<Res<Parallelism>>,
+    bodies: EndBodies,
     mut commands: Commands,
 ) {
     let ledger = &mut *ledger;
@@ -186,24 +258,20 @@ pub fn audit_energy(
     // which its number rules out): a spring's memo is reused only with its bodies' poses
     // measured in the same pass.
     ledger.end_passes += 1;
-    let pass = ledger.end_passes;
-    for (entity, t, v, m, scale, has_accumulator) in &bodies {
-        let Some(i) = ledger.slot(entity) else {
-            continue;
-        };
-        let body = &mut ledger.bodies[i];
-        body.end = *t;
-        let (force, torque) = match gravity {
-            // Bodies without an accumulator take gravity inside the integration.
-            Some(g) if !has_accumulator => (m.mass() * scale.map_or(1.0, |s| s.0) * g, Vec3::ZERO),
-            _ => body.load,
-        };
-        let v0 = body.start.1;
-        let v_mean = 0.5 * (v0.linear.widen() + v.linear.widen());
-        let w_mean = 0.5 * (v0.angular.widen() + v.angular.widen());
-        body.work = dt * (force.widen().dot(v_mean) + torque.widen().dot(w_mean));
-        body.memo = BodyMemo::measure(pass, t, v, m);
+    let end = EndPass {
+        pass: ledger.end_passes,
+        dt,
+        gravity,
+    };
+    let parallelism = parallelism.map_or_else(Parallelism::default, |p| *p);
+    if !end.measure_in_table_order(ledger, &bodies, &parallelism) {
+        for (entity, t, v, m, scale, has_accumulator) in &bodies {
+            if let Some(i) = ledger.slot(entity) {
+                end.measure(&mut ledger.bodies[i], t, v, m, scale, has_accumulator);
+            }
+        }
     }
+    let pass = end.pass;
     // Summed in the ledger's order (entity index order), not the query's.
     for body in &ledger.bodies {
         if !body.memo.measured_by(pass) {
@@ -215,11 +283,104 @@ pub fn audit_energy(
         g.work += work;
         g.magnitude += energy + work.abs();
     }
-    ledger.measure_springs_at_end(pass);
+    ledger.measure_springs_at_end(pass, &parallelism);
     ledger.rekey_restored_accounts();
     ledger.close_balances(&mut commands);
     ledger.accounts.retain(|_, a| a.seen);
     ledger.closed = true;
+}
+
+/// The bodies the end pass measures.
+type EndBodies<'w, 's> = Query<
+    'w,
+    's,
+    (
+        Entity,
+        &'static Pose,
+        &'static Velocity,
+        &'static MassProps,
+        Option<&'static GravityScale>,
+        Has<ForceAccumulator>,
+    ),
+    Dynamic,
+>;
+
+/// What the end pass measures each audited body with.
+struct EndPass {
+    /// The pass's number.
+    pass: u64,
+    dt: f64,
+    gravity: Option<Vec3>,
+}
+
+impl EndPass {
+    /// Measures one body at the end of the step: its end pose, the work its load did over the
+    /// step (`W = Δt (F·v̄ + τ·ω̄)` with the mean velocities), and its kinetic energy, kept with
+    /// its inputs for the next start ([`BodyMemo`]).
+    #[inline]
+    fn measure(
+        &self,
+        body: &mut Audited,
+        t: &Pose,
+        v: &Velocity,
+        m: &MassProps,
+        scale: Option<&GravityScale>,
+        has_accumulator: bool,
+    ) {
+        body.end = *t;
+        let (force, torque) = match self.gravity {
+            // Bodies without an accumulator take gravity inside the integration.
+            Some(g) if !has_accumulator => (m.mass() * scale.map_or(1.0, |s| s.0) * g, Vec3::ZERO),
+            _ => body.load,
+        };
+        let v0 = body.start.1;
+        let v_mean = 0.5 * (v0.linear.widen() + v.linear.widen());
+        let w_mean = 0.5 * (v0.angular.widen() + v.angular.widen());
+        body.work = self.dt * (force.widen().dot(v_mean) + torque.widen().dot(w_mean));
+        body.memo = BodyMemo::measure(self.pass, t, v, m);
+    }
+
+    /// Measures every body table by table, each table zipped with the ledger's entries in the
+    /// same order and split over the compute pool's threads as [`Parallelism`] allows (each
+    /// body is measured by the same code on any thread). Returns false, leaving the rest to the
+    /// caller's lookup by entity, where a table's bodies are not the ledger's next entries (the
+    /// tables visit the bodies out of entity index order, or a body came or went since the
+    /// start); what was measured by then is measured again from the same inputs.
+    fn measure_in_table_order(
+        &self,
+        ledger: &mut EnergyLedger,
+        bodies: &EndBodies,
+        parallelism: &Parallelism,
+    ) -> bool {
+        let mut first = 0;
+        for (entities, poses, velocities, masses, scales, has_accumulator) in
+            dense(bodies.contiguous_iter())
+        {
+            let Some(entries) = ledger.bodies.get_mut(first..first + entities.len()) else {
+                return false;
+            };
+            if entries.iter().zip(entities).any(|(b, e)| b.entity != *e) {
+                return false;
+            }
+            let threads = parallelism.threads_for(entries.len());
+            in_runs(threads, entries, |at, run| {
+                for (k, body) in run.iter_mut().enumerate() {
+                    let j = at + k;
+                    let scale = scales.map(|s| &s[j]);
+                    self.measure(
+                        body,
+                        &poses[j],
+                        &velocities[j],
+                        &masses[j],
+                        scale,
+                        has_accumulator,
+                    );
+                }
+            });
+            first += entities.len();
+        }
+        true
+    }
 }
 
 impl EnergyLedger {
@@ -273,22 +434,27 @@ impl EnergyLedger {
     }
 
     /// Adds each spring's elastic energy at the end of the step to its group, remembering it
-    /// for the next step's start (measured in pass `pass`).
-    fn measure_springs_at_end(&mut self, pass: u64) {
+    /// for the next step's start (measured in pass `pass`). The energies are measured on the
+    /// compute pool's threads as [`Parallelism`] allows, then added in spring order.
+    fn measure_springs_at_end(&mut self, pass: u64, parallelism: &Parallelism) {
+        let bodies = &self.bodies;
+        let threads = parallelism.threads_for(self.links.len());
+        in_runs(threads, &mut self.links, |_, links| {
+            for link in links.iter_mut().filter(|link| link.is_audited()) {
+                (link.measured, link.elastic) = match elastic_among(bodies, link, |b| b.end) {
+                    Some(v) => (pass, v),
+                    None => (0, 0.0),
+                };
+            }
+        });
         for k in 0..self.links.len() {
             let link = self.links[k];
             let Some(group) = self.group_of(&link) else {
                 continue;
             };
-            let elastic = self.elastic(&link, |b| b.end);
-            let memo = &mut self.links[k];
-            (memo.measured, memo.elastic) = match elastic {
-                Some(v) => (pass, v),
-                None => (0, 0.0),
-            };
-            if let Some(v) = elastic {
-                self.groups[group].end += v;
-                self.groups[group].magnitude += v;
+            if link.measured == pass {
+                self.groups[group].end += link.elastic;
+                self.groups[group].magnitude += link.elastic;
             }
         }
     }

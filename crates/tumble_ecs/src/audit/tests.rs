@@ -180,10 +180,10 @@ fn reused_start_energies_are_the_energies_measured_afresh() {
     compare_with_fresh(Parallelism::SINGLE_THREAD);
 }
 
-/// The same with the reusing world's end pass (and its steps) split over the thread pool (with
-/// the `parallel` feature), the fresh one on one thread: the accounts agree bit for bit.
+/// The same with the reusing world's audit passes (and its steps) split over the thread pool
+/// (with the `parallel` feature), the fresh one on one thread: the accounts agree bit for bit.
 #[test]
-fn the_end_pass_gives_the_same_accounts_on_any_number_of_threads() {
+fn the_audit_gives_the_same_accounts_on_any_number_of_threads() {
     compare_with_fresh(THREADED);
 }
 

@@ -1,0 +1,169 @@
+//! The start of a step when the world's spring graph is as the last step left it: the groups,
+//! links and union–find of the last step hold, and only the energies need measuring.
+
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use bevy_ecs::prelude::*;
+use tumble_core::math::{Vec3, Widen};
+
+use super::ledger::{
+    Audited, AuditedBodies, AuditedSprings, Ends, EnergyLedger, Link, for_each_audited,
+    resolve_ends,
+};
+use super::memo::BodyMemo;
+use crate::components::{MassProps, Pose, Velocity, dense, kinetic_energy_f64};
+use crate::parallel::{Parallelism, in_runs};
+
+impl EnergyLedger {
+    /// The start of a step when the world's spring graph is as the last step left it: the
+    /// same audited bodies in the same order with the same masses, the same springs (bit for
+    /// bit) with the same ends. Then the groups, links and union–find of the last step hold,
+    /// and only the energies need measuring, each reused from its [`memo`] where its inputs
+    /// are unchanged; when nothing changed at all, each group's `T + V` is the sum its end pass
+    /// closed with (the start pass would add the same energies in the same order). Either way
+    /// the sums are the full start pass's, bit for bit. Returns false as soon as the graph
+    /// differs, having changed only what the full start pass rebuilds.
+    pub(super) fn restart(
+        &mut self,
+        bodies: &AuditedBodies,
+        ends: &Ends,
+        springs: &AuditedSprings,
+        parallelism: &Parallelism,
+    ) -> bool {
+        let Some(all_still) = self.restart_bodies(bodies, parallelism) else {
+            return false;
+        };
+        let mut same = true;
+        let mut k = 0;
+        let spring_order = std::mem::take(&mut self.spring_order);
+        spring_order.for_each(springs, |spring| {
+            let Some(link) = self.links.get(k).filter(|_| same) else {
+                same = false;
+                return;
+            };
+            // Resolved again: an end that is not an audited body may have moved (a static
+            // body) or changed kind since.
+            let (a, b) = resolve_ends(self, ends, spring);
+            same &= link.same_inputs(&Link::new(spring, a, b));
+            k += 1;
+        });
+        self.spring_order = spring_order;
+        if !same || k != self.links.len() {
+            return false;
+        }
+        if all_still {
+            for g in &mut self.groups {
+                (g.start, g.magnitude) = (g.end, g.end);
+                (g.end, g.work) = (0.0, 0.0);
+            }
+            #[cfg(test)]
+            {
+                self.restarts += 1;
+            }
+            return true;
+        }
+        self.sum_start_energies();
+        #[cfg(test)]
+        {
+            self.partial_restarts += 1;
+        }
+        true
+    }
+
+    /// The bodies' part of [`restart`](Self::restart): each audited body, in entity index
+    /// order, must be the ledger's entry at its index with its mass unchanged; each entry then
+    /// takes its body's start. Returns whether every body is still (`None` where the bodies
+    /// differ from the ledger's, having restarted some entries: the full start pass rebuilds
+    /// them). Where the query visits the bodies in that order, table by table, each table is
+    /// zipped with the ledger's next entries and split over the compute pool's threads as
+    /// [`Parallelism`] allows (each entry is restarted by the same code on any thread).
+    fn restart_bodies(
+        &mut self,
+        bodies: &AuditedBodies,
+        parallelism: &Parallelism,
+    ) -> Option<bool> {
+        let passes = self.end_passes;
+        let mut order = std::mem::take(&mut self.body_order);
+        order.refresh_entities(bodies.iter().map(|(e, ..)| e));
+        let in_order = order.is_query_order();
+        self.body_order = order;
+        let mut n = 0;
+        let mut all_still = true;
+        if in_order {
+            let differ = AtomicBool::new(false);
+            let moved = AtomicBool::new(false);
+            for (entities, poses, velocities, masses) in dense(bodies.contiguous_iter()) {
+                let entries = self.bodies.get_mut(n..n + entities.len())?;
+                in_runs(
+                    parallelism.threads_for(entries.len()),
+                    entries,
+                    |at, run| {
+                        for (k, body) in run.iter_mut().enumerate() {
+                            let j = at + k;
+                            let item = (entities[j], &poses[j], &velocities[j], &masses[j]);
+                            match restart_entry(body, passes, item) {
+                                None => differ.store(true, Ordering::Relaxed),
+                                Some(still) if !still => moved.store(true, Ordering::Relaxed),
+                                Some(_) => {}
+                            }
+                        }
+                    },
+                );
+                n += entities.len();
+            }
+            if differ.into_inner() {
+                return None;
+            }
+            all_still = !moved.into_inner();
+        } else {
+            let mut same = true;
+            let mut order = std::mem::take(&mut self.body_order);
+            for_each_audited(&mut order, bodies, |item| {
+                let Some(body) = self.bodies.get_mut(n).filter(|_| same) else {
+                    same = false;
+                    return;
+                };
+                match restart_entry(body, passes, item) {
+                    None => same = false,
+                    Some(still) => all_still &= still,
+                }
+                n += 1;
+            });
+            self.body_order = order;
+            if !same {
+                return None;
+            }
+        }
+        (n == self.bodies.len()).then_some(all_still)
+    }
+}
+
+/// Restarts the ledger's entry `body` with the audited body `item` read at its index: `None`
+/// (the entry untouched) where it is another entity or its mass changed (a new mass changes its
+/// springs' reduced masses, so their stiffness bound: the groups must be formed again); else
+/// the entry takes the body's start, its kinetic energy reused from the memo where the body is
+/// still as end pass `passes` measured it, and says whether it is.
+#[inline]
+fn restart_entry(
+    body: &mut Audited,
+    passes: u64,
+    (entity, t, v, m): (Entity, &Pose, &Velocity, &MassProps),
+) -> Option<bool> {
+    if body.entity != entity {
+        return None;
+    }
+    let (energy, still) = if body.memo.still(passes, &body.end, t, v, m) {
+        (body.memo.kinetic(), true)
+    } else {
+        (kinetic_energy_f64(t, v, m), false)
+    };
+    if !still && m.mass().widen().to_bits() != body.mass.to_bits() {
+        return None;
+    }
+    body.start = (*t, *v);
+    body.end = *t;
+    body.memo = BodyMemo::NONE;
+    body.load = (Vec3::ZERO, Vec3::ZERO);
+    (body.start_energy, body.still) = (energy, still);
+    Some(still)
+}
