@@ -124,3 +124,33 @@ pub(crate) fn in_runs<T: Send>(
         }
     });
 }
+
+/// [`in_runs`] over items that are only read: `work` gets each run and the index of its first
+/// item, and returns whether the run passed; true when every run did.
+pub(crate) fn all_runs<T: Sync>(
+    threads: usize,
+    items: &[T],
+    work: impl Fn(usize, &[T]) -> bool + Sync,
+) -> bool {
+    if threads <= 1 {
+        return work(0, items);
+    }
+    let failed = std::sync::atomic::AtomicBool::new(false);
+    let (work, failed_ref) = (&work, &failed);
+    scope(|spawn| {
+        let mut rest = items;
+        let mut first = 0;
+        for k in (1..=threads).rev() {
+            let take = rest.len() / k;
+            let (run, tail) = rest.split_at(take);
+            spawn(Box::new(move || {
+                if !work(first, run) {
+                    failed_ref.store(true, std::sync::atomic::Ordering::Relaxed);
+                }
+            }));
+            first += take;
+            rest = tail;
+        }
+    });
+    !failed.into_inner()
+}

@@ -11,8 +11,8 @@ use super::ledger::{
     resolve_ends,
 };
 use super::memo::BodyMemo;
-use crate::components::{MassProps, Pose, Velocity, dense, kinetic_energy_f64};
-use crate::parallel::{Parallelism, in_runs};
+use crate::components::{MassProps, Pose, Spring, Velocity, dense, kinetic_energy_f64};
+use crate::parallel::{Parallelism, all_runs, in_runs};
 
 impl EnergyLedger {
     /// The start of a step when the world's spring graph is as the last step left it: the
@@ -33,22 +33,7 @@ impl EnergyLedger {
         let Some(all_still) = self.restart_bodies(bodies, parallelism) else {
             return false;
         };
-        let mut same = true;
-        let mut k = 0;
-        let spring_order = std::mem::take(&mut self.spring_order);
-        spring_order.for_each(springs, |spring| {
-            let Some(link) = self.links.get(k).filter(|_| same) else {
-                same = false;
-                return;
-            };
-            // Resolved again: an end that is not an audited body may have moved (a static
-            // body) or changed kind since.
-            let (a, b) = resolve_ends(self, ends, spring);
-            same &= link.same_inputs(&Link::new(spring, a, b));
-            k += 1;
-        });
-        self.spring_order = spring_order;
-        if !same || k != self.links.len() {
+        if !self.same_springs(ends, springs, parallelism) {
             return false;
         }
         if all_still {
@@ -68,6 +53,56 @@ impl EnergyLedger {
             self.partial_restarts += 1;
         }
         true
+    }
+
+    /// The springs' part of [`restart`](Self::restart): each spring, in entity index order, is
+    /// the ledger's link at its index with the same inputs, bit for bit, its ends resolved
+    /// again (an end that is not an audited body may have moved, a static body, or changed
+    /// kind since). Where the query visits the springs in that order, table by table, each
+    /// table is zipped with the ledger's next links and split over the compute pool's threads
+    /// as [`Parallelism`] allows.
+    fn same_springs(
+        &self,
+        ends: &Ends,
+        springs: &AuditedSprings,
+        parallelism: &Parallelism,
+    ) -> bool {
+        let same_link = |link: &Link, spring: &Spring| {
+            let (a, b) = resolve_ends(self, ends, spring);
+            link.same_inputs(&Link::new(spring, a, b))
+        };
+        let mut k = 0;
+        if self.spring_order.is_query_order() {
+            for (_, table) in dense(springs.contiguous_iter()) {
+                let Some(links) = self.links.get(k..k + table.len()) else {
+                    return false;
+                };
+                let threads = parallelism.threads_for(links.len());
+                let same = all_runs(threads, links, |at, run| {
+                    let springs = &table[at..at + run.len()];
+                    run.iter()
+                        .zip(springs)
+                        .all(|(link, spring)| same_link(link, spring))
+                });
+                if !same {
+                    return false;
+                }
+                k += table.len();
+            }
+        } else {
+            let mut same = true;
+            self.spring_order.for_each(springs, |spring| {
+                match self.links.get(k).filter(|_| same) {
+                    Some(link) => same = same_link(link, spring),
+                    None => same = false,
+                }
+                k += 1;
+            });
+            if !same {
+                return false;
+            }
+        }
+        k == self.links.len()
     }
 
     /// The bodies' part of [`restart`](Self::restart): each audited body, in entity index
