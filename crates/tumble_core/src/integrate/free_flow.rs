@@ -174,30 +174,58 @@ pub fn split_rotation_drift(inertia: DVec3, omega: DVec3, h: f64, horizon: f64) 
 /// `D` over `horizon` from the body's `e_orbit` ([`split_orbit_error`]), see
 /// [`split_rotation_drift`].
 fn drift_of_orbit_error(inertia: DVec3, omega: DVec3, e_orbit: f64, horizon: f64) -> f64 {
-    let mut sorted = inertia.to_array();
-    if split_axes(sorted).is_none() {
-        return 0.0;
+    match OrbitTerms::of(inertia, omega) {
+        Some(terms) => terms.drift(inertia, e_orbit, horizon),
+        None => 0.0,
     }
-    sorted.sort_by(f64::total_cmp);
-    let elongation = 1.0 - sorted[0] / sorted[1];
-    let energy = 0.5 * (inertia * omega * omega).element_sum();
-    let rate = (2.0 * energy / sorted[1]).sqrt();
-    DRIFT_FACTOR * elongation * elongation * e_orbit * rate * horizon
 }
 
 /// `e_orbit`, the bound of [`split_rotation_error`] over the body's whole torque-free orbit:
 /// `|ω_b ω_c|` bounded by `E/√(I_b I_c)` and by `|L|²/(2 I_b I_c)` (module docs). Zero for a
 /// body with a locked axis.
 pub fn split_orbit_error(inertia: DVec3, omega: DVec3, h: f64) -> f64 {
-    let i = inertia.to_array();
-    let Some((a, b, c)) = split_axes(i) else {
-        return 0.0;
-    };
-    let energy = 0.5 * (inertia * omega * omega).element_sum();
-    let momentum2 = (inertia * omega).length_squared();
-    let bc = i[b] * i[c];
-    let orbit = (energy / bc.sqrt()).min(momentum2 / (2.0 * bc));
-    h * h * (i[b] - i[c]).abs() / i[a] * orbit
+    OrbitTerms::of(inertia, omega).map_or(0.0, |terms| terms.orbit_error(inertia, omega, h))
+}
+
+/// What `e_orbit` and `D` share for one body: its split axes and its kinetic energy, formed
+/// once when the switch judges both.
+#[derive(Clone, Copy)]
+struct OrbitTerms {
+    /// The split axes (`a` the odd one, see [`split_axes`]).
+    axes: (usize, usize, usize),
+    /// `E = ½ Σ I ω²`.
+    energy: f64,
+}
+
+impl OrbitTerms {
+    /// `None` for a body with a locked axis (no split error).
+    #[inline]
+    fn of(inertia: DVec3, omega: DVec3) -> Option<Self> {
+        Some(Self {
+            axes: split_axes(inertia.to_array())?,
+            energy: 0.5 * (inertia * omega * omega).element_sum(),
+        })
+    }
+
+    /// `e_orbit` ([`split_orbit_error`]).
+    #[inline]
+    fn orbit_error(self, inertia: DVec3, omega: DVec3, h: f64) -> f64 {
+        let (i, (a, b, c)) = (inertia.to_array(), self.axes);
+        let momentum2 = (inertia * omega).length_squared();
+        let bc = i[b] * i[c];
+        let orbit = (self.energy / bc.sqrt()).min(momentum2 / (2.0 * bc));
+        h * h * (i[b] - i[c]).abs() / i[a] * orbit
+    }
+
+    /// `D` over `horizon` from `e_orbit` ([`drift_of_orbit_error`]).
+    #[inline]
+    fn drift(self, inertia: DVec3, e_orbit: f64, horizon: f64) -> f64 {
+        let mut sorted = inertia.to_array();
+        sorted.sort_by(f64::total_cmp);
+        let elongation = 1.0 - sorted[0] / sorted[1];
+        let rate = (2.0 * self.energy / sorted[1]).sqrt();
+        DRIFT_FACTOR * elongation * elongation * e_orbit * rate * horizon
+    }
 }
 
 /// The constant of `D` (module docs).
@@ -374,9 +402,12 @@ impl ExactSwitch {
         let principal = principal_orientation(state, mass).widen();
         let omega = rotate64(principal.conjugate(), state.angular_velocity.widen());
         let inertia = mass.principal_inertia().widen();
-        let e_orbit = split_orbit_error(inertia, omega, self.span);
+        let Some(terms) = OrbitTerms::of(inertia, omega) else {
+            return (0.0, 0.0, omega);
+        };
+        let e_orbit = terms.orbit_error(inertia, omega, self.span);
         let measure = match self.rule {
-            Rule::Drift => drift_of_orbit_error(inertia, omega, e_orbit, ACCURACY_HORIZON.widen()),
+            Rule::Drift => terms.drift(inertia, e_orbit, ACCURACY_HORIZON.widen()),
             Rule::StageError => e_orbit,
         };
         (measure, e_orbit, omega)
