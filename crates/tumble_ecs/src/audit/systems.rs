@@ -196,28 +196,37 @@ impl LoadRecord {
     }
 
     /// Records every body's load table by table, zipped with the ledger's entries and split over
-    /// the compute pool's threads (as [`EndPass::measure_in_table_order`]). Returns false,
-    /// having recorded nothing, where a table's bodies are not the ledger's next entries: a
-    /// stage's share adds to the load, so the tables are matched with the entries before any
-    /// is recorded, and the caller's lookup by entity records each load once.
+    /// the compute pool's threads (as [`EndPass::measure_in_table_order`]). Returns false where
+    /// a table's bodies are not the ledger's next entries, and the caller's lookup by entity
+    /// records the loads: a step of one stage sets each load (recording one again is
+    /// harmless), a stage's share adds to it, so then the tables are matched with the entries
+    /// before any load is recorded.
     fn in_table_order(
         &self,
         ledger: &mut EnergyLedger,
         bodies: &LoadedBodies,
         parallelism: &Parallelism,
     ) -> bool {
-        let mut first = 0;
-        for (entities, ..) in dense(bodies.contiguous_iter()) {
-            let Some(entries) = ledger.bodies.get(first..first + entities.len()) else {
-                return false;
-            };
-            if entries.iter().zip(entities).any(|(b, e)| b.entity != *e) {
-                return false;
+        let matches = |ledger: &EnergyLedger, first: usize, entities: &[Entity]| {
+            ledger
+                .bodies
+                .get(first..first + entities.len())
+                .is_some_and(|entries| entries.iter().zip(entities).all(|(b, e)| b.entity == *e))
+        };
+        if self.share.is_some() {
+            let mut first = 0;
+            for (entities, ..) in dense(bodies.contiguous_iter()) {
+                if !matches(ledger, first, entities) {
+                    return false;
+                }
+                first += entities.len();
             }
-            first += entities.len();
         }
         let mut first = 0;
         for (entities, poses, accumulators, implicit) in dense(bodies.contiguous_iter()) {
+            if !matches(ledger, first, entities) {
+                return false;
+            }
             let entries = &mut ledger.bodies[first..first + entities.len()];
             in_runs(
                 parallelism.threads_for(entries.len()),

@@ -20,10 +20,10 @@ struct Handles {
 
 /// An audited spring world: a chain of five asymmetric bodies tied to the world and, at its
 /// far end, to a static post; a free body; gravity.
-fn spring_world(parallelism: Parallelism) -> (World, Handles) {
+fn spring_world(parallelism: Parallelism, integrator: Integrator) -> (World, Handles) {
     let mut world = World::new();
     world.insert_resource(
-        PhysicsSettings::new(DT, Integrator::Splitting)
+        PhysicsSettings::new(DT, integrator)
             .unwrap()
             .with_springs(SpringSolver::Explicit),
     );
@@ -177,19 +177,25 @@ const THREADED: Parallelism = Parallelism {
 
 #[test]
 fn reused_start_energies_are_the_energies_measured_afresh() {
-    compare_with_fresh(Parallelism::SINGLE_THREAD);
+    compare_with_fresh(Parallelism::SINGLE_THREAD, Integrator::Splitting);
 }
 
 /// The same with the reusing world's audit passes (and its steps) split over the thread pool
 /// (with the `parallel` feature), the fresh one on one thread: the accounts agree bit for bit.
 #[test]
 fn the_audit_gives_the_same_accounts_on_any_number_of_threads() {
-    compare_with_fresh(THREADED);
+    compare_with_fresh(THREADED, Integrator::Splitting);
 }
 
-fn compare_with_fresh(parallelism: Parallelism) {
-    let (mut reusing, handles) = spring_world(parallelism);
-    let (mut fresh, _) = spring_world(Parallelism::SINGLE_THREAD);
+/// The same in steps of three stages (`yoshida4`), whose loads the audit adds stage by stage.
+#[test]
+fn a_composed_step_gives_the_same_accounts_on_any_number_of_threads() {
+    compare_with_fresh(THREADED, Integrator::Yoshida4);
+}
+
+fn compare_with_fresh(parallelism: Parallelism, integrator: Integrator) {
+    let (mut reusing, handles) = spring_world(parallelism, integrator);
+    let (mut fresh, _) = spring_world(Parallelism::SINGLE_THREAD, integrator);
     let (plan_r, plan_f) = (
         PhysicsPlan::for_world(&mut reusing),
         PhysicsPlan::for_world(&mut fresh),
