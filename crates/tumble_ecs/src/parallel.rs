@@ -100,29 +100,35 @@ pub fn pool_threads() -> usize {
 
 /// Runs `work` on `items` cut into `threads` runs of nearly equal length, one job per run on
 /// the compute pool (on this thread alone when `threads` is 1), each with the index of its first
-/// item. For passes whose items are independent: each item is worked by the same code in any
-/// cut, so the results do not depend on the number of threads.
+/// item; true when `work` returned true for every run. For passes whose items are independent:
+/// each item is worked by the same code in any cut, so the results do not depend on the number
+/// of threads.
 pub(crate) fn in_runs<T: Send>(
     threads: usize,
     items: &mut [T],
-    work: impl Fn(usize, &mut [T]) + Sync,
-) {
+    work: impl Fn(usize, &mut [T]) -> bool + Sync,
+) -> bool {
     if threads <= 1 {
-        work(0, items);
-        return;
+        return work(0, items);
     }
-    let work = &work;
+    let failed = std::sync::atomic::AtomicBool::new(false);
+    let (work, failed_ref) = (&work, &failed);
     scope(|spawn| {
         let mut rest = items;
         let mut first = 0;
         for k in (1..=threads).rev() {
             let take = rest.len() / k;
             let (run, tail) = std::mem::take(&mut rest).split_at_mut(take);
-            spawn(Box::new(move || work(first, run)));
+            spawn(Box::new(move || {
+                if !work(first, run) {
+                    failed_ref.store(true, std::sync::atomic::Ordering::Relaxed);
+                }
+            }));
             first += take;
             rest = tail;
         }
     });
+    !failed.into_inner()
 }
 
 /// [`in_runs`] over items that are only read: `work` gets each run and the index of its first

@@ -70,7 +70,14 @@ pub(super) struct Link {
     pub(super) measured: u64,
     /// The elastic energy that pass measured.
     pub(super) elastic: f64,
+    /// Its group's index in [`EnergyLedger::groups`] ([`NO_GROUP`] without an audited end),
+    /// once the start pass has numbered the groups: the sums over a group's springs read it
+    /// here rather than from the bodies.
+    pub(super) group: u32,
 }
+
+/// [`Link::group`] of a link without an audited end.
+pub(super) const NO_GROUP: u32 = u32::MAX;
 
 impl Link {
     /// The spring `spring` with its ends resolved to `a` and `b`, not measured yet.
@@ -82,6 +89,7 @@ impl Link {
             b,
             measured: 0,
             elastic: 0.0,
+            group: NO_GROUP,
         }
     }
 
@@ -299,8 +307,14 @@ impl EnergyLedger {
         self.restored = from.restored;
     }
 
-    /// The group (root index) a link belongs to, if it touches an audited body.
+    /// The group a link belongs to (as the start pass numbered it), if it touches an audited
+    /// body.
     pub(super) fn group_of(&self, link: &Link) -> Option<usize> {
+        (link.group != NO_GROUP).then_some(link.group as usize)
+    }
+
+    /// The group of a link's first audited end, from the bodies (for numbering the links).
+    pub(super) fn group_of_ends(&self, link: &Link) -> Option<usize> {
         match (link.a, link.b) {
             (End::Audited(i, _), _) | (_, End::Audited(i, _)) => {
                 Some(self.bodies[i as usize].group)

@@ -125,29 +125,26 @@ impl EnergyLedger {
         let mut n = 0;
         let mut all_still = true;
         if in_order {
-            let differ = AtomicBool::new(false);
             let moved = AtomicBool::new(false);
             for (entities, poses, velocities, masses) in dense(bodies.contiguous_iter()) {
                 let entries = self.bodies.get_mut(n..n + entities.len())?;
-                in_runs(
-                    parallelism.threads_for(entries.len()),
-                    entries,
-                    |at, run| {
-                        for (k, body) in run.iter_mut().enumerate() {
-                            let j = at + k;
-                            let item = (entities[j], &poses[j], &velocities[j], &masses[j]);
-                            match restart_entry(body, passes, item) {
-                                None => differ.store(true, Ordering::Relaxed),
-                                Some(still) if !still => moved.store(true, Ordering::Relaxed),
-                                Some(_) => {}
-                            }
+                let threads = parallelism.threads_for(entries.len());
+                let same = in_runs(threads, entries, |at, run| {
+                    for (k, body) in run.iter_mut().enumerate() {
+                        let j = at + k;
+                        let item = (entities[j], &poses[j], &velocities[j], &masses[j]);
+                        match restart_entry(body, passes, item) {
+                            None => return false,
+                            Some(still) if !still => moved.store(true, Ordering::Relaxed),
+                            Some(_) => {}
                         }
-                    },
-                );
+                    }
+                    true
+                });
+                if !same {
+                    return None;
+                }
                 n += entities.len();
-            }
-            if differ.into_inner() {
-                return None;
             }
             all_still = !moved.into_inner();
         } else {

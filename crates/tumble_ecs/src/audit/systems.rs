@@ -224,21 +224,24 @@ impl LoadRecord {
         }
         let mut first = 0;
         for (entities, poses, accumulators, implicit) in dense(bodies.contiguous_iter()) {
-            if !matches(ledger, first, entities) {
+            let Some(entries) = ledger.bodies.get_mut(first..first + entities.len()) else {
+                return false;
+            };
+            let threads = parallelism.threads_for(entries.len());
+            let matched = in_runs(threads, entries, |at, run| {
+                for (k, body) in run.iter_mut().enumerate() {
+                    let j = at + k;
+                    if body.entity != entities[j] {
+                        return false;
+                    }
+                    let implicit = implicit.map(|b| &b[j]);
+                    self.record(body, &poses[j], &accumulators[j], implicit);
+                }
+                true
+            });
+            if !matched {
                 return false;
             }
-            let entries = &mut ledger.bodies[first..first + entities.len()];
-            in_runs(
-                parallelism.threads_for(entries.len()),
-                entries,
-                |at, run| {
-                    for (k, body) in run.iter_mut().enumerate() {
-                        let j = at + k;
-                        let implicit = implicit.map(|b| &b[j]);
-                        self.record(body, &poses[j], &accumulators[j], implicit);
-                    }
-                },
-            );
             first += entities.len();
         }
         true
@@ -368,13 +371,13 @@ impl EndPass {
             let Some(entries) = ledger.bodies.get_mut(first..first + entities.len()) else {
                 return false;
             };
-            if entries.iter().zip(entities).any(|(b, e)| b.entity != *e) {
-                return false;
-            }
             let threads = parallelism.threads_for(entries.len());
-            in_runs(threads, entries, |at, run| {
+            let matched = in_runs(threads, entries, |at, run| {
                 for (k, body) in run.iter_mut().enumerate() {
                     let j = at + k;
+                    if body.entity != entities[j] {
+                        return false;
+                    }
                     let scale = scales.map(|s| &s[j]);
                     self.measure(
                         body,
@@ -385,7 +388,11 @@ impl EndPass {
                         has_accumulator,
                     );
                 }
+                true
             });
+            if !matched {
+                return false;
+            }
             first += entities.len();
         }
         true
@@ -413,14 +420,15 @@ impl EnergyLedger {
         }
     }
 
-    /// Counts each group's springs, whether a kinematic body holds one, and its stiffest
-    /// spring's `ω Δt` on the stability span.
+    /// Gives each link its group, and counts each group's springs, whether a kinematic body
+    /// holds one, and its stiffest spring's `ω Δt` on the stability span.
     fn count_group_springs(&mut self) {
         for k in 0..self.links.len() {
             let link = self.links[k];
-            let Some(group) = self.group_of(&link) else {
+            let Some(group) = self.group_of_ends(&link) else {
                 continue;
             };
+            self.links[k].group = u32::try_from(group).expect("fewer than 2³² groups");
             let kinematic = matches!(link.a, End::Kinematic) || matches!(link.b, End::Kinematic);
             let mass = |end: End| match end {
                 End::Audited(i, _) => self.bodies[i as usize].mass,
@@ -455,6 +463,7 @@ impl EnergyLedger {
                     None => (0, 0.0),
                 };
             }
+            true
         });
         for k in 0..self.links.len() {
             let link = self.links[k];
