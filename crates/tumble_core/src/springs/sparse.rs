@@ -35,6 +35,18 @@ fn subtract_product(c: &mut Block, a: &Block, b: &Block) {
     }
 }
 
+/// `pool[c] −= pool[a] pool[b]`, `c` neither `a` nor `b`, the blocks read in place.
+#[inline]
+fn subtract_in_pool(pool: &mut [Block], c: usize, a: usize, b: usize) {
+    let (before, rest) = pool.split_at_mut(c);
+    let (target, after) = rest.split_first_mut().expect("the target is in the pool");
+    let block = |k: usize| if k < c { &before[k] } else { &after[k - c - 1] };
+    subtract_product(target, block(a), block(b));
+}
+
+/// The target of a Schur update on a body's diagonal block (not in the pool).
+const DIAGONAL: u32 = u32::MAX;
+
 /// `a ← a b` for 6×6 blocks, in place: row `i` of the product needs only row `i` of `a`.
 fn multiply_right(a: &mut Block, b: &Block) {
     for ai in a.iter_mut() {
@@ -86,9 +98,9 @@ pub(crate) struct BlockLu {
     slot: Vec<usize>,
     /// The symbolic graph of `analyze`.
     graph: Vec<Vec<usize>>,
-    /// The blocks `A_pj` of the pivot being eliminated, side by side: the Schur updates read
-    /// them once per remaining neighbour, and write only to other blocks of the pool.
-    upper_blocks: Vec<Block>,
+    /// The Schur updates of the pivot being eliminated: `(i, target, A_ip P, A_pj)`, the
+    /// target block of the pool or [`DIAGONAL`] for body `i`'s own.
+    targets: Vec<(u32, u32, u32, u32)>,
     queue: BinaryHeap<Reverse<(usize, usize)>>,
     /// The pattern `order` was chosen for: the body count, then each row's length and columns
     /// (see [`BlockLu::analyze_unless_known`]).
@@ -246,7 +258,7 @@ impl BlockLu {
             pivot_count,
             order,
             slot,
-            upper_blocks,
+            targets,
             ..
         } = self;
         *pivot_count = 0;
@@ -280,20 +292,19 @@ impl BlockLu {
                 row.swap_remove(at);
             }
             // Schur complement: A_ij −= (A_ip P) A_pj over all remaining neighbours i, j of p.
-            upper_blocks.clear();
-            upper_blocks.extend(pivot.upper.iter().map(|&(_, a)| pool[a as usize]));
+            // The fill blocks first, so that the updates read the pool's blocks in place (a
+            // target `(i, j)` is never `(i, p)` or `(p, j)`); in the same order as the updates,
+            // so every block keeps its place in the pool.
+            targets.clear();
             for &(i, l_ip) in &pivot.lower {
-                let l_ip = pool[l_ip as usize];
                 let row = &mut rows[i as usize];
                 for (at, (j, _)) in row.iter().enumerate() {
                     slot[*j as usize] = at;
                 }
-                for (&(j, _), a_pj) in pivot.upper.iter().zip(upper_blocks.iter()) {
-                    if i == j {
-                        subtract_product(&mut diagonal[i as usize], &l_ip, a_pj);
-                        continue;
-                    }
-                    let target = if slot[j as usize] != usize::MAX {
+                for &(j, a_pj) in &pivot.upper {
+                    let target = if i == j {
+                        DIAGONAL
+                    } else if slot[j as usize] != usize::MAX {
                         row[slot[j as usize]].1
                     } else {
                         pool.push([[0.0; 6]; 6]);
@@ -302,10 +313,18 @@ impl BlockLu {
                         row.push((j, block));
                         block
                     };
-                    subtract_product(&mut pool[target as usize], &l_ip, a_pj);
+                    targets.push((i, target, l_ip, a_pj));
                 }
                 for (j, _) in row.iter() {
                     slot[*j as usize] = usize::MAX;
+                }
+            }
+            for &(i, target, l_ip, a_pj) in targets.iter() {
+                if target == DIAGONAL {
+                    let (l, a) = (&pool[l_ip as usize], &pool[a_pj as usize]);
+                    subtract_product(&mut diagonal[i as usize], l, a);
+                } else {
+                    subtract_in_pool(pool, target as usize, l_ip as usize, a_pj as usize);
                 }
             }
         }
