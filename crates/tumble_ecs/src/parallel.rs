@@ -108,54 +108,45 @@ pub(crate) fn in_runs<T: Send>(
     items: &mut [T],
     work: impl Fn(usize, &mut [T]) -> bool + Sync,
 ) -> bool {
-    if threads <= 1 {
-        return work(0, items);
-    }
-    let failed = std::sync::atomic::AtomicBool::new(false);
-    let (work, failed_ref) = (&work, &failed);
-    scope(|spawn| {
-        let mut rest = items;
-        let mut first = 0;
-        for k in (1..=threads).rev() {
-            let take = rest.len() / k;
-            let (run, tail) = std::mem::take(&mut rest).split_at_mut(take);
-            spawn(Box::new(move || {
-                if !work(first, run) {
-                    failed_ref.store(true, std::sync::atomic::Ordering::Relaxed);
-                }
-            }));
-            first += take;
-            rest = tail;
-        }
-    });
-    !failed.into_inner()
+    let len = items.len();
+    each_run(threads, items, len, |s, n| s.split_at_mut(n), &work)
 }
 
-/// [`in_runs`] over items that are only read: `work` gets each run and the index of its first
-/// item, and returns whether the run passed; true when every run did.
+/// [`in_runs`] over items that are only read.
 pub(crate) fn all_runs<T: Sync>(
     threads: usize,
     items: &[T],
     work: impl Fn(usize, &[T]) -> bool + Sync,
 ) -> bool {
+    each_run(threads, items, items.len(), |s, n| s.split_at(n), &work)
+}
+
+/// The cut of [`in_runs`] and [`all_runs`]: `items` (of `len` items) into `threads` runs,
+/// `split` taking the first `n` items off a run.
+fn each_run<S: Send>(
+    threads: usize,
+    items: S,
+    len: usize,
+    split: fn(S, usize) -> (S, S),
+    work: &(impl Fn(usize, S) -> bool + Sync),
+) -> bool {
     if threads <= 1 {
         return work(0, items);
     }
     let failed = std::sync::atomic::AtomicBool::new(false);
-    let (work, failed_ref) = (&work, &failed);
+    let failed_ref = &failed;
     scope(|spawn| {
-        let mut rest = items;
-        let mut first = 0;
+        let (mut rest, mut left, mut first) = (Some(items), len, 0);
         for k in (1..=threads).rev() {
-            let take = rest.len() / k;
-            let (run, tail) = rest.split_at(take);
+            let take = left / k;
+            let Some(items) = rest.take() else { break };
+            let (run, tail) = split(items, take);
             spawn(Box::new(move || {
                 if !work(first, run) {
                     failed_ref.store(true, std::sync::atomic::Ordering::Relaxed);
                 }
             }));
-            first += take;
-            rest = tail;
+            (rest, left, first) = (Some(tail), left - take, first + take);
         }
     });
     !failed.into_inner()

@@ -9,6 +9,7 @@ use crate::components::{
     Dynamic, IndexOrder, IndexedQuery, Kinematic, MassProps, Pose, Rejected, RigidBody, Spring,
     SpringEnd, Static, Velocity, kinetic_energy_f64,
 };
+use crate::parallel::{Parallelism, in_runs};
 
 /// The audit's largest `ωΔt` in the stable-spring factor: at 2 the factor is infinite, and
 /// beyond it the spring is unstable and grows geometrically past any finite bound anyway.
@@ -426,6 +427,32 @@ pub(super) fn elastic_among(
     let pa = anchor_among(bodies, link.a, pose)?;
     let pb = anchor_among(bodies, link.b, pose)?;
     Some(link.elastic_energy(pa, pb))
+}
+
+/// Works `each` on the ledger's entries from index `first` zipped with a table's `entities`
+/// (`each` gets the entry and its body's row in the table, and returns false to stop), split
+/// over the compute pool's threads as [`Parallelism`] allows. False where an entry is not its
+/// row's body or `each` stopped (the run's entries before it are worked), or the ledger ends
+/// before the table does.
+pub(super) fn zip_table(
+    entries: &mut [Audited],
+    first: usize,
+    entities: &[Entity],
+    parallelism: &Parallelism,
+    each: impl Fn(&mut Audited, usize) -> bool + Sync,
+) -> bool {
+    let Some(entries) = entries.get_mut(first..first + entities.len()) else {
+        return false;
+    };
+    in_runs(
+        parallelism.threads_for(entries.len()),
+        entries,
+        |at, run| {
+            run.iter_mut()
+                .enumerate()
+                .all(|(k, body)| body.entity == entities[at + k] && each(body, at + k))
+        },
+    )
 }
 
 /// Rigid bodies that are not quarantined, whatever their kind (spring ends may be static or

@@ -8,11 +8,11 @@ use tumble_core::math::{Vec3, Widen};
 
 use super::ledger::{
     Audited, AuditedBodies, AuditedSprings, Ends, EnergyLedger, Link, for_each_audited,
-    resolve_ends,
+    resolve_ends, zip_table,
 };
 use super::memo::BodyMemo;
 use crate::components::{MassProps, Pose, Spring, Velocity, dense, kinetic_energy_f64};
-use crate::parallel::{Parallelism, all_runs, in_runs};
+use crate::parallel::{Parallelism, all_runs};
 
 impl EnergyLedger {
     /// The start of a step when the world's spring graph is as the last step left it: the
@@ -127,19 +127,13 @@ impl EnergyLedger {
         if in_order {
             let moved = AtomicBool::new(false);
             for (entities, poses, velocities, masses) in dense(bodies.contiguous_iter()) {
-                let entries = self.bodies.get_mut(n..n + entities.len())?;
-                let threads = parallelism.threads_for(entries.len());
-                let same = in_runs(threads, entries, |at, run| {
-                    for (k, body) in run.iter_mut().enumerate() {
-                        let j = at + k;
-                        let item = (entities[j], &poses[j], &velocities[j], &masses[j]);
-                        match restart_entry(body, passes, item) {
-                            None => return false,
-                            Some(still) if !still => moved.store(true, Ordering::Relaxed),
-                            Some(_) => {}
-                        }
+                let same = zip_table(&mut self.bodies, n, entities, parallelism, |body, j| {
+                    let item = (entities[j], &poses[j], &velocities[j], &masses[j]);
+                    let still = restart_entry(body, passes, item);
+                    if still == Some(false) {
+                        moved.store(true, Ordering::Relaxed);
                     }
-                    true
+                    still.is_some()
                 });
                 if !same {
                     return None;

@@ -5,7 +5,7 @@ use tumble_core::math::{Real, Vec3, Widen};
 
 use super::ledger::{
     Account, Audited, AuditedBodies, AuditedSprings, End, Ends, EnergyLedger, GroupStep, Link,
-    OMEGA_DT_CAP, ROUND_OFF_ULPS, elastic_among, for_each_audited, resolve_ends,
+    OMEGA_DT_CAP, ROUND_OFF_ULPS, elastic_among, for_each_audited, resolve_ends, zip_table,
 };
 use super::memo::BodyMemo;
 use crate::components::dense;
@@ -224,22 +224,18 @@ impl LoadRecord {
         }
         let mut first = 0;
         for (entities, poses, accumulators, implicit) in dense(bodies.contiguous_iter()) {
-            let Some(entries) = ledger.bodies.get_mut(first..first + entities.len()) else {
-                return false;
-            };
-            let threads = parallelism.threads_for(entries.len());
-            let matched = in_runs(threads, entries, |at, run| {
-                for (k, body) in run.iter_mut().enumerate() {
-                    let j = at + k;
-                    if body.entity != entities[j] {
-                        return false;
-                    }
+            let recorded = zip_table(
+                &mut ledger.bodies,
+                first,
+                entities,
+                parallelism,
+                |body, j| {
                     let implicit = implicit.map(|b| &b[j]);
                     self.record(body, &poses[j], &accumulators[j], implicit);
-                }
-                true
-            });
-            if !matched {
+                    true
+                },
+            );
+            if !recorded {
                 return false;
             }
             first += entities.len();
@@ -368,29 +364,19 @@ impl EndPass {
         for (entities, poses, velocities, masses, scales, has_accumulator) in
             dense(bodies.contiguous_iter())
         {
-            let Some(entries) = ledger.bodies.get_mut(first..first + entities.len()) else {
-                return false;
-            };
-            let threads = parallelism.threads_for(entries.len());
-            let matched = in_runs(threads, entries, |at, run| {
-                for (k, body) in run.iter_mut().enumerate() {
-                    let j = at + k;
-                    if body.entity != entities[j] {
-                        return false;
-                    }
+            let measured = zip_table(
+                &mut ledger.bodies,
+                first,
+                entities,
+                parallelism,
+                |body, j| {
                     let scale = scales.map(|s| &s[j]);
-                    self.measure(
-                        body,
-                        &poses[j],
-                        &velocities[j],
-                        &masses[j],
-                        scale,
-                        has_accumulator,
-                    );
-                }
-                true
-            });
-            if !matched {
+                    let (t, v, m) = (&poses[j], &velocities[j], &masses[j]);
+                    self.measure(body, t, v, m, scale, has_accumulator);
+                    true
+                },
+            );
+            if !measured {
                 return false;
             }
             first += entities.len();
