@@ -352,12 +352,7 @@ impl EnergyLedger {
         (entity, t, v, m): (Entity, &Pose, &Velocity, &MassProps),
     ) -> (f64, bool) {
         match self.bodies.get(i) {
-            Some(last)
-                if last.entity == entity
-                    && last.memo.still(self.end_passes, &last.end, t, v, m) =>
-            {
-                (last.memo.kinetic(), true)
-            }
+            Some(last) if last.entity == entity => start_kinetic_of(last, self.end_passes, t, v, m),
             _ => (kinetic_energy_f64(t, v, m), false),
         }
     }
@@ -404,6 +399,25 @@ impl EnergyLedger {
             link.measured = 0;
         }
         self.closed = false;
+    }
+}
+
+/// The kinetic energy at the start of the step of the body at `t`, `v`, `m` whose ledger entry
+/// is `last` (the caller has checked the entity), and whether it is still as end pass `passes`
+/// measured it (bit for bit, [`memo`]): then the energy is that measurement, else it is
+/// measured now.
+#[inline]
+pub(super) fn start_kinetic_of(
+    last: &Audited,
+    passes: u64,
+    t: &Pose,
+    v: &Velocity,
+    m: &MassProps,
+) -> (f64, bool) {
+    if last.memo.still(passes, &last.end, t, v, m) {
+        (last.memo.kinetic(), true)
+    } else {
+        (kinetic_energy_f64(t, v, m), false)
     }
 }
 

@@ -8,10 +8,10 @@ use tumble_core::math::{Vec3, Widen};
 
 use super::ledger::{
     Audited, AuditedBodies, AuditedSprings, Ends, EnergyLedger, Link, for_each_audited,
-    resolve_ends, zip_table,
+    resolve_ends, start_kinetic_of, zip_table,
 };
 use super::memo::BodyMemo;
-use crate::components::{MassProps, Pose, Spring, Velocity, dense, kinetic_energy_f64};
+use crate::components::{MassProps, Pose, Spring, Velocity, dense};
 use crate::parallel::{Parallelism, all_runs};
 
 impl EnergyLedger {
@@ -178,11 +178,7 @@ fn restart_entry(
     if body.entity != entity {
         return None;
     }
-    let (energy, still) = if body.memo.still(passes, &body.end, t, v, m) {
-        (body.memo.kinetic(), true)
-    } else {
-        (kinetic_energy_f64(t, v, m), false)
-    };
+    let (energy, still) = start_kinetic_of(body, passes, t, v, m);
     if !still && m.mass().widen().to_bits() != body.mass.to_bits() {
         return None;
     }

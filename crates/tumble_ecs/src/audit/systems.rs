@@ -8,10 +8,9 @@ use super::ledger::{
     OMEGA_DT_CAP, ROUND_OFF_ULPS, elastic_among, for_each_audited, resolve_ends, zip_table,
 };
 use super::memo::BodyMemo;
-use crate::components::dense;
 use crate::components::{
     BodyError, BodyErrorKind, Dynamic, ForceAccumulator, Gravity, GravityScale, ImplicitBody,
-    MassProps, PhysicsSettings, Pose, Velocity, reject,
+    MassProps, PhysicsSettings, Pose, Velocity, dense, reject,
 };
 use crate::integrate::StageCursor;
 use crate::parallel::{Parallelism, in_runs};

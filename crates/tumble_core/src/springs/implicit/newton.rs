@@ -446,6 +446,7 @@ impl ImplicitSpringSolver {
             })
             .sum::<f64>()
     }
+
     /// The parts of the Newton matrix at the last evaluated iterate that the residual does not
     /// need: each body's Cayley derivative and each spring's stiffness `−2 ∂F̄/∂d₁`. Only an
     /// iteration that assembles the matrix needs them, so trial evaluations (the backtracking,
