@@ -407,7 +407,8 @@ pub fn write_body_state(
 
 /// Checks the body data of a [`Pose`], [`Velocity`] and optional [`ForceAccumulator`].
 ///
-/// Runs for every body every step, so valid data takes an inlined fast test (finite values, unit
+/// Runs in the insert hooks and on every body whose step failed (to name the bad field), so valid
+/// data takes an inlined fast test (finite values, unit
 /// quaternion within [`UNIT_QUATERNION_TOLERANCE`](tumble_core::error::UNIT_QUATERNION_TOLERANCE));
 /// only bad data goes through the detailed checks that build the error.
 #[inline]
@@ -432,6 +433,24 @@ pub fn check_body(
         return Ok(());
     }
     check_body_in_detail(transform, velocity, forces)
+}
+
+/// The part of [`check_body`] a batched step makes before it steps a body: the rotation is a unit
+/// quaternion within [`UNIT_QUATERNION_TOLERANCE`](tumble_core::error::UNIT_QUATERNION_TOLERANCE)
+/// (and finite). Every method normalizes the rotation it writes, so a step cannot be trusted to
+/// show a non-unit one. The translation and velocities need no test before the step: a
+/// non-finite value in them reaches the stepped state through IEEE arithmetic (every method
+/// moves the position by the velocity, and the rotation by the angular velocity), the step's
+/// result then fails its own check, and [`check_body`] on the untouched components names the
+/// field (see the integrate systems).
+#[inline]
+pub(crate) fn check_rotation(transform: &Pose) -> Result<(), BodyErrorKind> {
+    let unit = (transform.rotation.length_squared() - 1.0).abs()
+        <= tumble_core::error::UNIT_QUATERNION_TOLERANCE;
+    if unit {
+        return Ok(());
+    }
+    check_body_in_detail(transform, &Velocity::ZERO, None)
 }
 
 /// The detailed checks behind [`check_body`], naming the component and field at fault.

@@ -42,6 +42,7 @@ mod markers;
 mod order;
 mod settings;
 
+pub(crate) use body::check_rotation;
 pub use body::{
     AssumedMass, Damping, ForceAccumulator, GravityScale, HeldLoad, Kinematic, MassProps, Pose,
     RigidBody, Static, Velocity, assume_missing_masses, bodies_without_mass, body_state,
