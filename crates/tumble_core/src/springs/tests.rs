@@ -842,3 +842,40 @@ fn turning_compliance_is_the_largest_eigenvalue() {
         );
     }
 }
+
+/// Newton's last update, once within the tolerance, is taken whole without a trial evaluation
+/// of the residual (backtracking could only weigh round-off against round-off there). A solve
+/// that converges without backtracking evaluates the residual at its first iterate and at each
+/// trial: once per iteration when it ends on such an update, once more when it ends on the
+/// contraction-rate estimate (which needs the last trial's residual).
+#[test]
+fn the_last_update_within_the_tolerance_costs_no_evaluation() {
+    let dt = 1.0 / 60.0;
+    // Mild enough that no step is split (a split solves each piece, with its own evaluations).
+    for omega_dt in [0.3, 0.5] {
+        let (mut bodies, springs) = chain(5, omega_dt, dt);
+        let mut solver = ImplicitSpringSolver::default();
+        let mut taken_whole = 0;
+        for step in 0..50 {
+            let stats = solver
+                .step(&mut bodies, &springs, dt)
+                .unwrap_or_else(|e| panic!("ωΔt {omega_dt}: {e}"));
+            let case = format!("ωΔt {omega_dt}, step {step}: {stats:?}");
+            assert_eq!(stats.splits, 0, "{case}");
+            assert!(stats.factorizations >= 1, "{case}");
+            let iterations = stats.newton_iterations;
+            assert!(
+                (iterations..=iterations + 1).contains(&stats.residual_evaluations),
+                "{case}"
+            );
+            if stats.residual_evaluations == iterations {
+                taken_whole += 1;
+            }
+        }
+        assert!(
+            taken_whole > 0,
+            "ωΔt {omega_dt}: no solve ended on a whole update"
+        );
+        eprintln!("ωΔt {omega_dt}: {taken_whole} of 50 solves ended on a whole update");
+    }
+}

@@ -437,6 +437,8 @@ pub fn solve_implicit_springs(
                     newton = stats.newton_iterations,
                     linear = stats.linear_iterations,
                     splits = stats.splits,
+                    evaluations = stats.residual_evaluations,
+                    factorizations = stats.factorizations,
                     "implicit spring group stepped"
                 );
                 for (k, &i) in s.members[members].iter().enumerate() {

@@ -252,6 +252,11 @@ pub struct SolveStats {
     pub linear_iterations: usize,
     /// Times a step was split in two because Newton's method did not converge.
     pub splits: usize,
+    /// Evaluations of the step's residual: one at the first iterate and one per trial iterate
+    /// (an update taken whole when it is already within the tolerance needs none).
+    pub residual_evaluations: usize,
+    /// Newton matrices assembled and factorized (a chord iteration reuses the last one).
+    pub factorizations: usize,
 }
 
 /// The default [`ImplicitSpringSolver::tolerance`]: a step's energy error is about twice it,

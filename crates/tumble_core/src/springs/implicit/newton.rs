@@ -27,6 +27,7 @@ impl ImplicitSpringSolver {
         };
         let scale = self.energy_scale(h);
         let mut norm = self.evaluate(h);
+        stats.residual_evaluations += 1;
         let mut update = f64::INFINITY;
         let mut iterations = 0;
         let (mut previous_full, mut previous_step) = (f64::INFINITY, 0.0);
@@ -44,11 +45,24 @@ impl ImplicitSpringSolver {
             if refactor {
                 self.build_blocks(h);
                 self.factor(h);
+                stats.factorizations += 1;
             }
             let delta = self.newton_update(h, refactor, stats);
             let mut step = self.turn_limited_step(h, &delta);
-            let (accepted, stagnating) = self.backtrack(h, &delta, &mut step, &mut norm);
             let full = (self.kinetic_norm(&delta) / scale).sqrt();
+            if step == 1.0 && full <= tolerance {
+                // The whole update is within the tolerance: take it and stop. Backtracking
+                // guards against overshoot far from the solution; on an update this small its
+                // trial evaluation could only tell round-off from round-off, and it would be the
+                // solve's last (`finish` works from the iterate alone).
+                for (z, d) in self.z.iter_mut().zip(&delta) {
+                    *z += d;
+                }
+                self.delta = delta;
+                update = full;
+                break;
+            }
+            let (accepted, stagnating) = self.backtrack(h, &delta, &mut step, &mut norm, stats);
             self.delta = delta;
             let chord = !refactor && self.factored;
             if chord && (!accepted || stagnating) {
@@ -56,6 +70,7 @@ impl ImplicitSpringSolver {
                 // linearized at the iterate (the last evaluation was of a rejected trial).
                 if !accepted {
                     norm = self.evaluate(h);
+                    stats.residual_evaluations += 1;
                 }
                 refactor = true;
                 continue;
@@ -191,7 +206,14 @@ impl ImplicitSpringSolver {
     /// until the iterate `z + step·δ` does not raise the residual norm `norm`, at most 12 times.
     /// On success the iterate and `norm` move there; returns whether it did and whether the
     /// accepted step stagnates (tiny, and hardly lowering the residual).
-    fn backtrack(&mut self, h: f64, delta: &[f64], step: &mut f64, norm: &mut f64) -> (bool, bool) {
+    fn backtrack(
+        &mut self,
+        h: f64,
+        delta: &[f64],
+        step: &mut f64,
+        norm: &mut f64,
+        stats: &mut SolveStats,
+    ) -> (bool, bool) {
         for _ in 0..12 {
             for ((t, z), d) in self.trial.iter_mut().zip(&self.z).zip(delta) {
                 *t = z + *step * d;
@@ -199,6 +221,7 @@ impl ImplicitSpringSolver {
             std::mem::swap(&mut self.z, &mut self.trial);
             std::mem::swap(&mut self.residual, &mut self.trial_residual);
             let trial_norm = self.evaluate(h);
+            stats.residual_evaluations += 1;
             if trial_norm.is_finite() && trial_norm <= *norm {
                 let stagnating =
                     *step < STAGNANT_STEP && trial_norm > (1.0 - STAGNANT_DECREASE) * *norm;
