@@ -4,7 +4,7 @@ use bevy_ecs::entity::EntityHashMap;
 use bevy_ecs::prelude::*;
 use tumble_core::math::{Real, Vec3, Widen};
 
-use super::memo::BodyMemo;
+use super::memo::{BodyMemo, same_bits};
 use crate::components::{
     Dynamic, IndexOrder, IndexedQuery, Kinematic, MassProps, Pose, Rejected, RigidBody, Spring,
     SpringEnd, Static, Velocity, kinetic_energy_f64,
@@ -110,8 +110,10 @@ impl Link {
     /// True when `other` has the same inputs, bit for bit, apart from its audited bodies'
     /// poses (see [`BodyMemo::still`] for those).
     pub(super) fn same_inputs(&self, other: &Link) -> bool {
-        let bits = |l: &Link| [l.stiffness, l.rest_length].map(Real::to_bits);
-        bits(self) == bits(other) && same_end(self.a, other.a) && same_end(self.b, other.b)
+        let inputs = |l: &Link| [l.stiffness, l.rest_length];
+        same_bits(inputs(self), inputs(other))
+            && same_end(self.a, other.a)
+            && same_end(self.b, other.b)
     }
 
     /// `½ k (|d| − L₀)²` with the anchors at the world points `pa` and `pb` (J, `f64`).
@@ -501,10 +503,10 @@ pub(super) fn end_of(ledger: &EnergyLedger, ends: &Ends, body: Entity, anchor: V
 
 /// The same end, bit for bit.
 pub(super) fn same_end(a: End, b: End) -> bool {
-    let bits = |p: Vec3| p.to_array().map(Real::to_bits);
+    let same = |p: Vec3, q: Vec3| same_bits(p.to_array(), q.to_array());
     match (a, b) {
-        (End::Audited(i, p), End::Audited(j, q)) => i == j && bits(p) == bits(q),
-        (End::Fixed(p), End::Fixed(q)) => bits(p) == bits(q),
+        (End::Audited(i, p), End::Audited(j, q)) => i == j && same(p, q),
+        (End::Fixed(p), End::Fixed(q)) => same(p, q),
         (End::Kinematic, End::Kinematic) | (End::Inactive, End::Inactive) => true,
         _ => false,
     }
