@@ -14,7 +14,7 @@ use tumble_core::springs::{
 use crate::components::{
     BodyError, BodyErrorKind, Dynamic, ForceAccumulator, ImplicitBody, ImplicitSpring, MassProps,
     PhysicsSettings, Pose, RigidBody, Spring, SpringEnd, SpringSolver, SpringTurn, Stepped,
-    body_state, reject, write_body_state,
+    body_state, check_body, reject, write_body_state,
 };
 use crate::integrate::damp;
 
@@ -396,6 +396,16 @@ pub fn solve_implicit_springs(
     s.all.reserve_exact(count);
     s.index.reserve(count);
     for ((entity, t, mut v, m, mut acc, damping, turn), mut implicit) in &mut bodies {
+        // Bad data game code wrote into one body is refused for that body alone, naming the
+        // field, as on the explicit path: left out here, it is not in its group this stage
+        // (its springs exert nothing, as a quarantined body's), and its components and
+        // accumulator stay as they are. The point forces' moment is this stage's only (no
+        // snapshot holds it): it goes with the stage.
+        if let Err(kind) = check_body(&t, &v, Some(&acc)) {
+            implicit.take_load_moment();
+            reject(&mut commands, BodyError { entity, kind });
+            continue;
+        }
         // `Damping` is a flow of its own, half a substep before the substep and half after (see
         // `tumble_core::damping`), as on the explicit path.
         if let Some(d) = damping

@@ -465,3 +465,108 @@ fn state_bits((pose, velocity): (Pose, Velocity)) -> Vec<String> {
         .map(|x| x.to_bits().to_string())
         .collect()
 }
+
+/// Bad data written by game code into one body of a stiff (implicit) spring group is refused
+/// for that body alone, naming the field, as on the explicit path: the rest of the group steps
+/// on without it (its springs to the refused body exert nothing, as to any quarantined body),
+/// and the refused body keeps what game code wrote.
+#[test]
+fn bad_data_in_a_stiff_group_is_refused_for_its_body_alone() {
+    type Corrupt = fn(&mut World, Entity);
+    let cases: [(&str, Corrupt, &str); 4] = [
+        (
+            "nan velocity",
+            |w, e| w.get_mut::<Velocity>(e).unwrap().linear.y = Real::NAN,
+            "Velocity",
+        ),
+        (
+            "infinite translation",
+            |w, e| w.get_mut::<Pose>(e).unwrap().translation.x = Real::INFINITY,
+            "Pose",
+        ),
+        (
+            "non-unit rotation",
+            |w, e| w.get_mut::<Pose>(e).unwrap().rotation = Quat::from_xyzw(0.0, 0.0, 0.0, 2.0),
+            "Pose",
+        ),
+        (
+            "nan force",
+            |w, e| w.entity_mut(e).apply_force(Vec3::new(0.0, Real::NAN, 0.0)),
+            "ForceAccumulator",
+        ),
+    ];
+    for (name, corrupt, component) in cases {
+        let mut world = world_with(1.0 / 60.0, Integrator::Splitting);
+        world.resource_mut::<PhysicsSettings>().springs = SpringSolver::Implicit;
+        world.insert_resource(Gravity(Vec3::new(0.0, -9.81, 0.0)));
+        let bodies: Vec<Entity> = (0..5)
+            .map(|i| {
+                world
+                    .spawn((
+                        RigidBody,
+                        mass_props(1.0, [0.02, 0.03, 0.04]),
+                        Pose::from_translation(Vec3::new(0.5 * i as Real, 0.0, 0.0)),
+                        Velocity::angular(Vec3::new(0.3, -0.2, 0.1)),
+                        ForceAccumulator::default(),
+                    ))
+                    .id()
+            })
+            .collect();
+        for pair in bodies.windows(2) {
+            world.spawn(Spring {
+                a: pair[0],
+                anchor_a: Vec3::new(0.2, 0.02, 0.0),
+                b: SpringEnd::Body {
+                    body: pair[1],
+                    anchor: Vec3::new(-0.2, 0.0, 0.01),
+                },
+                stiffness: 1.0e5,
+                damping: 0.0,
+                rest_length: 0.1,
+            });
+        }
+        let mut physics = PhysicsRunner::new(&mut world);
+        run_steps(&mut world, &mut physics, 3);
+        let bad = bodies[2];
+        corrupt(&mut world, bad);
+        let written = (
+            *world.get::<Pose>(bad).unwrap(),
+            *world.get::<Velocity>(bad).unwrap(),
+        );
+        run_steps(&mut world, &mut physics, 20);
+        let rejected = world
+            .get::<Rejected>(bad)
+            .unwrap_or_else(|| panic!("{name}: not rejected"));
+        assert!(
+            matches!(&rejected.0.kind, BodyErrorKind::Invalid { component: c, .. } if *c == component),
+            "{name}: {}",
+            rejected.0
+        );
+        assert_eq!(
+            state_bits((
+                *world.get::<Pose>(bad).unwrap(),
+                *world.get::<Velocity>(bad).unwrap()
+            )),
+            state_bits(written),
+            "{name}: the refused body was written"
+        );
+        for &good in bodies.iter().filter(|&&b| b != bad) {
+            assert!(
+                world.get::<Rejected>(good).is_none(),
+                "{name}: {good} was refused with the bad body: {}",
+                world.get::<Rejected>(good).unwrap().0
+            );
+            let pose = world.get::<Pose>(good).unwrap();
+            let velocity = world.get::<Velocity>(good).unwrap();
+            assert!(
+                pose.translation.is_finite() && velocity.linear.is_finite(),
+                "{name}: {good} went bad"
+            );
+        }
+        // The rest of the group kept moving: under gravity it fell.
+        assert!(
+            world.get::<Pose>(bodies[0]).unwrap().translation.y < -0.01,
+            "{name}"
+        );
+    }
+}
