@@ -165,9 +165,22 @@ enum SpringPush {
 }
 
 impl SpringPush {
-    /// The push of `spring` on the bodies as `targets` holds them.
+    /// The push of `spring` on the bodies as `targets` holds them: nothing where the force is
+    /// not finite (bad data game code wrote into an end between steps — that body is refused by
+    /// the integrate systems, or by [`check_fixed_bodies`](crate::integrate::check_fixed_bodies)
+    /// where tumble never steps it — and the spring must not carry it to the other end first).
     #[inline]
     fn of(spring: &Spring, targets: &Targets) -> Self {
+        let push = Self::unchecked(spring, targets);
+        match push {
+            Self::OnA { f, .. } | Self::OnBoth { f, .. } if !f.is_finite() => Self::Nothing,
+            push => push,
+        }
+    }
+
+    /// [`of`](Self::of) before the test of the force.
+    #[inline(always)]
+    fn unchecked(spring: &Spring, targets: &Targets) -> Self {
         let Some((ta, ma)) = targets.body(spring.a) else {
             return Self::Nothing;
         };

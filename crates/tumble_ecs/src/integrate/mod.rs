@@ -26,7 +26,8 @@ mod table;
 
 pub use stages::{StageCursor, hold_game_loads, next_stage};
 pub use systems::{
-    begin_stage, discard_fixed_body_forces, integrate_with_forces, integrate_without_forces,
+    begin_stage, check_fixed_bodies, discard_fixed_body_forces, integrate_with_forces,
+    integrate_without_forces,
 };
 
 // Schedule state between two systems of one stage, in their signatures; not for game code.

@@ -17,7 +17,7 @@ use crate::components::{ForceAccumulator, Gravity, Kinematic, PhysicsSettings, R
 use crate::components::{ImplicitBody, ImplicitSpring};
 use crate::forces::{apply_constant_forces, apply_constant_torques, apply_gravity, apply_springs};
 use crate::integrate::{
-    HalfDrifted, begin_stage, discard_fixed_body_forces, integrate_with_forces,
+    HalfDrifted, begin_stage, check_fixed_bodies, discard_fixed_body_forces, integrate_with_forces,
     integrate_without_forces,
 };
 use crate::integrate::{StageCursor, hold_game_loads, next_stage};
@@ -80,6 +80,8 @@ physics_systems! {
     HoldGameLoads => "hold_game_loads",
     /// [`audit_energy_start`].
     AuditEnergyStart => "audit_energy_start",
+    /// [`check_fixed_bodies`].
+    CheckFixedBodies => "check_fixed_bodies",
     /// [`damp_springs_start`]: the spring dampers' flow over the first half step.
     DampSpringsStart => "damp_springs_start",
     /// [`begin_stage`].
@@ -149,6 +151,8 @@ struct Contents {
     dynamic_with_accumulator: bool,
     dynamic_without_accumulator: bool,
     fixed_with_accumulator: bool,
+    /// Static or kinematic bodies.
+    fixed_bodies: bool,
     constant_forces: bool,
     constant_torques: bool,
     springs: bool,
@@ -183,6 +187,7 @@ impl Contents {
             let has = |c: Option<ComponentId>| c.is_some_and(|c| archetype.contains(c));
             if has(body) {
                 let is_fixed = fixed.iter().any(|&c| has(c));
+                out.fixed_bodies |= is_fixed;
                 out.implicit_bodies |= !is_fixed && has(implicit);
                 // Implicit bodies take their whole step in `solve_implicit_springs`.
                 match (is_fixed || has(implicit), has(acc)) {
@@ -269,6 +274,7 @@ impl PhysicsPlan {
         let needed = [
             (PhysicsSystem::HoldGameLoads, staged && loaded),
             (PhysicsSystem::AuditEnergyStart, audit),
+            (PhysicsSystem::CheckFixedBodies, c.fixed_bodies && c.springs),
             (PhysicsSystem::DampSpringsStart, c.damped_springs),
             (
                 PhysicsSystem::BeginStage,
@@ -365,6 +371,7 @@ impl PhysicsPlan {
             let set = match system {
                 PhysicsSystem::HoldGameLoads
                 | PhysicsSystem::AuditEnergyStart
+                | PhysicsSystem::CheckFixedBodies
                 | PhysicsSystem::DampSpringsStart
                 | PhysicsSystem::BeginStage => PhysicsSet::Prepare,
                 PhysicsSystem::Gravity => PhysicsSet::Gravity,
@@ -406,6 +413,7 @@ fn add_system(
         PhysicsSystem::AuditEnergyStart => audit_energy_start.into_configs(),
         PhysicsSystem::AuditExternalLoads => audit_external_loads.into_configs(),
         PhysicsSystem::AuditEnergy => audit_energy.into_configs(),
+        PhysicsSystem::CheckFixedBodies => check_fixed_bodies.into_configs(),
         PhysicsSystem::DampSpringsStart => damp_springs_start.into_configs(),
         PhysicsSystem::DampSpringsEnd => damp_springs_end.into_configs(),
         PhysicsSystem::BeginStage => begin_stage.into_configs(),

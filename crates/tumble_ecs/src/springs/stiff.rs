@@ -663,8 +663,13 @@ fn group_spring(
                 index: local[k],
                 anchor,
             },
-            // A static, kinematic or quarantined body holds its anchor still.
-            None => LinkEnd::Fixed(others.get(body).ok()?.transform_point(anchor)),
+            // A static, kinematic or quarantined body holds its anchor still; a spring to one
+            // whose pose game code made bad exerts nothing (that body is refused, see
+            // `check_fixed_bodies`).
+            None => {
+                let point = others.get(body).ok()?.transform_point(anchor);
+                LinkEnd::Fixed(point.is_finite().then_some(point)?)
+            }
         },
     };
     Some((

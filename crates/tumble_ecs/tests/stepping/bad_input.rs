@@ -570,3 +570,94 @@ fn bad_data_in_a_stiff_group_is_refused_for_its_body_alone() {
         );
     }
 }
+
+/// Bad data game code writes into a body tumble never integrates — a kinematic body it moves,
+/// a static anchor — is refused for that body, naming the field, and harms none of the bodies
+/// its springs pull: explicit springs with dampers and implicit (stiff) ones alike. Those
+/// springs exert nothing while their end is bad, as a quarantined body's.
+#[test]
+fn bad_data_in_a_fixed_body_harms_none_of_its_springs_bodies() {
+    type Corrupt = fn(&mut World, Entity);
+    let cases: [(&str, Corrupt, &str); 3] = [
+        (
+            "nan translation",
+            |w, e| w.get_mut::<Pose>(e).unwrap().translation.y = Real::NAN,
+            "Pose",
+        ),
+        (
+            "infinite velocity",
+            |w, e| w.get_mut::<Velocity>(e).unwrap().linear.x = Real::INFINITY,
+            "Velocity",
+        ),
+        (
+            "non-unit rotation",
+            |w, e| w.get_mut::<Pose>(e).unwrap().rotation = Quat::from_xyzw(0.0, 0.0, 0.0, 3.0),
+            "Pose",
+        ),
+    ];
+    for solver in [SpringSolver::Explicit, SpringSolver::Implicit] {
+        for fixed_kind in ["kinematic", "static"] {
+            for (name, corrupt, component) in cases {
+                let case = format!("{solver:?} springs, {fixed_kind} anchor, {name}");
+                let mut world = world_with(1.0 / 60.0, Integrator::Splitting);
+                world.resource_mut::<PhysicsSettings>().springs = solver;
+                world.insert_resource(Gravity(Vec3::new(0.0, -9.81, 0.0)));
+                let mut anchor = world.spawn((RigidBody, Pose::IDENTITY, Velocity::ZERO));
+                if fixed_kind == "kinematic" {
+                    anchor.insert(Kinematic);
+                } else {
+                    anchor.insert(Static);
+                }
+                let anchor = anchor.id();
+                let body = world
+                    .spawn((
+                        RigidBody,
+                        mass_props(1.0, [0.02, 0.03, 0.04]),
+                        Pose::from_translation(Vec3::new(0.5, 0.0, 0.0)),
+                        Velocity::angular(Vec3::new(0.3, -0.2, 0.1)),
+                        ForceAccumulator::default(),
+                    ))
+                    .id();
+                world.spawn(Spring {
+                    a: body,
+                    anchor_a: Vec3::new(-0.1, 0.02, 0.0),
+                    b: SpringEnd::Body {
+                        body: anchor,
+                        anchor: Vec3::new(0.05, 0.0, 0.0),
+                    },
+                    // √(k/m)Δt = 0.5 explicit (inside its stable region), 2.4 implicit.
+                    stiffness: if solver == SpringSolver::Explicit {
+                        900.0
+                    } else {
+                        2.0e4
+                    },
+                    damping: 1.0,
+                    rest_length: 0.3,
+                });
+                let mut physics = PhysicsRunner::new(&mut world);
+                run_steps(&mut world, &mut physics, 3);
+                corrupt(&mut world, anchor);
+                run_steps(&mut world, &mut physics, 5);
+                let rejected = world
+                    .get::<Rejected>(anchor)
+                    .unwrap_or_else(|| panic!("{case}: the anchor was not refused"));
+                assert!(
+                    matches!(&rejected.0.kind, BodyErrorKind::Invalid { component: c, .. } if *c == component),
+                    "{case}: {}",
+                    rejected.0
+                );
+                if let Some(r) = world.get::<Rejected>(body) {
+                    panic!("{case}: the pulled body was refused: {}", r.0);
+                }
+                let pose = world.get::<Pose>(body).unwrap();
+                let velocity = world.get::<Velocity>(body).unwrap();
+                assert!(
+                    pose.translation.is_finite()
+                        && velocity.linear.is_finite()
+                        && velocity.angular.is_finite(),
+                    "{case}: the pulled body went bad"
+                );
+            }
+        }
+    }
+}

@@ -95,8 +95,9 @@ fn static_and_kinematic_bodies_are_never_integrated() {
     let plan = PhysicsPlan::for_world(&mut world);
     assert_eq!(
         plan.to_string(),
-        "audit_energy_start → begin_stage → apply_gravity → audit_external_loads → \
-         apply_springs → integrate_with_forces → discard_fixed_body_forces → audit_energy"
+        "audit_energy_start → check_fixed_bodies → begin_stage → apply_gravity → \
+         audit_external_loads → apply_springs → integrate_with_forces → \
+         discard_fixed_body_forces → audit_energy"
     );
     let mut physics = PhysicsRunner::new(&mut world);
     assert_eq!(physics.plan(), &plan);
