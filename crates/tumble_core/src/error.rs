@@ -85,6 +85,23 @@ pub enum InvalidInput {
     /// Saved data whose parts disagree (e.g. moments and their stored reciprocals).
     #[error("inconsistent saved data: {0}")]
     Inconsistent(&'static str),
+    /// A coefficient that must be finite and `>= 0` (e.g. a damping rate) is negative or NaN.
+    #[error("{field} must be >= 0 and finite, got {}", compact(*.value))]
+    Negative {
+        /// Which quantity, e.g. `"linear"` (of `Damping`).
+        field: &'static str,
+        /// The offending value.
+        value: Real,
+    },
+}
+
+/// Checks that the coefficient `value` is finite and `>= 0` (NaN fails).
+pub fn check_non_negative(field: &'static str, value: Real) -> Result<(), InvalidInput> {
+    if value >= 0.0 && value.is_finite() {
+        Ok(())
+    } else {
+        Err(InvalidInput::Negative { field, value })
+    }
 }
 
 /// Checks that `value` is finite.

@@ -347,6 +347,27 @@ pub struct Damping {
     pub angular: Real,
 }
 
+impl Damping {
+    /// Checks that both coefficients are finite and `>= 0`: the flow treats a negative or NaN
+    /// rate as no damping (never growth), so a bad one would otherwise be ignored silently.
+    #[inline]
+    pub fn check(&self) -> Result<(), BodyErrorKind> {
+        if self.linear >= 0.0
+            && self.angular >= 0.0
+            && self.linear.is_finite()
+            && self.angular.is_finite()
+        {
+            return Ok(());
+        }
+        let invalid = |source| BodyErrorKind::Invalid {
+            component: "Damping",
+            source,
+        };
+        tumble_core::error::check_non_negative("linear", self.linear).map_err(invalid)?;
+        tumble_core::error::check_non_negative("angular", self.angular).map_err(invalid)
+    }
+}
+
 /// The world offset `R c` of the centre of mass from the body origin, or `None` when the centre
 /// of mass is the origin (the common case, which then costs no arithmetic at all).
 ///

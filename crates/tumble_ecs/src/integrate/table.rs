@@ -223,9 +223,12 @@ impl BodyBatch for TableBatch<'_, '_> {
         let bodies = &mut self.bodies;
         let (transform, velocity) = (&bodies.transforms[i], &bodies.velocities[i]);
         let mass = &bodies.masses[i];
-        // Only the rotation is checked here; a non-finite translation or velocity is found in
-        // the stepped state and named by `diverged` (see `check_rotation`).
-        match check_rotation(transform).and_then(|()| bodies.loads.take(i, mass)) {
+        // Only the rotation is checked here, and the damping (its flow would ignore a bad rate
+        // silently); a non-finite translation or velocity is found in the stepped state and
+        // named by `diverged` (see `check_rotation`).
+        let checked = check_rotation(transform)
+            .and_then(|()| bodies.dampings.map_or(Ok(()), |d| d[i].check()));
+        match checked.and_then(|()| bodies.loads.take(i, mass)) {
             Ok(wrench) => {
                 state.copy_fields_from(&body_state(transform, velocity, mass));
                 if self.damp_read

@@ -401,7 +401,9 @@ pub fn solve_implicit_springs(
         // (its springs exert nothing, as a quarantined body's), and its components and
         // accumulator stay as they are. The point forces' moment is this stage's only (no
         // snapshot holds it): it goes with the stage.
-        if let Err(kind) = check_body(&t, &v, Some(&acc)) {
+        let checked =
+            check_body(&t, &v, Some(&acc)).and_then(|()| damping.map_or(Ok(()), |d| d.check()));
+        if let Err(kind) = checked {
             implicit.take_load_moment();
             reject(&mut commands, BodyError { entity, kind });
             continue;

@@ -661,3 +661,75 @@ fn bad_data_in_a_fixed_body_harms_none_of_its_springs_bodies() {
         }
     }
 }
+
+/// A negative or NaN damping rate written by game code is refused for its body, naming the
+/// field, on the explicit and the implicit path: the damping flow treats such a rate as no
+/// damping (never growth), so without the check it would be ignored silently.
+#[test]
+fn a_bad_damping_rate_is_refused_not_ignored() {
+    for solver in [SpringSolver::Explicit, SpringSolver::Implicit] {
+        for (field, bad) in [("linear", Real::NAN), ("angular", -0.5)] {
+            let case = format!("{solver:?}, {field} = {bad}");
+            let mut world = world_with(1.0 / 60.0, Integrator::Splitting);
+            world.resource_mut::<PhysicsSettings>().springs = solver;
+            let spawn = |world: &mut World, x: Real| {
+                world
+                    .spawn((
+                        RigidBody,
+                        mass_props(1.0, [0.02, 0.03, 0.04]),
+                        Pose::from_translation(Vec3::new(x, 0.0, 0.0)),
+                        Velocity::angular(Vec3::new(0.3, -0.2, 0.1)),
+                        ForceAccumulator::default(),
+                        Damping {
+                            linear: 0.1,
+                            angular: 0.1,
+                        },
+                    ))
+                    .id()
+            };
+            let (a, b) = (spawn(&mut world, 0.0), spawn(&mut world, 0.6));
+            world.spawn(Spring {
+                a,
+                anchor_a: Vec3::new(0.1, 0.0, 0.0),
+                b: SpringEnd::Body {
+                    body: b,
+                    anchor: Vec3::new(-0.1, 0.0, 0.0),
+                },
+                stiffness: if solver == SpringSolver::Explicit {
+                    400.0
+                } else {
+                    2.0e4
+                },
+                damping: 0.0,
+                rest_length: 0.3,
+            });
+            let mut physics = PhysicsRunner::new(&mut world);
+            run_steps(&mut world, &mut physics, 2);
+            let mut damping = world.get_mut::<Damping>(a).unwrap();
+            if field == "linear" {
+                damping.linear = bad;
+            } else {
+                damping.angular = bad;
+            }
+            run_steps(&mut world, &mut physics, 2);
+            let rejected = world
+                .get::<Rejected>(a)
+                .unwrap_or_else(|| panic!("{case}: not refused"));
+            assert!(
+                matches!(
+                    &rejected.0.kind,
+                    BodyErrorKind::Invalid {
+                        component: "Damping",
+                        source: tumble_core::InvalidInput::Negative { field: f, .. },
+                    } if *f == field
+                ),
+                "{case}: {}",
+                rejected.0
+            );
+            assert!(
+                world.get::<Rejected>(b).is_none(),
+                "{case}: its partner was refused"
+            );
+        }
+    }
+}
