@@ -428,8 +428,9 @@ pub fn write_body_state(
 
 /// Checks the body data of a [`Pose`], [`Velocity`] and optional [`ForceAccumulator`].
 ///
-/// Runs in the insert hooks and on every body whose step failed (to name the bad field), so valid
-/// data takes an inlined fast test (finite values, unit
+/// Runs in the insert hooks, on the bodies tumble never steps (`check_fixed_bodies`), on each
+/// body of a stiff group before its solve, and on every body whose batched step failed (to name
+/// the bad field), so valid data takes an inlined fast test (finite values, unit
 /// quaternion within [`UNIT_QUATERNION_TOLERANCE`](tumble_core::error::UNIT_QUATERNION_TOLERANCE));
 /// only bad data goes through the detailed checks that build the error.
 #[inline]
