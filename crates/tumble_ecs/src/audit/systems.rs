@@ -260,7 +260,7 @@ pub fn audit_energy(
         return;
     }
     let dt = ledger.dt;
-    let gravity = gravity.map(|g| g.0);
+    let gravity = gravity.and_then(|g| g.field());
     // Only what this pass measures may be reused (a body it does not see keeps an older memo,
     // which its number rules out): a spring's memo is reused only with its bodies' poses
     // measured in the same pass.

@@ -1,4 +1,5 @@
-//! The errors a world records: a quarantined body, a generator left out of the step.
+//! The errors a world records: a quarantined body, a generator left out of the step, a world
+//! resource left out of the step.
 
 use bevy_ecs::prelude::*;
 use thiserror::Error;
@@ -71,12 +72,26 @@ pub struct PhysicsErrors {
     pub bodies: Vec<BodyError>,
     /// Force generators left out of the step (see [`crate::components`]).
     pub generators: Vec<crate::components::GeneratorError>,
+    /// World resources left out of the step (see [`WorldError`]).
+    pub world: Vec<WorldError>,
+}
+
+/// A world resource game code made bad (a non-finite [`Gravity`](crate::components::Gravity)):
+/// it is left out of the step until it is valid again, rather than carried into every body it
+/// reaches. Recorded once per bad value.
+#[derive(Debug, Clone, PartialEq, Error)]
+#[error("{resource}: {source}; left out of the step until it is valid")]
+pub struct WorldError {
+    /// The resource, e.g. `"Gravity"`.
+    pub resource: &'static str,
+    /// What is wrong with it.
+    pub source: InvalidInput,
 }
 
 impl PhysicsErrors {
     /// True when nothing was recorded.
     pub fn is_empty(&self) -> bool {
-        self.bodies.is_empty() && self.generators.is_empty()
+        self.bodies.is_empty() && self.generators.is_empty() && self.world.is_empty()
     }
 }
 

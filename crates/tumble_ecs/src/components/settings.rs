@@ -15,6 +15,15 @@ pub struct Gravity(pub Vec3);
 impl Gravity {
     /// Earth gravity along −y: `(0, −9.81, 0)`.
     pub const EARTH_Y_DOWN: Self = Self(Vec3::new(0.0, -9.81, 0.0));
+
+    /// The acceleration the step applies: `None` where it is not finite (game code wrote a bad
+    /// value), so that the step leaves gravity out instead of quarantining every body it would
+    /// reach; [`PhysicsRunner`](crate::schedule::PhysicsRunner) records a
+    /// [`WorldError`](crate::components::WorldError) for it.
+    #[inline]
+    pub fn field(&self) -> Option<Vec3> {
+        self.0.is_finite().then_some(self.0)
+    }
 }
 
 /// The step size and integrator of a world. The time step is validated on construction and the

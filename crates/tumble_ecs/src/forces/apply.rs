@@ -39,7 +39,8 @@ pub fn kinetic_and_elastic_energy(world: &mut World) -> f64 {
 }
 
 /// Adds `m g s` to every dynamic body with an accumulator (`s` = [`GravityScale`], default 1).
-/// Only in the schedule when a [`Gravity`] resource exists.
+/// Only in the schedule when a [`Gravity`] resource exists; nothing while it is not finite
+/// ([`Gravity::field`]).
 pub fn apply_gravity(
     gravity: Res<Gravity>,
     mut bodies: Query<
@@ -47,7 +48,9 @@ pub fn apply_gravity(
         crate::components::Dynamic,
     >,
 ) {
-    let g = gravity.0;
+    let Some(g) = gravity.field() else {
+        return;
+    };
     for (mass, scale, mut acc) in &mut bodies {
         let s = scale.map_or(1.0, |s| s.0);
         acc.force += (mass.mass() * s) * g;

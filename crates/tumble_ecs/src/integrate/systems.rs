@@ -169,7 +169,7 @@ pub fn integrate_without_forces(
     mut commands: Commands,
     mut bodies: Query<Stepped<Option<&GravityScale>>, (Dynamic, Without<ForceAccumulator>)>,
 ) {
-    let gravity = gravity.map(|g| g.0);
+    let gravity = gravity.and_then(|g| g.field());
     let Some(stage) = StageTiming::free_motion(&settings, *cursor) else {
         return;
     };

@@ -134,6 +134,9 @@ pub struct PhysicsRunner {
     force_systems: Option<bevy_ecs::change_detection::Tick>,
     /// The checks of the force generators before each step.
     generators: GeneratorWatch,
+    /// The bad [`Gravity`](crate::components::Gravity) last recorded, so that one bad value
+    /// (bit for bit: a NaN is not equal to itself) is one record.
+    bad_gravity: Option<tumble_core::math::Vec3>,
 }
 
 impl PhysicsRunner {
@@ -149,6 +152,7 @@ impl PhysicsRunner {
             springs: None,
             force_systems: force_systems_changed(world),
             generators: GeneratorWatch::default(),
+            bad_gravity: None,
         }
     }
 
@@ -166,9 +170,45 @@ impl PhysicsRunner {
     pub fn prepare(&mut self, world: &mut World) {
         crate::components::assume_missing_masses(world);
         self.generators.check(world);
+        self.check_gravity(world);
         if self.is_stale(world) {
             self.replan(world);
         }
+    }
+
+    /// Records a [`WorldError`](crate::components::WorldError) (and logs it) when the
+    /// [`Gravity`](crate::components::Gravity) resource is not finite, once per bad value: the
+    /// step leaves such a gravity out ([`Gravity::field`](crate::components::Gravity::field)).
+    fn check_gravity(&mut self, world: &mut World) {
+        let Some(gravity) = world.get_resource::<crate::components::Gravity>() else {
+            self.bad_gravity = None;
+            return;
+        };
+        if gravity.field().is_some() {
+            self.bad_gravity = None;
+            return;
+        }
+        let g = gravity.0;
+        let same_bits = |last: tumble_core::math::Vec3| {
+            let pairs = last.to_array().into_iter().zip(g.to_array());
+            pairs.into_iter().all(|(a, b)| a.to_bits() == b.to_bits())
+        };
+        if self.bad_gravity.is_some_and(same_bits) {
+            return;
+        }
+        self.bad_gravity = Some(g);
+        let Err(source) = tumble_core::error::check_finite_vec3("acceleration", g) else {
+            return;
+        };
+        let error = crate::components::WorldError {
+            resource: "Gravity",
+            source,
+        };
+        tracing::error!("{error}");
+        world
+            .get_resource_or_init::<crate::components::PhysicsErrors>()
+            .world
+            .push(error);
     }
 
     /// True when `world` no longer matches the plan (see the type's docs).

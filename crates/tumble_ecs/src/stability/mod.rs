@@ -212,7 +212,10 @@ fn check_springs(world: &mut World, dt: Real, warnings: &mut Vec<StabilityWarnin
 /// Moving bodies that turn about a locked axis, or sit so far out that their position
 /// rounds away a visible part of each step.
 fn check_positions(world: &mut World, dt: Real, warnings: &mut Vec<StabilityWarning>) {
-    let gravity = world.get_resource::<Gravity>().map_or(Vec3::ZERO, |g| g.0);
+    let gravity = world
+        .get_resource::<Gravity>()
+        .and_then(Gravity::field)
+        .unwrap_or(Vec3::ZERO);
     let mut moving = world.query_filtered::<(
         Entity,
         &Pose,

@@ -251,7 +251,7 @@ impl Snapshot {
                 .collect();
             world.insert_resource(PhysicsErrors {
                 bodies: errors,
-                generators: Vec::new(),
+                ..PhysicsErrors::default()
             });
         }
         Ok(map)

@@ -733,3 +733,77 @@ fn a_bad_damping_rate_is_refused_not_ignored() {
         }
     }
 }
+
+/// A non-finite `Gravity` written by game code is left out of the step and recorded once, as a
+/// `WorldError` naming the resource; no body is quarantined for it (bodies with and without
+/// accumulators, in an audited spring pair). A valid gravity applies again at once.
+#[test]
+fn a_bad_gravity_is_left_out_not_carried_into_every_body() {
+    let mut world = world_with(1.0 / 60.0, Integrator::Splitting);
+    world.insert_resource(Gravity(Vec3::new(0.0, -9.81, 0.0)));
+    let free = spawn_body(&mut world, 1.0, [1.0, 2.0, 3.0], Velocity::ZERO);
+    let loaded = world
+        .spawn((
+            RigidBody,
+            mass_props(1.0, [0.02, 0.03, 0.04]),
+            Pose::from_translation(Vec3::new(1.0, 0.0, 0.0)),
+            Velocity::ZERO,
+            ForceAccumulator::default(),
+        ))
+        .id();
+    let partner = world
+        .spawn((
+            RigidBody,
+            mass_props(1.0, [0.02, 0.03, 0.04]),
+            Pose::from_translation(Vec3::new(1.5, 0.0, 0.0)),
+            Velocity::ZERO,
+            ForceAccumulator::default(),
+        ))
+        .id();
+    world.spawn(Spring::new(
+        loaded,
+        Vec3::ZERO,
+        SpringEnd::on_body(partner, Vec3::ZERO),
+        100.0,
+        0.5,
+    ));
+    let mut physics = PhysicsRunner::new(&mut world);
+    run_steps(&mut world, &mut physics, 3);
+    let falling = world.get::<Velocity>(free).unwrap().linear.y;
+    assert!(falling < 0.0);
+    world.resource_mut::<Gravity>().0.y = Real::NAN;
+    run_steps(&mut world, &mut physics, 4);
+    for body in [free, loaded, partner] {
+        if let Some(r) = world.get::<Rejected>(body) {
+            panic!("{body} was refused for the world's gravity: {}", r.0);
+        }
+        let v = world.get::<Velocity>(body).unwrap();
+        assert!(v.linear.is_finite(), "{body}");
+    }
+    // No gravity while it is bad: the free body keeps its vertical velocity, bit for bit.
+    assert_eq!(world.get::<Velocity>(free).unwrap().linear.y, falling);
+    let errors = world.resource::<PhysicsErrors>();
+    assert_eq!(
+        errors.world.len(),
+        1,
+        "one record for one bad value: {errors:?}"
+    );
+    let message = errors.world[0].to_string();
+    assert!(
+        message.contains("Gravity") && message.contains("not finite"),
+        "{message}"
+    );
+    world.resource_mut::<Gravity>().0 = Vec3::new(Real::INFINITY, 0.0, 0.0);
+    run_steps(&mut world, &mut physics, 2);
+    assert_eq!(
+        world.resource::<PhysicsErrors>().world.len(),
+        2,
+        "a new bad value"
+    );
+    world.resource_mut::<Gravity>().0 = Vec3::new(0.0, -9.81, 0.0);
+    run_steps(&mut world, &mut physics, 1);
+    assert!(
+        world.get::<Velocity>(free).unwrap().linear.y < falling,
+        "gravity applies again"
+    );
+}
