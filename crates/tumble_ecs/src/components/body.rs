@@ -352,13 +352,6 @@ impl Damping {
     /// rate as no damping (never growth), so a bad one would otherwise be ignored silently.
     #[inline]
     pub fn check(&self) -> Result<(), BodyErrorKind> {
-        if self.linear >= 0.0
-            && self.angular >= 0.0
-            && self.linear.is_finite()
-            && self.angular.is_finite()
-        {
-            return Ok(());
-        }
         let invalid = |source| BodyErrorKind::Invalid {
             component: "Damping",
             source,

@@ -180,26 +180,22 @@ impl PhysicsRunner {
     /// [`Gravity`](crate::components::Gravity) resource is not finite, once per bad value: the
     /// step leaves such a gravity out ([`Gravity::field`](crate::components::Gravity::field)).
     fn check_gravity(&mut self, world: &mut World) {
-        let Some(gravity) = world.get_resource::<crate::components::Gravity>() else {
+        let Some(&crate::components::Gravity(g)) = world.get_resource() else {
             self.bad_gravity = None;
             return;
         };
-        if gravity.field().is_some() {
+        let Err(source) = tumble_core::error::check_finite_vec3("acceleration", g) else {
             self.bad_gravity = None;
             return;
-        }
-        let g = gravity.0;
+        };
         let same_bits = |last: tumble_core::math::Vec3| {
-            let pairs = last.to_array().into_iter().zip(g.to_array());
-            pairs.into_iter().all(|(a, b)| a.to_bits() == b.to_bits())
+            let mut pairs = last.to_array().into_iter().zip(g.to_array());
+            pairs.all(|(a, b)| a.to_bits() == b.to_bits())
         };
         if self.bad_gravity.is_some_and(same_bits) {
             return;
         }
         self.bad_gravity = Some(g);
-        let Err(source) = tumble_core::error::check_finite_vec3("acceleration", g) else {
-            return;
-        };
         let error = crate::components::WorldError {
             resource: "Gravity",
             source,
