@@ -66,12 +66,10 @@ pub(crate) fn run(mut args: RunArgs) -> Result<(), Failure> {
     // the run: a run that cannot be written fails with its one error line, and fast.
     let mut out_file = match args.out.as_deref() {
         Some(path) if !to_stdout => {
-            let inputs: Vec<&Path> = loaded.path.as_deref().into_iter().collect();
-            let file = OutputFile::create(path, &inputs)?;
-            if !args.force {
-                check_free_space(&file, &built, steps, &record)?;
-            }
-            Some(file)
+            let input = loaded.path.as_deref();
+            Some(open_output(
+                path, input, args.force, &built, steps, &record,
+            )?)
         }
         _ => None,
     };
@@ -135,6 +133,24 @@ pub(crate) fn run(mut args: RunArgs) -> Result<(), Failure> {
         ));
     }
     Ok(())
+}
+
+/// The trajectory's output file at `path` (never the scene file `input`), with room for the
+/// run's rows unless `force`.
+fn open_output(
+    path: &Path,
+    input: Option<&Path>,
+    force: bool,
+    built: &BuiltScene,
+    steps: u64,
+    record: &Recording,
+) -> Result<OutputFile, Failure> {
+    let inputs: Vec<&Path> = input.into_iter().collect();
+    let file = OutputFile::create(path, &inputs)?;
+    if !force {
+        check_free_space(&file, built, steps, record)?;
+    }
+    Ok(file)
 }
 
 /// `--every`: a step count of at least 1.

@@ -186,36 +186,12 @@ pub fn compare(
             f64::NAN
         });
         for (i, diff) in bodies.iter_mut().enumerate() {
-            let (a, b) = (tumble_states[i], rapier_states[i]);
-            if diff.tumble_rejected_at.is_none() && tumble.is_rejected(i) {
-                diff.tumble_rejected_at = Some(step);
-            }
-            if diff.rapier_quarantined_at.is_none() && rapier.is_quarantined(i) {
-                diff.rapier_quarantined_at = Some(step);
-            }
-            if diff.non_finite_at.is_none() && !(a.is_finite() && b.is_finite()) {
-                diff.non_finite_at = Some(step);
-            }
-            diff.position = max_keep_nan(diff.position, (a.position - b.position).length());
-            diff.angle = max_keep_nan(diff.angle, angle_between(a.rotation, b.rotation));
-            diff.linear_velocity = max_keep_nan(
-                diff.linear_velocity,
-                (a.linear_velocity - b.linear_velocity).length(),
+            diff.record(
+                step,
+                (&tumble_states[i], tumble.is_rejected(i)),
+                (&rapier_states[i], rapier.is_quarantined(i)),
+                exact.and_then(|f| f(i, t)),
             );
-            diff.angular_velocity = max_keep_nan(
-                diff.angular_velocity,
-                (a.angular_velocity - b.angular_velocity).length(),
-            );
-            if let Some(reference) = exact.and_then(|f| f(i, t)) {
-                let pos = |s: &BodyState| to_f64((s.position - reference.position).length());
-                let (pt, pr) = diff.exact_position.unwrap_or((0.0, 0.0));
-                diff.exact_position = Some((max_keep_nan(pt, pos(&a)), max_keep_nan(pr, pos(&b))));
-                let (at, ar) = diff.exact_angle.unwrap_or((0.0, 0.0));
-                diff.exact_angle = Some((
-                    max_keep_nan(at, angle_between(a.rotation, reference.rotation)),
-                    max_keep_nan(ar, angle_between(b.rotation, reference.rotation)),
-                ));
-            }
         }
     }
     let steps = options.steps.max(1) as f64;
@@ -225,5 +201,48 @@ pub fn compare(
         rapier_ns_per_step: rapier_ns as f64 / steps,
         tumble_energy,
         rapier_energy,
+    }
+}
+
+impl BodyDifference {
+    /// Takes in step `step`: tumble's state `a` (and whether tumble has rejected the body),
+    /// rapier's `b` (and whether it is quarantined), and the exact solution's state where there
+    /// is one.
+    fn record(
+        &mut self,
+        step: usize,
+        (a, tumble_rejected): (&BodyState, bool),
+        (b, rapier_quarantined): (&BodyState, bool),
+        reference: Option<BodyState>,
+    ) {
+        if self.tumble_rejected_at.is_none() && tumble_rejected {
+            self.tumble_rejected_at = Some(step);
+        }
+        if self.rapier_quarantined_at.is_none() && rapier_quarantined {
+            self.rapier_quarantined_at = Some(step);
+        }
+        if self.non_finite_at.is_none() && !(a.is_finite() && b.is_finite()) {
+            self.non_finite_at = Some(step);
+        }
+        self.position = max_keep_nan(self.position, (a.position - b.position).length());
+        self.angle = max_keep_nan(self.angle, angle_between(a.rotation, b.rotation));
+        self.linear_velocity = max_keep_nan(
+            self.linear_velocity,
+            (a.linear_velocity - b.linear_velocity).length(),
+        );
+        self.angular_velocity = max_keep_nan(
+            self.angular_velocity,
+            (a.angular_velocity - b.angular_velocity).length(),
+        );
+        if let Some(reference) = reference {
+            let pos = |s: &BodyState| to_f64((s.position - reference.position).length());
+            let (pt, pr) = self.exact_position.unwrap_or((0.0, 0.0));
+            self.exact_position = Some((max_keep_nan(pt, pos(a)), max_keep_nan(pr, pos(b))));
+            let (at, ar) = self.exact_angle.unwrap_or((0.0, 0.0));
+            self.exact_angle = Some((
+                max_keep_nan(at, angle_between(a.rotation, reference.rotation)),
+                max_keep_nan(ar, angle_between(b.rotation, reference.rotation)),
+            ));
+        }
     }
 }

@@ -291,30 +291,7 @@ pub fn markdown(results: &Results, plots: &[String]) -> String {
     for plot in plots {
         let _ = writeln!(out, "![{plot}]({plot})\n");
     }
-    let mut scenes: Vec<&str> = results
-        .work_precision
-        .iter()
-        .map(|p| p.scene.as_str())
-        .collect();
-    scenes.dedup();
-    for scene in scenes {
-        let _ = writeln!(out, "### {scene}\n");
-        out.push_str("| method | Δt (s) | orientation (rad) | position (m) | energy drift | |L| drift | ns/body-step |\n|---|---|---|---|---|---|---|\n");
-        for p in results.work_precision.iter().filter(|p| p.scene == scene) {
-            let _ = writeln!(
-                out,
-                "| `{}` | 1/{:.0} | {} | {} | {} | {} | {:.0} |",
-                p.method,
-                1.0 / p.dt_s,
-                sci(p.orientation_error_rad),
-                sci(p.position_error_m),
-                sci(p.energy_drift),
-                p.momentum_drift.map_or("—".to_owned(), sci),
-                p.ns_per_body_step
-            );
-        }
-        out.push('\n');
-    }
+    out.push_str(&work_precision_tables(&results.work_precision));
     out.push_str(&crate::storage::storage_section(&results.f32_storage));
     out.push_str(&thin_plate_section(&results.thin_plate));
     let _ = writeln!(
@@ -329,8 +306,43 @@ pub fn markdown(results: &Results, plots: &[String]) -> String {
          `springs` = the spring step (`auto` takes the implicit one for stiff groups). The same \
          verdicts as a heatmap: [stability.svg](stability.svg).\n"
     );
+    out.push_str(&stability_table(&results.stability));
+    out.push('\n');
+    out.push_str(&crate::spring_output::spring_section(&results.springs));
+    out
+}
+
+/// One table per scene of every method's work–precision points.
+fn work_precision_tables(points: &[Point]) -> String {
+    let mut out = String::new();
+    let mut scenes: Vec<&str> = points.iter().map(|p| p.scene.as_str()).collect();
+    scenes.dedup();
+    for scene in scenes {
+        let _ = writeln!(out, "### {scene}\n");
+        out.push_str("| method | Δt (s) | orientation (rad) | position (m) | energy drift | |L| drift | ns/body-step |\n|---|---|---|---|---|---|---|\n");
+        for p in points.iter().filter(|p| p.scene == scene) {
+            let _ = writeln!(
+                out,
+                "| `{}` | 1/{:.0} | {} | {} | {} | {} | {:.0} |",
+                p.method,
+                1.0 / p.dt_s,
+                sci(p.orientation_error_rad),
+                sci(p.position_error_m),
+                sci(p.energy_drift),
+                p.momentum_drift.map_or("—".to_owned(), sci),
+                p.ns_per_body_step
+            );
+        }
+        out.push('\n');
+    }
+    out
+}
+
+/// The stability matrix, one row per scene, setting and integrator.
+fn stability_table(cells: &[Cell]) -> String {
+    let mut out = String::new();
     out.push_str("| scene | setting | integrator | springs | finite | max \\|\\|q\\|−1\\| | E/E₀ | E/E₀ range | verdict | warned |\n|---|---|---|---|---|---|---|---|---|---|\n");
-    for c in &results.stability {
+    for c in cells {
         let mark = |s: String| if c.stable() { s } else { format!("**{s}**") };
         let [low, high] = c.energy_range;
         let range = if low.is_finite() && high.is_finite() {
@@ -356,8 +368,6 @@ pub fn markdown(results: &Results, plots: &[String]) -> String {
             c.warned
         );
     }
-    out.push('\n');
-    out.push_str(&crate::spring_output::spring_section(&results.springs));
     out
 }
 

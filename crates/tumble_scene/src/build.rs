@@ -13,7 +13,7 @@ use tumble_ecs::springs::{Classification, ClassifiedSpring, classify};
 use crate::error::{SaveError, SceneError};
 use crate::format::{SceneFile, WorldDef};
 use crate::json::JsonSource;
-use crate::spawn::{BodyKind, BodySpawn, batch, spawn_bodies};
+use crate::spawn::{BodyKind, batch, runs, spawn_in_runs};
 use crate::text::terminal_safe;
 use crate::validate::{Checker, Locate, NoText, TomlText};
 
@@ -540,58 +540,6 @@ impl Scene {
             bodies,
         }
     }
-}
-
-/// Body `i` (`body`) as it is spawned: with its accumulator when a generator names it
-/// (`loaded`) and the markers the spring classification gives it.
-fn body_spawn(
-    body: ValidBody,
-    i: usize,
-    loaded: &[bool],
-    classified: &Classification,
-) -> BodySpawn {
-    BodySpawn {
-        body,
-        loaded: loaded[i],
-        turn: classified.turns.get(i).copied().flatten(),
-        implicit: classified.implicit_bodies.get(i).copied().unwrap_or(false),
-    }
-}
-
-/// The runs of equal consecutive values of `kinds`, as `(start, length)`.
-fn runs<K: PartialEq>(kinds: &[K]) -> impl Iterator<Item = (usize, usize)> + '_ {
-    let mut start = 0;
-    std::iter::from_fn(move || {
-        let first = kinds.get(start)?;
-        let len = kinds[start..].iter().take_while(|k| *k == first).count();
-        start += len;
-        Some((start - len, len))
-    })
-}
-
-/// Spawns the bodies in file order, each run of one kind (`kinds`, per body) by one batch;
-/// `next(i)` gives body `i`'s name and checked body, once per body, in order.
-fn spawn_in_runs(
-    world: &mut World,
-    kinds: &[BodyKind],
-    loaded: &[bool],
-    classified: &Classification,
-    mut next: impl FnMut(usize) -> (String, ValidBody),
-) -> Vec<(String, Entity)> {
-    let mut bodies: Vec<(String, Entity)> = Vec::with_capacity(kinds.len());
-    for (start, len) in runs(kinds) {
-        let run = (start..start + len).map(|i| {
-            let (name, body) = next(i);
-            bodies.push((name, Entity::PLACEHOLDER));
-            body_spawn(body, i, loaded, classified)
-        });
-        let mut spawned = Vec::with_capacity(len);
-        spawn_bodies(world, kinds[start], run, |e| spawned.push(e));
-        for (slot, entity) in bodies[start..].iter_mut().zip(spawned) {
-            slot.1 = entity;
-        }
-    }
-    bodies
 }
 
 impl BuiltScene {

@@ -14,6 +14,7 @@ use bevy_ecs::prelude::*;
 use tumble_core::math::Real;
 use tumble_ecs::components::{ImplicitBody, SpringTurn};
 use tumble_ecs::prelude::*;
+use tumble_ecs::springs::Classification;
 
 use crate::build::ValidBody;
 
@@ -169,4 +170,56 @@ pub(crate) fn batch<B: Bundle<Effect: NoBundleEffect>>(
     out: impl FnMut(Entity),
 ) {
     world.spawn_batch(bundles).for_each(out);
+}
+
+/// Body `i` (`body`) as it is spawned: with its accumulator when a generator names it
+/// (`loaded`) and the markers the spring classification gives it.
+fn body_spawn(
+    body: ValidBody,
+    i: usize,
+    loaded: &[bool],
+    classified: &Classification,
+) -> BodySpawn {
+    BodySpawn {
+        body,
+        loaded: loaded[i],
+        turn: classified.turns.get(i).copied().flatten(),
+        implicit: classified.implicit_bodies.get(i).copied().unwrap_or(false),
+    }
+}
+
+/// The runs of equal consecutive values of `kinds`, as `(start, length)`.
+pub(crate) fn runs<K: PartialEq>(kinds: &[K]) -> impl Iterator<Item = (usize, usize)> + '_ {
+    let mut start = 0;
+    std::iter::from_fn(move || {
+        let first = kinds.get(start)?;
+        let len = kinds[start..].iter().take_while(|k| *k == first).count();
+        start += len;
+        Some((start - len, len))
+    })
+}
+
+/// Spawns the bodies in file order, each run of one kind (`kinds`, per body) by one batch;
+/// `next(i)` gives body `i`'s name and checked body, once per body, in order.
+pub(crate) fn spawn_in_runs(
+    world: &mut World,
+    kinds: &[BodyKind],
+    loaded: &[bool],
+    classified: &Classification,
+    mut next: impl FnMut(usize) -> (String, ValidBody),
+) -> Vec<(String, Entity)> {
+    let mut bodies: Vec<(String, Entity)> = Vec::with_capacity(kinds.len());
+    for (start, len) in runs(kinds) {
+        let run = (start..start + len).map(|i| {
+            let (name, body) = next(i);
+            bodies.push((name, Entity::PLACEHOLDER));
+            body_spawn(body, i, loaded, classified)
+        });
+        let mut spawned = Vec::with_capacity(len);
+        spawn_bodies(world, kinds[start], run, |e| spawned.push(e));
+        for (slot, entity) in bodies[start..].iter_mut().zip(spawned) {
+            slot.1 = entity;
+        }
+    }
+    bodies
 }

@@ -16,6 +16,7 @@
 use crate::math::{Real, Vec3};
 use std::borrow::Borrow;
 
+use super::body_batch::{BodyBatch, PREFETCH_AHEAD, Slices, commit};
 use super::exact_flow::{rotate_exactly, rotate_exactly_pair};
 use super::kick_drift_kernel::{KickDrift, kick_drift_translation};
 use super::lane_input::LaneInputs;
@@ -23,116 +24,13 @@ use super::pending::{KickDriftQueue, PendingRotations, QueuedLanes, SymmetricQue
 use super::splitting::{
     drift_kick_drift_linear, drift_kick_drift_translation, free_rotation_span, kick_angular,
 };
+use super::stages::StepPhase;
 use super::symmetric_kernel::LaneFlow;
 use super::{ExactSwitch, Integrator};
 use crate::mass::MassProperties;
-use crate::prefetch::prefetch;
 use crate::rotation::rotate_exact;
 use crate::simd::Kernel;
 use crate::state::{BodyState, Wrench};
-
-/// Which part of a stage a batch performs (see [`Integrator::begin_stage`] and
-/// [`Integrator::finish_stage`]).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum StepPhase {
-    /// The whole stage, [`Integrator::whole_stage`], under the body's constant load.
-    Whole,
-    /// The first phase, [`Integrator::begin_stage`]; the load is not used.
-    Begin,
-    /// The second phase, [`Integrator::finish_stage`], under the load sampled after
-    /// [`Begin`](Self::Begin).
-    Finish,
-}
-
-/// Where a batched step finds its bodies and puts them back.
-///
-/// [`Integrator::stage_batch`] calls [`read`](Self::read) once for every index in `0..len()`,
-/// in increasing order, then exactly one of [`write`](Self::write) (the new state is valid:
-/// finite, with a unit rotation, [`BodyState::is_valid`]) or [`diverged`](Self::diverged) (it is
-/// not: the body keeps its old state) for every body that `read` returned, not necessarily in
-/// order.
-///
-/// Bodies kept in your own layout, here one struct per body with a frozen flag:
-///
-/// ```
-/// use tumble_core::math::Vec3;
-/// use tumble_core::{BodyBatch, BodyState, Integrator, Mass, MassProperties, StepPhase, Wrench};
-///
-/// struct Crate { state: BodyState, mass: MassProperties, frozen: bool }
-/// struct Crates(Vec<Crate>);
-///
-/// impl BodyBatch for Crates {
-///     fn len(&self) -> usize { self.0.len() }
-///     fn read(&mut self, i: usize, state: &mut BodyState) -> Option<Wrench> {
-///         let c = &self.0[i];
-///         if c.frozen { return None; }
-///         state.copy_fields_from(&c.state);
-///         Some(Wrench { force: Vec3::new(0.0, -9.81, 0.0) * c.mass.mass(), torque: Vec3::ZERO })
-///     }
-///     fn mass(&self, i: usize) -> &MassProperties { &self.0[i].mass }
-///     fn write(&mut self, i: usize, state: &BodyState) { self.0[i].state = *state; }
-///     fn diverged(&mut self, i: usize) { self.0[i].frozen = true; }
-/// }
-///
-/// let mass = MassProperties::new(Mass::new(2.0).unwrap(), Vec3::new(1.0, 2.0, 3.0)).unwrap();
-/// let body = |frozen| Crate { state: BodyState::default(), mass, frozen };
-/// let mut crates = Crates(vec![body(false), body(true)]);
-/// Integrator::Splitting.stage_batch(StepPhase::Whole, &mut crates, 0.5);
-/// // Drift–kick–drift is exact under constant gravity: y = −g t²/2.
-/// assert!((crates.0[0].state.position.y + 9.81 * 0.125).abs() < 1e-5);
-/// assert_eq!(crates.0[1].state.position.y, 0.0); // frozen: never read, never written
-/// ```
-pub trait BodyBatch {
-    /// Number of bodies.
-    fn len(&self) -> usize;
-    /// True when there are no bodies.
-    fn is_empty(&self) -> bool {
-        self.len() == 0
-    }
-    /// Writes body `i`'s state into `state` and returns its load; or returns `None` when the
-    /// body must not be stepped (the implementation records why). `state` is a scratch value
-    /// whose padding bytes are zero: assign it with
-    /// [`BodyState::copy_fields_from`], not as a whole struct (see there why).
-    fn read(&mut self, i: usize, state: &mut BodyState) -> Option<Wrench>;
-    /// Body `i`'s mass properties.
-    fn mass(&self, i: usize) -> &MassProperties;
-    /// Stores body `i`'s new, valid state.
-    fn write(&mut self, i: usize, state: &BodyState);
-    /// Body `i`'s step did not give a valid state (non-finite, or a non-unit rotation); it keeps
-    /// its old one.
-    fn diverged(&mut self, i: usize);
-    /// How fast body `i`'s springs can turn it (rad/s; 0 for a body without springs): where
-    /// they turn it fast enough that their own error outweighs the split free rotation's, the
-    /// exact switch leaves the body on the method's flow (see
-    /// [`ExactSwitch::applies_turned`]). Default: 0.
-    #[inline(always)]
-    fn spring_turn_rate(&self, i: usize) -> Real {
-        let _ = i;
-        0.0
-    }
-    /// A hint: body `i` (possibly beyond the last) will be read soon; fetch its memory with
-    /// [`prefetch`](crate::prefetch::prefetch). The batch loops call it a few dozen bodies
-    /// ahead, far enough for the memory to arrive before the body is read. Default: nothing.
-    #[inline(always)]
-    fn prefetch(&self, i: usize) {
-        let _ = i;
-    }
-}
-
-/// How many bodies ahead of the one being read the batch loops call [`BodyBatch::prefetch`]:
-/// it pays in worlds that outgrow the caches (see `report/bench-avx512.md`); smaller worlds,
-/// where the hardware prefetchers keep up, are unchanged.
-const PREFETCH_AHEAD: usize = 32;
-
-/// Hands `next` to `bodies` as body `i`'s new state if it is valid, else reports divergence.
-#[inline(always)]
-pub(super) fn commit(bodies: &mut impl BodyBatch, i: usize, next: &BodyState) {
-    if next.is_valid() {
-        bodies.write(i, next);
-    } else {
-        bodies.diverged(i);
-    }
-}
 
 /// The methods without a batched kernel: every body steps alone with `single`.
 fn each_alone(
@@ -359,73 +257,6 @@ fn paired(
     if let Some((j, mut last)) = waiting {
         rotate_exactly(&mut last, bodies.mass(j), h);
         commit(bodies, j, &last);
-    }
-}
-
-/// Plain arrays as a [`BodyBatch`]; divergent indices are collected in order of discovery.
-struct Slices<'a, M> {
-    states: &'a mut [BodyState],
-    masses: &'a [M],
-    wrenches: Option<&'a [Wrench]>,
-    diverged: Vec<usize>,
-}
-
-impl<'a, M> Slices<'a, M> {
-    /// The batch of `states[i]` with `masses[i]` (and `wrenches[i]`); panics if the lengths
-    /// differ.
-    fn new(states: &'a mut [BodyState], masses: &'a [M], wrenches: Option<&'a [Wrench]>) -> Self {
-        assert!(states.len() == masses.len());
-        assert!(wrenches.is_none_or(|w| w.len() == states.len()));
-        Self {
-            states,
-            masses,
-            wrenches,
-            diverged: Vec::new(),
-        }
-    }
-
-    /// The indices of the bodies that diverged, in increasing order.
-    fn sorted_diverged(self) -> Vec<usize> {
-        let mut diverged = self.diverged;
-        diverged.sort_unstable();
-        diverged
-    }
-}
-
-impl<M: Borrow<MassProperties>> BodyBatch for Slices<'_, M> {
-    fn len(&self) -> usize {
-        self.states.len()
-    }
-
-    #[inline(always)]
-    fn read(&mut self, i: usize, state: &mut BodyState) -> Option<Wrench> {
-        state.copy_fields_from(&self.states[i]);
-        Some(self.wrenches.map_or(Wrench::ZERO, |w| w[i]))
-    }
-
-    #[inline(always)]
-    fn mass(&self, i: usize) -> &MassProperties {
-        self.masses[i].borrow()
-    }
-
-    #[inline(always)]
-    fn write(&mut self, i: usize, state: &BodyState) {
-        self.states[i] = *state;
-    }
-
-    #[inline(always)]
-    fn prefetch(&self, i: usize) {
-        if i < self.states.len() {
-            prefetch(&self.states[i]);
-            prefetch(self.masses[i].borrow());
-            if let Some(wrenches) = self.wrenches {
-                prefetch(&wrenches[i]);
-            }
-        }
-    }
-
-    fn diverged(&mut self, i: usize) {
-        self.diverged.push(i);
     }
 }
 

@@ -30,8 +30,9 @@
 //! | `exact4` | triple jump of `exact`'s whole step | exact | 4 | round-off | round-off torque-free |
 
 mod batch;
+mod body_batch;
 mod exact_flow;
-pub use batch::{BodyBatch, StepPhase};
+pub use body_batch::BodyBatch;
 mod frame;
 mod free_flow;
 pub use free_flow::{
@@ -49,7 +50,7 @@ pub(crate) use momentum_flow::free_turn;
 mod rk4;
 mod splitting;
 mod stages;
-pub use stages::{StageSpan, Stages, TRIPLE_JUMP_LIMIT, TRIPLE_JUMP_SWING_MATCH};
+pub use stages::{StageSpan, Stages, StepPhase, TRIPLE_JUMP_LIMIT, TRIPLE_JUMP_SWING_MATCH};
 mod symmetric_kernel;
 mod symplectic_euler;
 #[cfg(test)]

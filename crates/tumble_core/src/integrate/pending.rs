@@ -8,7 +8,7 @@ use crate::simd::{Kernel, LANES};
 use crate::state::BodyState;
 
 use super::BodyBatch;
-use super::batch::commit;
+use super::body_batch::commit;
 use super::kick_drift_kernel::{KickDrift, kick_drift_lanes, kick_drift_one};
 use super::lane_input::{LaneInputs, RotatedLanes};
 use super::symmetric_kernel::{LaneFlow, rotate_symmetric_lanes, rotate_symmetric_one};

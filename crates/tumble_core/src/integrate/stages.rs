@@ -66,6 +66,19 @@ pub(super) fn rotate_composed(
         rotate_symmetric_one(&input, h, LaneFlow::Composed(weights));
 }
 
+/// Which part of a stage a batch performs (see [`Integrator::begin_stage`] and
+/// [`Integrator::finish_stage`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StepPhase {
+    /// The whole stage, [`Integrator::whole_stage`], under the body's constant load.
+    Whole,
+    /// The first phase, [`Integrator::begin_stage`]; the load is not used.
+    Begin,
+    /// The second phase, [`Integrator::finish_stage`], under the load sampled after
+    /// [`Begin`](Self::Begin).
+    Finish,
+}
+
 /// One stage of a step (see the module docs).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct StageSpan {

@@ -112,19 +112,21 @@
 //! which depends on what else the world made before the system's query (as do the sums of an
 //! implicit group, over its bodies and springs in entity order).
 
+mod classify;
 mod damping;
-mod stiff;
+mod implicit_step;
 
-pub use damping::{damp_springs_end, damp_springs_start};
-pub use stiff::{
+pub use classify::{
     Classification, ClassifiedSpring, SpringClassification, classification_is_stale, classify,
-    classify_springs, solve_implicit_springs,
+    classify_springs,
 };
+pub use damping::{damp_springs_end, damp_springs_start};
+pub use implicit_step::solve_implicit_springs;
 
-pub(crate) use stiff::classification_span;
+pub(crate) use classify::classification_span;
 
 pub(crate) use damping::is_damped;
 
 // Scratch memory of `solve_implicit_springs`, in its signature; not for game code.
 #[doc(hidden)]
-pub use stiff::ImplicitScratch;
+pub use implicit_step::ImplicitScratch;

@@ -186,19 +186,7 @@ impl std::fmt::Display for StabilityWarning {
                 body,
                 integrator,
                 error_per_step,
-            } => write!(
-                f,
-                "rigid body {body}: integrator `{integrator}` splits its free rotation with a \
-                 relative error of {:.1} % per {} in its spin (Δt²|ω_b ω_c||I_b − I_c|/I_a); \
-                 use free_flow = `auto` (the exact flow where the split errs), `exact`, or a \
-                 smaller time step",
-                100.0 * error_per_step,
-                if integrator.composition().len() > 1 {
-                    "stage"
-                } else {
-                    "step"
-                }
-            ),
+            } => inexact_free_rotation(f, body, integrator, error_per_step),
             StabilityWarning::ExactFreeFlow {
                 body,
                 bodies,
@@ -216,11 +204,7 @@ impl std::fmt::Display for StabilityWarning {
                  solve: translation with the springs; rotation by `{integrator}` for {}, by the \
                  implicit midpoint for {midpoint} (their springs turn them stiffly: energy kept \
                  exactly)",
-                if bodies == 1 {
-                    "alone".to_owned()
-                } else {
-                    format!("and {} more bodies", bodies - 1)
-                },
+                alone_or_with(bodies),
                 bodies - midpoint
             ),
             StabilityWarning::CannotCombine {
@@ -234,11 +218,7 @@ impl std::fmt::Display for StabilityWarning {
                  the implicit spring solve; choose `splitting`, `splitting-xyz`, `yoshida4`, \
                  `rk4`, `exact` or `exact4`, or springs = `explicit` with a time step small \
                  enough for their stiffness",
-                if bodies == 1 {
-                    "alone".to_owned()
-                } else {
-                    format!("and {} more bodies", bodies - 1)
-                }
+                alone_or_with(bodies)
             ),
             StabilityWarning::FirstOrderGyroscopic {
                 body,
@@ -283,6 +263,36 @@ impl std::fmt::Display for StabilityWarning {
             ),
         }
     }
+}
+
+/// "alone" for a group of one body, "and N more bodies" for a bigger one.
+fn alone_or_with(bodies: usize) -> String {
+    if bodies == 1 {
+        "alone".to_owned()
+    } else {
+        format!("and {} more bodies", bodies - 1)
+    }
+}
+
+/// The notice of [`StabilityWarning::InexactFreeRotation`].
+fn inexact_free_rotation(
+    f: &mut std::fmt::Formatter<'_>,
+    body: Entity,
+    integrator: Integrator,
+    error_per_step: Real,
+) -> std::fmt::Result {
+    let span = if integrator.composition().len() > 1 {
+        "stage"
+    } else {
+        "step"
+    };
+    write!(
+        f,
+        "rigid body {body}: integrator `{integrator}` splits its free rotation with a relative \
+         error of {:.1} % per {span} in its spin (Δt²|ω_b ω_c||I_b − I_c|/I_a); use free_flow = \
+         `auto` (the exact flow where the split errs), `exact`, or a smaller time step",
+        100.0 * error_per_step,
+    )
 }
 
 /// The notice of [`StabilityWarning::ExactFreeFlow`].

@@ -16,15 +16,7 @@ impl ImplicitSpringSolver {
     ) -> Result<(), ImplicitSpringError> {
         self.prepare(bodies, springs)?;
         self.start_iterate();
-        // A method's turn enters the Newton matrix by the Cayley rotation's derivative, an
-        // approximation: the iteration converges linearly, and what it leaves unconverged the
-        // momenta lose. Converging a hundred times further keeps them to round-off, for a few
-        // more evaluations (the contraction per iteration is about `(h|Ω̄|)²`).
-        let tolerance = if self.starts.iter().any(|s| s.method.is_some()) {
-            METHOD_TURN_TOLERANCE * self.tolerance
-        } else {
-            self.tolerance
-        };
+        let tolerance = self.update_tolerance();
         let scale = self.energy_scale(h);
         let mut norm = self.evaluate(h);
         stats.residual_evaluations += 1;
@@ -55,10 +47,7 @@ impl ImplicitSpringSolver {
                 // guards against overshoot far from the solution; on an update this small its
                 // trial evaluation could only tell round-off from round-off, and it would be the
                 // solve's last (`finish` works from the iterate alone).
-                for (z, d) in self.z.iter_mut().zip(&delta) {
-                    *z += d;
-                }
-                self.delta = delta;
+                self.take_whole(delta);
                 update = full;
                 break;
             }
@@ -115,6 +104,40 @@ impl ImplicitSpringSolver {
                 break;
             }
         }
+        self.check_converged(update, tolerance, iterations)?;
+        self.finish(h, bodies)
+    }
+
+    /// The tolerance on the update's energy-weighted norm. A method's turn enters the Newton
+    /// matrix by the Cayley rotation's derivative, an approximation: the iteration converges
+    /// linearly, and what it leaves unconverged the momenta lose. Converging a hundred times
+    /// further keeps them to round-off, for a few more evaluations (the contraction per
+    /// iteration is about `(h|Ω̄|)²`).
+    fn update_tolerance(&self) -> f64 {
+        if self.starts.iter().any(|s| s.method.is_some()) {
+            METHOD_TURN_TOLERANCE * self.tolerance
+        } else {
+            self.tolerance
+        }
+    }
+
+    /// Moves the iterate by the whole update `delta` (`z + 1·δ`, the bits of an accepted
+    /// trial at step 1) and gives its buffer back.
+    fn take_whole(&mut self, delta: Vec<f64>) {
+        for (z, d) in self.z.iter_mut().zip(&delta) {
+            *z += d;
+        }
+        self.delta = delta;
+    }
+
+    /// The solve's verdict on its last update: a non-finite update or iterate, or an update
+    /// still above `tolerance` after `iterations`, is an error.
+    fn check_converged(
+        &self,
+        update: f64,
+        tolerance: f64,
+        iterations: usize,
+    ) -> Result<(), ImplicitSpringError> {
         if !update.is_finite() || self.z.iter().any(|v| !v.is_finite()) {
             return Err(ImplicitSpringError::NonFinite);
         }
@@ -125,7 +148,7 @@ impl ImplicitSpringSolver {
                 tolerance,
             });
         }
-        self.finish(h, bodies)
+        Ok(())
     }
 
     /// The first iterate, the start's velocities `(v, Ω)` of every body, and the working
@@ -242,6 +265,16 @@ impl ImplicitSpringSolver {
         springs: &[GroupSpring],
     ) -> Result<(), ImplicitSpringError> {
         self.analyzed = false;
+        self.read_starts(bodies)?;
+        self.read_links(bodies, springs)?;
+        self.lin.clear();
+        self.lin.resize(self.links.len(), Linearized::default());
+        self.sort_ends_by_body(bodies.len());
+        Ok(())
+    }
+
+    /// Each body's start in its principal frame.
+    fn read_starts(&mut self, bodies: &[GroupBody]) -> Result<(), ImplicitSpringError> {
         self.starts.clear();
         // Exact sizes: grown by doubling, a group of a million bodies would hold up to twice
         // its starts, three times while a doubling copies them.
@@ -275,6 +308,16 @@ impl ImplicitSpringSolver {
                 odd: m.odd_axis(),
             });
         }
+        Ok(())
+    }
+
+    /// Each spring as a link between its two ends' principal-frame anchors, with its start
+    /// geometry.
+    fn read_links(
+        &mut self,
+        bodies: &[GroupBody],
+        springs: &[GroupSpring],
+    ) -> Result<(), ImplicitSpringError> {
         self.links.clear();
         self.links.reserve_exact(springs.len());
         let len = bodies.len();
@@ -311,9 +354,12 @@ impl ImplicitSpringSolver {
             link.l0 = link.d0.length();
             self.links.push(link);
         }
-        self.lin.clear();
-        self.lin.resize(self.links.len(), Linearized::default());
-        // Counting sort of the spring ends by body.
+        Ok(())
+    }
+
+    /// A counting sort of the spring ends by body: body `i`'s ends are
+    /// `ends_of[ends_start[i]..ends_start[i + 1]]`, as `(link, end)`, in link order.
+    fn sort_ends_by_body(&mut self, len: usize) {
         self.ends_start.clear();
         self.ends_start.resize(len + 1, 0);
         for link in &self.links {
@@ -339,7 +385,6 @@ impl ImplicitSpringSolver {
                 self.cursor[end.body] += 1;
             }
         }
-        Ok(())
     }
 
     pub(super) fn anchor_start(&self, end: &End) -> DVec3 {
