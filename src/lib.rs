@@ -41,9 +41,13 @@
 //! from avian or bevy_rapier, architecture) is in the repository's `docs/` directory, starting
 //! at `docs/README.md`.
 //!
-//! The crates: [`core`] (ECS-free math: state, mass properties, integrators, invariants) and
-//! [`ecs`] (components, systems, schedule). `glam`, `bevy_ecs` (and `parry3d` with the `parry`
-//! feature) are re-exported so versions always match.
+//! The surface: [`prelude`] (a game loop's one import), [`math`] (the precision's scalar,
+//! vectors and quaternion), [`core`] (ECS-free math: state, mass properties, integrators and
+//! their batch interface, invariants) and [`ecs`] (components, forces, the plan and runner,
+//! state, stability). Each is a curated list: the systems a step runs, their scratch memory
+//! and the checks they share stay inside `tumble_core` and `tumble_ecs`, so they can change
+//! without changing tumble's API. `glam`, `bevy_ecs` (and `parry3d` with the `parry` feature)
+//! are re-exported so versions always match.
 //!
 //! Features (a build pays only for what it enables):
 //!
@@ -66,14 +70,15 @@
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
+pub mod core;
+pub mod ecs;
+
 pub use bevy_ecs;
 pub use glam;
-pub use tumble_core as core;
 pub use tumble_core::math;
 /// The parry crate of the shapes: `parry3d`, or `parry3d-f64` with the feature `parry-f64`.
 #[cfg(any(feature = "parry", feature = "parry-f64"))]
 pub use tumble_core::shapes::parry;
-pub use tumble_ecs as ecs;
 /// Scene files and trajectories (feature `scene`).
 #[cfg(feature = "scene")]
 pub use tumble_scene as scene;

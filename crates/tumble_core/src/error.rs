@@ -116,6 +116,15 @@ pub fn check_finite_vec3(field: &'static str, value: Vec3) -> Result<(), Invalid
     }
 }
 
+/// The fast half of the unit-quaternion test: `||q|² − 1| ≤` [`UNIT_QUATERNION_TOLERANCE`],
+/// without a square root. `|q|² − 1 = (|q| − 1)(|q| + 1)`, so it implies `||q| − 1| ≤ tol`; a
+/// quaternion it rejects may still pass the exact test of [`check_unit_quat`] (the rare one in
+/// between). False for a non-finite quaternion.
+#[inline(always)]
+pub fn is_clearly_unit(q: Quat) -> bool {
+    (q.length_squared() - 1.0).abs() <= UNIT_QUATERNION_TOLERANCE
+}
+
 /// Checks that `q` is finite and of unit length within [`UNIT_QUATERNION_TOLERANCE`].
 pub fn check_unit_quat(field: &'static str, q: Quat) -> Result<(), InvalidInput> {
     if !q.is_finite() {

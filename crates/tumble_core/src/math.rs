@@ -60,6 +60,19 @@ pub fn to_f64(x: impl Into<f64>) -> f64 {
     x.into()
 }
 
+/// True when `a` and `b` have the same bits: equal bits are equal inputs to any function (`==`
+/// on floats would call `−0` and `+0` equal and a NaN unequal to itself). One OR of the
+/// differences rather than an array comparison, which compiles to a call to `memcmp` per check
+/// (the energy audit runs these for every body and spring every step).
+#[inline(always)]
+pub fn same_bits<const N: usize>(a: [Real; N], b: [Real; N]) -> bool {
+    let mut differ = 0;
+    for k in 0..N {
+        differ |= a[k].to_bits() ^ b[k].to_bits();
+    }
+    differ == 0
+}
+
 /// Conversion to `f64` (exact): `Real → f64`, `Vec3 → DVec3`, `Quat → DQuat`.
 ///
 /// The identity in an `f64` build; one exact widening in the default build.
@@ -151,6 +164,20 @@ mod tests {
         assert_eq!(v.widen().narrow(), v);
         let q = Quat::from_xyzw(0.1, 0.2, 0.3, 0.9);
         assert_eq!(q.widen().narrow(), q);
+    }
+
+    #[test]
+    fn same_bits_tells_every_bit() {
+        let a: [Real; 5] = [1.0, -0.0, Real::NAN, Real::INFINITY, 3.5];
+        assert!(same_bits(a, a), "a NaN is the same bits as itself");
+        let mut zero = a;
+        zero[1] = 0.0;
+        assert!(!same_bits(a, zero), "−0 and +0 differ");
+        for k in 0..a.len() {
+            let mut b = a;
+            b[k] = Real::from_bits(b[k].to_bits() ^ 1);
+            assert!(!same_bits(a, b), "the last bit of value {k}");
+        }
     }
 
     #[test]

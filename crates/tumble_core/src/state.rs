@@ -1,6 +1,8 @@
 //! Rigid-body state and the external load applied over one step.
 
-use crate::error::{InvalidInput, UNIT_QUATERNION_TOLERANCE, check_finite_vec3, check_unit_quat};
+use crate::error::{
+    InvalidInput, UNIT_QUATERNION_TOLERANCE, check_finite_vec3, check_unit_quat, is_clearly_unit,
+};
 use crate::math::{Quat, Vec3};
 
 /// Kinematic state of one rigid body.
@@ -80,7 +82,7 @@ impl BodyState {
         // `||q|² − 1| ≤ tol` implies `||q| − 1| ≤ tol` (with room for the rounding of the root);
         // only a quaternion in between takes the exact test.
         self.is_finite()
-            && ((self.rotation.length_squared() - 1.0).abs() <= UNIT_QUATERNION_TOLERANCE
+            && (is_clearly_unit(self.rotation)
                 || (self.rotation.length() - 1.0).abs() <= UNIT_QUATERNION_TOLERANCE)
     }
 

@@ -2,9 +2,9 @@
 
 use bevy_ecs::entity::EntityHashMap;
 use bevy_ecs::prelude::*;
-use tumble_core::math::{Real, Vec3, Widen};
+use tumble_core::math::{Real, Vec3, Widen, same_bits};
 
-use super::memo::{BodyMemo, same_bits};
+use super::memo::BodyMemo;
 use crate::components::{
     Dynamic, IndexOrder, IndexedQuery, Kinematic, MassProps, Pose, Rejected, RigidBody, Spring,
     SpringEnd, Static, Velocity, kinetic_energy_f64,

@@ -8,22 +8,9 @@
 //! involved; whatever changed a body (game code, a quarantine putting it back, a rollback) shows
 //! in its bits.
 
-use tumble_core::math::Real;
+use tumble_core::math::{Real, same_bits};
 
 use crate::components::{MassProps, Pose, Velocity, kinetic_energy_f64};
-
-/// True when `a` and `b` have the same bits: equal bits are equal inputs to the energy
-/// functions (`==` on floats would call `−0` and `+0` equal and a NaN unequal to itself). One
-/// OR of the differences rather than an array comparison, which compiles to a call to `memcmp`
-/// per check: these run for every body and spring every step.
-#[inline(always)]
-pub(super) fn same_bits<const N: usize>(a: [Real; N], b: [Real; N]) -> bool {
-    let mut differ = 0;
-    for k in 0..N {
-        differ |= a[k].to_bits() ^ b[k].to_bits();
-    }
-    differ == 0
-}
 
 /// Every input of a body's kinetic energy ([`kinetic_energy_f64`]: rotation, velocities,
 /// mass, principal moments and frame) and of its springs' anchors (translation, rotation) but
@@ -112,24 +99,5 @@ impl BodyMemo {
         self.measured_by(pass)
             && same_bits(pose_inputs(measured_pose), pose_inputs(pose))
             && same_bits(self.inputs, rest_inputs(velocity, mass))
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn same_bits_tells_every_bit() {
-        let a: [Real; 5] = [1.0, -0.0, Real::NAN, Real::INFINITY, 3.5];
-        assert!(same_bits(a, a), "a NaN is the same bits as itself");
-        let mut zero = a;
-        zero[1] = 0.0;
-        assert!(!same_bits(a, zero), "−0 and +0 differ");
-        for k in 0..a.len() {
-            let mut b = a;
-            b[k] = Real::from_bits(b[k].to_bits() ^ 1);
-            assert!(!same_bits(a, b), "the last bit of value {k}");
-        }
     }
 }

@@ -3,8 +3,9 @@
 use bevy_ecs::lifecycle::HookContext;
 use bevy_ecs::prelude::*;
 use bevy_ecs::world::DeferredWorld;
+use tumble_core::error::is_clearly_unit;
 use tumble_core::math::{Quat, Real, Vec3, Widen, quat_rotate};
-use tumble_core::{BodyState, MassProperties};
+use tumble_core::{BodyState, InvalidInput, MassProperties};
 
 use super::errors::{BodyError, BodyErrorKind, PhysicsErrors, Rejected};
 
@@ -325,6 +326,25 @@ impl Default for GravityScale {
     }
 }
 
+impl GravityScale {
+    /// Checks that the scale is finite: a NaN or infinite one would make the body's gravity
+    /// (and so its state) non-finite, and the fault is the scale's, not the accumulator's or
+    /// the integrator's.
+    #[inline]
+    pub fn check(&self) -> Result<(), BodyErrorKind> {
+        if self.0.is_finite() {
+            return Ok(());
+        }
+        Err(BodyErrorKind::Invalid {
+            component: "GravityScale",
+            source: InvalidInput::NonFinite {
+                field: "scale",
+                value: self.0.to_string(),
+            },
+        })
+    }
+}
+
 /// Velocity damping `v̇ = −c_lin v`, `ω̇ = −c_ang ω`, as a flow of its own, Strang-split around
 /// the step: for half a step before it and half a step after it,
 ///
@@ -439,12 +459,9 @@ pub fn check_body(
         zeros += acc.force * 0.0 + acc.torque * 0.0;
     }
     let finite = zeros.x + zeros.y + zeros.z == 0.0;
-    // The squared norm needs no square root: `|q|² − 1 = (|q| − 1)(|q| + 1)`, so
-    // `||q|² − 1| ≤ tol` implies `||q| − 1| ≤ tol`; the rare quaternion in between goes
-    // through the exact test in the detailed checks. NaN or Inf makes this false as well.
-    let unit = (transform.rotation.length_squared() - 1.0).abs()
-        <= tumble_core::error::UNIT_QUATERNION_TOLERANCE;
-    if finite && unit {
+    // The rare quaternion `is_clearly_unit` leaves open goes through the exact test in the
+    // detailed checks.
+    if finite && is_clearly_unit(transform.rotation) {
         return Ok(());
     }
     check_body_in_detail(transform, velocity, forces)
@@ -460,9 +477,7 @@ pub fn check_body(
 /// field (see the integrate systems).
 #[inline]
 pub(crate) fn check_rotation(transform: &Pose) -> Result<(), BodyErrorKind> {
-    let unit = (transform.rotation.length_squared() - 1.0).abs()
-        <= tumble_core::error::UNIT_QUATERNION_TOLERANCE;
-    if unit {
+    if is_clearly_unit(transform.rotation) {
         return Ok(());
     }
     check_body_in_detail(transform, &Velocity::ZERO, None)

@@ -108,16 +108,19 @@ pub fn begin_stage(
     parallelism: Option<Res<Parallelism>>,
     mut drifted: ResMut<HalfDrifted>,
     mut commands: Commands,
-    mut bodies: Query<Stepped<&ForceAccumulator>, (Dynamic, Without<ImplicitBody>)>,
+    mut bodies: Query<
+        Stepped<(&ForceAccumulator, Option<&GravityScale>)>,
+        (Dynamic, Without<ImplicitBody>),
+    >,
 ) {
     if !settings.integrator.samples_forces_at_midpoint() {
         return;
     }
     drifted.0 = true;
     let stage = StageTiming::new(&settings, *cursor, StepPhase::Begin);
-    step_each_table!(bodies, stage, parallelism, commands, |accs| Loads::Checked(
-        accs
-    ));
+    step_each_table!(bodies, stage, parallelism, commands, |(accs, scales)| {
+        Loads::Checked { accs, scales }
+    });
 }
 
 /// Integrates bodies that have a [`ForceAccumulator`], consuming (reading and zeroing) it.
@@ -134,7 +137,10 @@ pub fn integrate_with_forces(
     mut drifted: ResMut<HalfDrifted>,
     mut warned: Local<bool>,
     mut commands: Commands,
-    mut bodies: Query<Stepped<&mut ForceAccumulator>, (Dynamic, Without<ImplicitBody>)>,
+    mut bodies: Query<
+        Stepped<(&mut ForceAccumulator, Option<&GravityScale>)>,
+        (Dynamic, Without<ImplicitBody>),
+    >,
 ) {
     let phase = if drifted.0 {
         StepPhase::Finish
@@ -151,8 +157,14 @@ pub fn integrate_with_forces(
     }
     drifted.0 = false;
     let stage = StageTiming::new(&settings, *cursor, phase);
-    step_each_table!(bodies, stage, parallelism, commands, |mut accs| {
-        Loads::Consumed(&mut accs)
+    step_each_table!(bodies, stage, parallelism, commands, |(
+        mut accs,
+        scales,
+    )| {
+        Loads::Consumed {
+            accs: &mut accs,
+            scales,
+        }
     });
 }
 

@@ -36,10 +36,36 @@ pub(crate) enum Loads<'a> {
         gravity: Option<Vec3>,
         scales: Option<&'a [GravityScale]>,
     },
-    /// Accumulators that are only checked (the first half-drift samples no load).
-    Checked(&'a [ForceAccumulator]),
-    /// Accumulators that are checked and consumed.
-    Consumed(&'a mut [ForceAccumulator]),
+    /// Accumulators that are only checked (the first half-drift samples no load); the bodies'
+    /// gravity scales name the fault where one made its accumulator non-finite.
+    Checked {
+        accs: &'a [ForceAccumulator],
+        scales: Option<&'a [GravityScale]>,
+    },
+    /// Accumulators that are checked and consumed (scales as for `Checked`).
+    Consumed {
+        accs: &'a mut [ForceAccumulator],
+        scales: Option<&'a [GravityScale]>,
+    },
+}
+
+/// Body `i`'s gravity scale (1 where the table has none), checked before its load: a bad scale
+/// is named as such, not as the non-finite accumulator or state it would make, and before the
+/// first half drift of a stage, so the body keeps the state it had.
+#[inline(always)]
+fn check_scale(scales: Option<&[GravityScale]>, i: usize) -> Result<Real, BodyErrorKind> {
+    match scales {
+        Some(s) => s[i].check().map(|()| s[i].0),
+        None => Ok(1.0),
+    }
+}
+
+/// Splits optional per-body slices at `mid`.
+fn split_column<T>(column: Option<&[T]>, mid: usize) -> (Option<&[T]>, Option<&[T]>) {
+    column.map_or((None, None), |c| {
+        let (a, b) = c.split_at(mid);
+        (Some(a), Some(b))
+    })
 }
 
 impl Loads<'_> {
@@ -47,22 +73,39 @@ impl Loads<'_> {
     fn split_at(self, mid: usize) -> (Self, Self) {
         match self {
             Loads::Field { gravity, scales } => {
-                let (a, b) = scales.map_or((None, None), |s| {
-                    let (a, b) = s.split_at(mid);
-                    (Some(a), Some(b))
-                });
+                let (a, b) = split_column(scales, mid);
                 (
                     Loads::Field { gravity, scales: a },
                     Loads::Field { gravity, scales: b },
                 )
             }
-            Loads::Checked(accs) => {
+            Loads::Checked { accs, scales } => {
                 let (a, b) = accs.split_at(mid);
-                (Loads::Checked(a), Loads::Checked(b))
+                let (sa, sb) = split_column(scales, mid);
+                (
+                    Loads::Checked {
+                        accs: a,
+                        scales: sa,
+                    },
+                    Loads::Checked {
+                        accs: b,
+                        scales: sb,
+                    },
+                )
             }
-            Loads::Consumed(accs) => {
+            Loads::Consumed { accs, scales } => {
                 let (a, b) = accs.split_at_mut(mid);
-                (Loads::Consumed(a), Loads::Consumed(b))
+                let (sa, sb) = split_column(scales, mid);
+                (
+                    Loads::Consumed {
+                        accs: a,
+                        scales: sa,
+                    },
+                    Loads::Consumed {
+                        accs: b,
+                        scales: sb,
+                    },
+                )
             }
         }
     }
@@ -71,15 +114,24 @@ impl Loads<'_> {
     #[inline(always)]
     fn take(&mut self, i: usize, mass: &MassProps) -> Result<Wrench, BodyErrorKind> {
         match self {
-            Loads::Field { gravity, scales } => Ok(match gravity {
-                Some(g) => Wrench {
-                    force: (mass.mass() * scales.map_or(1.0, |s| s[i].0)) * *g,
-                    torque: Vec3::ZERO,
-                },
-                None => Wrench::ZERO,
-            }),
-            Loads::Checked(accs) => check_accumulator(&accs[i]).map(|()| Wrench::ZERO),
-            Loads::Consumed(accs) => check_accumulator(&accs[i]).map(|()| accs[i].take()),
+            Loads::Field { gravity, scales } => {
+                let scale = check_scale(*scales, i)?;
+                Ok(match gravity {
+                    Some(g) => Wrench {
+                        force: (mass.mass() * scale) * *g,
+                        torque: Vec3::ZERO,
+                    },
+                    None => Wrench::ZERO,
+                })
+            }
+            Loads::Checked { accs, scales } => {
+                check_scale(*scales, i)?;
+                check_accumulator(&accs[i]).map(|()| Wrench::ZERO)
+            }
+            Loads::Consumed { accs, scales } => {
+                check_scale(*scales, i)?;
+                check_accumulator(&accs[i]).map(|()| accs[i].take())
+            }
         }
     }
 }

@@ -9,6 +9,7 @@ use bevy_ecs::system::ScheduleSystem;
 use super::generator_watch::GeneratorWatch;
 use super::plan::{PhysicsPlan, PhysicsSet, SpringQuery};
 use crate::components::PhysicsSettings;
+use tumble_core::math::same_bits;
 
 /// Game systems that compute forces inside the step: added to [`PhysicsSet::Forces`] of every
 /// schedule a [`PhysicsRunner`] builds (and builds again after a re-plan), so they run in every
@@ -188,11 +189,8 @@ impl PhysicsRunner {
             self.bad_gravity = None;
             return;
         };
-        let same_bits = |last: tumble_core::math::Vec3| {
-            let mut pairs = last.to_array().into_iter().zip(g.to_array());
-            pairs.all(|(a, b)| a.to_bits() == b.to_bits())
-        };
-        if self.bad_gravity.is_some_and(same_bits) {
+        let same = |last: tumble_core::math::Vec3| same_bits(last.to_array(), g.to_array());
+        if self.bad_gravity.is_some_and(same) {
             return;
         }
         self.bad_gravity = Some(g);

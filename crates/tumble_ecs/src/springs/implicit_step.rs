@@ -10,9 +10,9 @@ use tumble_core::springs::{GroupBody, GroupRotation, GroupSpring, ImplicitSpring
 
 use super::classify::{classification_span, ends_in, find};
 use crate::components::{
-    BodyError, BodyErrorKind, Dynamic, ForceAccumulator, ImplicitBody, ImplicitSpring,
-    PhysicsSettings, Pose, RigidBody, Spring, SpringEnd, SpringTurn, Stepped, body_state,
-    check_body, reject, write_body_state,
+    BodyError, BodyErrorKind, Dynamic, ForceAccumulator, GravityScale, ImplicitBody,
+    ImplicitSpring, PhysicsSettings, Pose, RigidBody, Spring, SpringEnd, SpringTurn, Stepped,
+    body_state, check_body, reject, write_body_state,
 };
 use crate::components::{IndexOrder, IndexedQuery};
 use crate::integrate::damp;
@@ -83,6 +83,7 @@ type ImplicitBodies<'w, 's> = Query<
     (
         Stepped<&'static mut ForceAccumulator>,
         &'static mut ImplicitBody,
+        Option<&'static GravityScale>,
     ),
     (Dynamic, With<ImplicitBody>),
 >;
@@ -136,14 +137,18 @@ impl ImplicitScratch {
         self.parent.reserve_exact(count);
         self.all.reserve_exact(count);
         self.index.reserve(count);
-        for ((entity, t, mut v, m, mut acc, damping, turn), mut implicit) in bodies.iter_mut() {
+        for ((entity, t, mut v, m, mut acc, damping, turn), mut implicit, scale) in
+            bodies.iter_mut()
+        {
             // Bad data game code wrote into one body is refused for that body alone, naming
             // the field, as on the explicit path: left out here, it is not in its group this
             // stage (its springs exert nothing, as a quarantined body's), and its components
             // and accumulator stay as they are. The point forces' moment is this stage's only
             // (no snapshot holds it): it goes with the stage.
-            let checked =
-                check_body(&t, &v, Some(&acc)).and_then(|()| damping.map_or(Ok(()), |d| d.check()));
+            let checked = scale
+                .map_or(Ok(()), GravityScale::check)
+                .and_then(|()| check_body(&t, &v, Some(&acc)))
+                .and_then(|()| damping.map_or(Ok(()), |d| d.check()));
             if let Err(kind) = checked {
                 implicit.take_load_moment();
                 reject(commands, BodyError { entity, kind });
@@ -215,7 +220,9 @@ impl ImplicitScratch {
         );
         let half_substep = 0.5 * span.substep;
         for (k, &i) in self.members[members].iter().enumerate() {
-            if let Ok(((_, mut t, mut v, m, _, damping, _), _)) = bodies.get_mut(self.entities[i]) {
+            if let Ok(((_, mut t, mut v, m, _, damping, _), _, _)) =
+                bodies.get_mut(self.entities[i])
+            {
                 write_body_state(&self.bodies[k].state, m, &mut t, &mut v);
                 if let Some(d) = damping
                     && span.closes_substep

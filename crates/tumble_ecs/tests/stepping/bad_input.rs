@@ -807,3 +807,101 @@ fn a_bad_gravity_is_left_out_not_carried_into_every_body() {
         "gravity applies again"
     );
 }
+
+/// A non-finite `GravityScale` written by game code refuses its body before it steps, naming
+/// the scale (not the accumulator gravity is added to, nor a divergence): the body keeps the
+/// state it had, and the healthy body steps to the bits of a world without it. Bodies with and
+/// without an accumulator (gravity added by `apply_gravity`, or inside the integration), alone
+/// or in a stiff spring group.
+#[test]
+fn a_bad_gravity_scale_is_named_and_its_body_keeps_its_state() {
+    let steps = 6;
+    // A method the implicit spring step combines with (`base_world`'s first-order one cannot).
+    let base_world = || {
+        let mut world = world_with(1.0 / 60.0, Integrator::Splitting);
+        world.insert_resource(Gravity(Vec3::new(0.0, -9.81, 0.0)));
+        world
+    };
+    let good_alone = {
+        let mut world = base_world();
+        let good = spawn_good(&mut world);
+        let mut physics = PhysicsRunner::new(&mut world);
+        run_steps(&mut world, &mut physics, steps);
+        (
+            *world.get::<Pose>(good).unwrap(),
+            *world.get::<Velocity>(good).unwrap(),
+        )
+    };
+    for (accumulator, stiff) in [(false, false), (true, false), (true, true)] {
+        for bad in [Real::NAN, Real::INFINITY, Real::NEG_INFINITY] {
+            let case = format!("accumulator {accumulator}, stiff group {stiff}, scale {bad}");
+            let mut world = base_world();
+            let good = spawn_good(&mut world);
+            let v = Velocity {
+                linear: Vec3::new(0.5, 1.0, 0.0),
+                angular: Vec3::new(0.2, -0.4, 0.3),
+            };
+            let t = Pose::from_translation(Vec3::new(5.0, 0.0, 0.0));
+            let body = spawn_bad(
+                &mut world,
+                t,
+                v,
+                accumulator.then(ForceAccumulator::default),
+            );
+            world.entity_mut(body).insert(GravityScale(0.5));
+            let mut partner = None;
+            if stiff {
+                let other = spawn_body(&mut world, 1.0, [1.0, 1.0, 1.0], Velocity::ZERO);
+                partner = Some(other);
+                let partner = other;
+                world.get_mut::<Pose>(partner).unwrap().translation = Vec3::new(5.5, 0.0, 0.0);
+                world
+                    .entity_mut(partner)
+                    .insert(ForceAccumulator::default());
+                world.spawn(Spring::new(
+                    body,
+                    Vec3::ZERO,
+                    SpringEnd::on_body(partner, Vec3::ZERO),
+                    1.0e7,
+                    0.5,
+                ));
+            }
+            let mut physics = PhysicsRunner::new(&mut world);
+            run_steps(&mut world, &mut physics, steps / 2);
+            let before = (
+                *world.get::<Pose>(body).unwrap(),
+                *world.get::<Velocity>(body).unwrap(),
+            );
+            world.get_mut::<GravityScale>(body).unwrap().0 = bad;
+            run_steps(&mut world, &mut physics, steps - steps / 2);
+            let rejected = world
+                .get::<Rejected>(body)
+                .unwrap_or_else(|| panic!("{case}: not refused"));
+            assert!(
+                invalid("GravityScale")(&rejected.0.kind),
+                "{case}: {}",
+                rejected.0
+            );
+            let after = (
+                *world.get::<Pose>(body).unwrap(),
+                *world.get::<Velocity>(body).unwrap(),
+            );
+            assert_eq!(after, before, "{case}: the refused body moved");
+            let good_now = (
+                *world.get::<Pose>(good).unwrap(),
+                *world.get::<Velocity>(good).unwrap(),
+            );
+            assert_eq!(
+                good_now, good_alone,
+                "{case}: the healthy body was disturbed"
+            );
+            if let Some(other) = partner {
+                assert!(
+                    world.get::<Rejected>(other).is_none(),
+                    "{case}: its spring partner was refused"
+                );
+                assert!(world.get::<Velocity>(other).unwrap().linear.is_finite());
+            }
+        }
+    }
+}
