@@ -33,8 +33,10 @@ pub mod integrate {
 /// The implicit spring step on plain data: a group of bodies joined by stiff springs, stepped
 /// with energy kept exactly (the ECS layer runs it on the stiff groups it finds).
 pub mod springs {
+    pub use tumble_core::springs::implicit::{DEFAULT_TOLERANCE, MAX_SPLITS, SolveStats};
     pub use tumble_core::springs::{
-        GroupBody, GroupRotation, GroupSpring, ImplicitSpringError, ImplicitSpringSolver, LinkEnd,
+        AUTO_REFERENCE_DT, GroupBody, GroupRotation, GroupSpring, IMPLICIT_OMEGA_DT,
+        ImplicitSpringError, ImplicitSpringSolver, LinkEnd, omega_dt_bound,
     };
 }
 

@@ -5,14 +5,15 @@
 //! named by [`PhysicsSystem`](schedule::PhysicsSystem), and game code orders its own around
 //! [`PhysicsSet`](schedule::PhysicsSet).
 //!
-//! Plumbing stays out: the systems, the audit's ledger and the threading scopes are not here.
+//! Plumbing stays out: the systems, the implicit step's scratch and the threading scopes are
+//! not here.
 //!
 //! ```compile_fail
 //! use tumble::ecs::integrate::integrate_with_forces;
 //! ```
 //!
 //! ```compile_fail
-//! use tumble::ecs::audit::EnergyLedger;
+//! use tumble::ecs::audit::audit_energy;
 //! ```
 //!
 //! ```compile_fail
@@ -46,9 +47,10 @@ pub mod springs {
     };
 }
 
-/// The energy audit's setting.
+/// The energy audit: its setting, its ledger (a resource: the energy each spring group's
+/// integration has made up so far) and a group's account as a snapshot saves it.
 pub mod audit {
-    pub use tumble_ecs::audit::EnergyAudit;
+    pub use tumble_ecs::audit::{EnergyAudit, EnergyLedger, SavedAccount};
 }
 
 /// Big tables split over bevy's compute pool.
