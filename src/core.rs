@@ -24,9 +24,10 @@ pub mod shapes {
 /// The integrators, their stages and the SIMD kernel path they run on.
 pub mod integrate {
     pub use tumble_core::integrate::{
-        BodyBatch, ExactSwitch, FreeFlow, Integrator, KERNEL_ENV, KernelError, KernelPath,
-        OpCounts, StageSpan, Stages, StepError, StepPhase, kernel_path, rotate, rotate_inv,
-        symmetric_rotation_flops,
+        BodyBatch, COMPOSED_SPLIT_ERROR_LIMIT, ExactSwitch, FreeFlow, Integrator, KERNEL_ENV,
+        KernelError, KernelPath, OpCounts, SPLIT_DRIFT_TOLERANCE, SPLIT_ERROR_LIMIT, StageSpan,
+        Stages, StepError, StepPhase, UnknownIntegrator, kernel_path, rotate, rotate_inv,
+        split_orbit_error, split_rotation_drift, split_rotation_error, symmetric_rotation_flops,
     };
 }
 
@@ -36,7 +37,8 @@ pub mod springs {
     pub use tumble_core::springs::implicit::{DEFAULT_TOLERANCE, MAX_SPLITS, SolveStats};
     pub use tumble_core::springs::{
         AUTO_REFERENCE_DT, GroupBody, GroupRotation, GroupSpring, IMPLICIT_OMEGA_DT,
-        ImplicitSpringError, ImplicitSpringSolver, LinkEnd, omega_dt_bound,
+        ImplicitSpringError, ImplicitSpringSolver, LinkEnd, METHOD_TURN_RATE,
+        inverse_effective_mass_bound, omega_dt_bound, turning_compliance,
     };
 }
 

@@ -27,14 +27,16 @@ pub mod components {
         Damping, Dynamic, ForceAccumulator, GeneratorError, GeneratorErrorKind, Gravity,
         GravityScale, HeldLoad, ImplicitBody, ImplicitSpring, Kinematic, MassProps, PhysicsErrors,
         PhysicsSettings, Pose, Rejected, RejectedGenerator, RigidBody, Spring, SpringEnd,
-        SpringSolver, SpringTurn, Static, Velocity, WorldError, kinetic_energy_f64,
+        SpringSolver, SpringTurn, Static, Velocity, WorldError, assume_missing_masses,
+        bodies_without_mass, kinetic_energy_f64,
     };
 }
 
 /// Loads from game code, and the spring forces and energies the step uses.
 pub mod forces {
     pub use tumble_ecs::forces::{
-        ApplyForces, BodyForces, kinetic_and_elastic_energy, spring_force,
+        ApplyForces, BodyForces, BodyForcesItem, BodyForcesReadOnly, BodyForcesReadOnlyItem,
+        kinetic_and_elastic_energy, spring_force,
     };
 }
 

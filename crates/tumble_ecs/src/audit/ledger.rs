@@ -141,6 +141,10 @@ pub(super) struct GroupStep {
     pub(super) springs: usize,
     pub(super) key: Option<Entity>,
     pub(super) kinematic: bool,
+    /// A member left the audited bodies during the step (refused by a check in an earlier
+    /// stage, or despawned): its springs stopped acting part-way, so the balance does not
+    /// measure the integrator, and the group gets no verdict this step.
+    pub(super) left: bool,
     /// `(T + V)` at the start.
     pub(super) start: f64,
     /// `(T + V)` at the end.

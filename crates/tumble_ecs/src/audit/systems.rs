@@ -281,11 +281,12 @@ pub fn audit_energy(
     let pass = end.pass;
     // Summed in the ledger's order (entity index order), not the query's.
     for body in &ledger.bodies {
+        let g = &mut ledger.groups[body.group];
         if !body.memo.measured_by(pass) {
+            g.left = true;
             continue;
         }
         let (energy, work) = (body.memo.kinetic(), body.work);
-        let g = &mut ledger.groups[body.group];
         g.end += energy;
         g.work += work;
         g.magnitude += energy + work.abs();
@@ -493,6 +494,14 @@ impl EnergyLedger {
             };
             let g = self.groups[group];
             if g.kinematic {
+                continue;
+            }
+            if g.left {
+                // Start the account afresh from the next step, as for non-finite data below.
+                if let Some(account) = self.accounts.get_mut(&key) {
+                    account.created = 0.0;
+                    account.seen = true;
+                }
                 continue;
             }
             let signature = (g.members, g.springs);

@@ -329,7 +329,8 @@ impl Default for GravityScale {
 impl GravityScale {
     /// Checks that the scale is finite: a NaN or infinite one would make the body's gravity
     /// (and so its state) non-finite, and the fault is the scale's, not the accumulator's or
-    /// the integrator's.
+    /// the integrator's. The step checks it while a gravity field applies (a finite
+    /// [`Gravity`](super::Gravity)); without one the scale is unused and harms nothing.
     #[inline]
     pub fn check(&self) -> Result<(), BodyErrorKind> {
         if self.0.is_finite() {

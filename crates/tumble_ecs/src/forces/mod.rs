@@ -38,7 +38,9 @@ mod targets;
 
 pub use apply::{apply_constant_forces, apply_constant_torques, apply_gravity, apply_springs};
 pub use apply::{kinetic_and_elastic_energy, spring_force};
-pub use body_forces::{ApplyForces, BodyForces};
+pub use body_forces::{
+    ApplyForces, BodyForces, BodyForcesItem, BodyForcesReadOnly, BodyForcesReadOnlyItem,
+};
 pub use targets::ForceTargets;
 
 // System state of the force systems above, in their signatures; not for game code.

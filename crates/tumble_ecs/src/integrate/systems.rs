@@ -107,6 +107,7 @@ pub fn begin_stage(
     cursor: Res<crate::integrate::StageCursor>,
     parallelism: Option<Res<Parallelism>>,
     mut drifted: ResMut<HalfDrifted>,
+    gravity: Option<Res<Gravity>>,
     mut commands: Commands,
     mut bodies: Query<
         Stepped<(&ForceAccumulator, Option<&GravityScale>)>,
@@ -118,8 +119,12 @@ pub fn begin_stage(
     }
     drifted.0 = true;
     let stage = StageTiming::new(&settings, *cursor, StepPhase::Begin);
+    let weighed = gravity_applies(gravity);
     step_each_table!(bodies, stage, parallelism, commands, |(accs, scales)| {
-        Loads::Checked { accs, scales }
+        Loads::Checked {
+            accs,
+            scales: scales.filter(|_| weighed),
+        }
     });
 }
 
@@ -135,7 +140,7 @@ pub fn integrate_with_forces(
     cursor: Res<crate::integrate::StageCursor>,
     parallelism: Option<Res<Parallelism>>,
     mut drifted: ResMut<HalfDrifted>,
-    mut warned: Local<bool>,
+    (mut warned, gravity): (Local<bool>, Option<Res<Gravity>>),
     mut commands: Commands,
     mut bodies: Query<
         Stepped<(&mut ForceAccumulator, Option<&GravityScale>)>,
@@ -157,15 +162,22 @@ pub fn integrate_with_forces(
     }
     drifted.0 = false;
     let stage = StageTiming::new(&settings, *cursor, phase);
+    let weighed = gravity_applies(gravity);
     step_each_table!(bodies, stage, parallelism, commands, |(
         mut accs,
         scales,
     )| {
         Loads::Consumed {
             accs: &mut accs,
-            scales,
+            scales: scales.filter(|_| weighed),
         }
     });
+}
+
+/// True while a gravity field applies (a finite [`Gravity`]): only then does a body's
+/// [`GravityScale`] enter its load, and only then is a bad one refused.
+pub(crate) fn gravity_applies(gravity: Option<Res<Gravity>>) -> bool {
+    gravity.is_some_and(|g| g.field().is_some())
 }
 
 /// Integrates bodies without a [`ForceAccumulator`]: free motion, plus gravity when a

@@ -36,8 +36,9 @@ pub(crate) enum Loads<'a> {
         gravity: Option<Vec3>,
         scales: Option<&'a [GravityScale]>,
     },
-    /// Accumulators that are only checked (the first half-drift samples no load); the bodies'
-    /// gravity scales name the fault where one made its accumulator non-finite.
+    /// Accumulators that are only checked (the first half-drift samples no load), with the
+    /// bodies' gravity scales while a gravity field applies (`None` otherwise: unused, a scale
+    /// harms nothing).
     Checked {
         accs: &'a [ForceAccumulator],
         scales: Option<&'a [GravityScale]>,
@@ -49,9 +50,9 @@ pub(crate) enum Loads<'a> {
     },
 }
 
-/// Body `i`'s gravity scale (1 where the table has none), checked before its load: a bad scale
-/// is named as such, not as the non-finite accumulator or state it would make, and before the
-/// first half drift of a stage, so the body keeps the state it had.
+/// Body `i`'s gravity scale (1 where the table has none or no gravity applies), checked before
+/// its load: a bad scale is named as such, not as the non-finite accumulator or state it would
+/// make, and before the first half drift of a stage, so the body keeps the state it had.
 #[inline(always)]
 fn check_scale(scales: Option<&[GravityScale]>, i: usize) -> Result<Real, BodyErrorKind> {
     match scales {
@@ -114,16 +115,13 @@ impl Loads<'_> {
     #[inline(always)]
     fn take(&mut self, i: usize, mass: &MassProps) -> Result<Wrench, BodyErrorKind> {
         match self {
-            Loads::Field { gravity, scales } => {
-                let scale = check_scale(*scales, i)?;
-                Ok(match gravity {
-                    Some(g) => Wrench {
-                        force: (mass.mass() * scale) * *g,
-                        torque: Vec3::ZERO,
-                    },
-                    None => Wrench::ZERO,
-                })
-            }
+            Loads::Field { gravity, scales } => Ok(match gravity {
+                Some(g) => Wrench {
+                    force: (mass.mass() * check_scale(*scales, i)?) * *g,
+                    torque: Vec3::ZERO,
+                },
+                None => Wrench::ZERO,
+            }),
             Loads::Checked { accs, scales } => {
                 check_scale(*scales, i)?;
                 check_accumulator(&accs[i]).map(|()| Wrench::ZERO)

@@ -118,7 +118,7 @@ pub struct Classification {
 
 /// The spring classification of dynamic bodies of mass `masses` joined by `springs` (given in
 /// entity index order: a body's sums over its springs follow it) under `settings` (see the
-/// module docs). [`classify_springs`] applies it to a world; code that spawns a world whose
+/// [`springs`](crate::springs) docs). [`classify_springs`] applies it to a world; code that spawns a world whose
 /// springs it knows (a scene file) can spawn each body and spring with the markers it will
 /// carry, so that none moves to another table when the world is planned (a move leaves the
 /// table it left at its size).
@@ -134,7 +134,7 @@ where
     let mut stiff_group = vec![false; masses.len()];
     let mut spring_root: Vec<Option<u32>> = Vec::new();
     // Per spring, its inverse effective mass bounds `ι`; per body, `Σ k (ι_a + ι_b)` over its
-    // springs (see the module docs).
+    // springs (see the `springs` module docs).
     let bound = |end: Option<usize>, anchor| {
         end.map_or(0.0, |i| inverse_effective_mass_bound(&masses[i], anchor))
     };
@@ -204,7 +204,7 @@ where
     }
 }
 
-/// Decides which spring groups are stepped implicitly and marks them (see the module docs and
+/// Decides which spring groups are stepped implicitly and marks them (see the [`springs`](crate::springs) docs and
 /// [`classify`]).
 pub fn classify_springs(world: &mut World) {
     let settings = world

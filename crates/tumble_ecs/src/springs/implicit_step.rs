@@ -10,7 +10,7 @@ use tumble_core::springs::{GroupBody, GroupRotation, GroupSpring, ImplicitSpring
 
 use super::classify::{classification_span, ends_in, find};
 use crate::components::{
-    BodyError, BodyErrorKind, Dynamic, ForceAccumulator, GravityScale, ImplicitBody,
+    BodyError, BodyErrorKind, Dynamic, ForceAccumulator, Gravity, GravityScale, ImplicitBody,
     ImplicitSpring, PhysicsSettings, Pose, RigidBody, Spring, SpringEnd, SpringTurn, Stepped,
     body_state, check_body, reject, write_body_state,
 };
@@ -56,7 +56,7 @@ pub struct ImplicitScratch {
 pub fn solve_implicit_springs(
     settings: Res<PhysicsSettings>,
     cursor: Res<crate::integrate::StageCursor>,
-    mut scratch: Local<ImplicitScratch>,
+    (mut scratch, gravity): (Local<ImplicitScratch>, Option<Res<Gravity>>),
     mut commands: Commands,
     springs: ImplicitSprings,
     mut bodies: ImplicitBodies,
@@ -64,7 +64,8 @@ pub fn solve_implicit_springs(
 ) {
     let s = &mut *scratch;
     let span = cursor.span(&settings);
-    s.gather_bodies(&settings, span, &mut bodies, &mut commands);
+    let weighed = crate::integrate::gravity_applies(gravity);
+    s.gather_bodies(&settings, span, weighed, &mut bodies, &mut commands);
     s.sort_by_entity();
     let mut spring_order = std::mem::take(&mut s.spring_order);
     spring_order.refresh(&springs);
@@ -88,7 +89,7 @@ type ImplicitBodies<'w, 's> = Query<
     (Dynamic, With<ImplicitBody>),
 >;
 
-/// How the implicit solve turns a body of a stiff group (see the module docs): by the world's
+/// How the implicit solve turns a body of a stiff group (see the [`springs`](crate::springs) docs): by the world's
 /// integrator (its exact counterpart where `switch` gives the body the exact free flow this
 /// stage) where its springs turn it softly, by the implicit midpoint otherwise (`judged` the
 /// span the classification judges, [`classification_span`]). A method that cannot be combined
@@ -116,11 +117,13 @@ fn group_rotation(
 impl ImplicitScratch {
     /// Reads every body of the stiff groups into `all` (with its index in `index`, its entity
     /// in `entities`), consuming its accumulator and applying the first half of its `Damping`
-    /// where the stage opens a substep; a body with bad data is refused, not gathered.
+    /// where the stage opens a substep; a body with bad data is refused, not gathered (its
+    /// `GravityScale` counts while a gravity field applies, `weighed`).
     fn gather_bodies(
         &mut self,
         settings: &PhysicsSettings,
         span: StageSpan,
+        weighed: bool,
         bodies: &mut ImplicitBodies,
         commands: &mut Commands,
     ) {
@@ -146,6 +149,7 @@ impl ImplicitScratch {
             // and accumulator stay as they are. The point forces' moment is this stage's only
             // (no snapshot holds it): it goes with the stage.
             let checked = scale
+                .filter(|_| weighed)
                 .map_or(Ok(()), GravityScale::check)
                 .and_then(|()| check_body(&t, &v, Some(&acc)))
                 .and_then(|()| damping.map_or(Ok(()), |d| d.check()));
