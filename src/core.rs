@@ -7,7 +7,8 @@
 
 pub use tumble_core::error::{InvalidInput, UNIT_QUATERNION_TOLERANCE};
 pub use tumble_core::integrate::{
-    BodyBatch, FreeFlow, Integrator, KernelPath, StepError, StepPhase, kernel_path,
+    BodyBatch, FreeFlow, Integrator, KernelPath, StepError, StepPhase, UnknownIntegrator,
+    kernel_path,
 };
 pub use tumble_core::mass::{Density, Mass, MassProperties};
 pub use tumble_core::state::{BodyState, Wrench};
@@ -42,4 +43,6 @@ pub mod springs {
     };
 }
 
+/// Mass, density and mass properties, with the ranges they accept.
+pub use tumble_core::mass;
 pub use tumble_core::{damping, elliptic, invariants, rotation};
