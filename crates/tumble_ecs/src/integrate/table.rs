@@ -157,14 +157,8 @@ impl<'a> Bodies<'a> {
         let (t0, t1) = self.transforms.split_at_mut(mid);
         let (v0, v1) = self.velocities.split_at_mut(mid);
         let (m0, m1) = self.masses.split_at(mid);
-        let (d0, d1) = self.dampings.map_or((None, None), |d| {
-            let (a, b) = d.split_at(mid);
-            (Some(a), Some(b))
-        });
-        let (s0, s1) = self.turns.map_or((None, None), |s| {
-            let (a, b) = s.split_at(mid);
-            (Some(a), Some(b))
-        });
+        let (d0, d1) = split_column(self.dampings, mid);
+        let (s0, s1) = split_column(self.turns, mid);
         let (l0, l1) = self.loads.split_at(mid);
         (
             Bodies {
