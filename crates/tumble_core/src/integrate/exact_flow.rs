@@ -67,7 +67,11 @@ use std::f64::consts::FRAC_PI_2;
 
 use glam::{DQuat, DVec3};
 
-use super::splitting::{FreeBody, FreeState, rotate_freely};
+use super::StepPhase;
+use super::body_batch::{BodyBatch, PREFETCH_AHEAD, commit};
+use super::splitting::{
+    FreeBody, FreeState, drift_kick_drift_translation, free_rotation_span, rotate_freely,
+};
 use crate::elliptic::{
     complete_k_complement, incomplete_f_sin_cos, integral_sn2_over, jacobi_sn_cn_dn_complement,
     jacobi_sn_cn_dn_complement_pair, norm2, sign,
@@ -75,7 +79,7 @@ use crate::elliptic::{
 use crate::mass::MassProperties;
 use crate::math::{Real, Widen};
 use crate::simd::sin_cos;
-use crate::state::BodyState;
+use crate::state::{BodyState, Wrench};
 
 /// `atan x`: the series `x − x³/3 + x⁵/5 − x⁷/7` below `|x| = 10⁻³` (the first term left out,
 /// `x⁹/9`, is below `10⁻¹⁸ |x|`), tumble's own `atan` above.
@@ -500,6 +504,50 @@ pub(crate) fn rotate_exactly_pair(
     exact_free_flow_pair([&mut fa.body, &mut fb.body], r, h.widen());
     fa.write(a);
     fb.write(b);
+}
+
+/// The `exact` batch: each body's drift–kick–drift translation, then its free rotation, two
+/// bodies at a time ([`rotate_exactly_pair`]: their long dependency chains overlap), or stepped
+/// whole by `alone` when it is spherical or its translation cannot run first (a whole step
+/// under a torque).
+#[inline(always)]
+pub(super) fn exact_flow_batch(
+    phase: StepPhase,
+    bodies: &mut impl BodyBatch,
+    dt: Real,
+    mut alone: impl FnMut(&mut BodyState, &MassProperties, &Wrench, Real),
+) {
+    let h = free_rotation_span(phase, dt);
+    let mut next = BodyState::ZEROED;
+    // A translated body waiting for a partner.
+    let mut waiting: Option<(usize, BodyState)> = None;
+    for i in 0..bodies.len() {
+        bodies.prefetch(i + PREFETCH_AHEAD);
+        let Some(wrench) = bodies.read(i, &mut next) else {
+            continue;
+        };
+        let mass = bodies.mass(i);
+        if mass.is_spherical() || !drift_kick_drift_translation(phase, &mut next, mass, &wrench, dt)
+        {
+            let mut single = next;
+            alone(&mut single, mass, &wrench, bodies.spring_turn_rate(i));
+            commit(bodies, i, &single);
+            continue;
+        }
+        match waiting.take() {
+            None => waiting = Some((i, next)),
+            Some((j, mut first)) => {
+                let mut second = next;
+                rotate_exactly_pair([&mut first, &mut second], [bodies.mass(j), mass], h);
+                commit(bodies, j, &first);
+                commit(bodies, i, &second);
+            }
+        }
+    }
+    if let Some((j, mut last)) = waiting {
+        rotate_exactly(&mut last, bodies.mass(j), h);
+        commit(bodies, j, &last);
+    }
 }
 
 #[cfg(test)]

@@ -13,7 +13,7 @@
 //! kick–drift kernel (`kick_drift_kernel`); `J⁻¹` is applied by Cramer's rule,
 //! `J⁻¹ = [b×c | c×a | a×b] / (a · b×c)` for the rows `a, b, c` of `J`.
 
-use super::kick_drift_kernel::PrincipalBody;
+use super::lanes::PrincipalBody;
 use super::lanes::{Vec3L, cross};
 use crate::simd::Lane;
 

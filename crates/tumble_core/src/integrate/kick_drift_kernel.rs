@@ -23,12 +23,12 @@ use super::Integrator;
 use super::frame::reciprocal;
 use super::implicit_gyroscopic::implicit_kick;
 use super::lane_input::{LaneInput, LaneInputs, RotatedLanes, to_real};
-use super::lanes::{Quat4, Rotor, Vec3L, conjugate, mul, normalize};
+use super::lanes::{PrincipalBody, Quat4, Rotor, Vec3L, conjugate, mul, normalize};
 use super::lclamp::clamped_kick;
 use super::symplectic_euler::explicit_kick;
 use crate::mass::MassProperties;
 use crate::math::{Quat, Real, Vec3, Widen};
-use crate::simd::{Kernel, LANES, Lane, LaneKernel, run_on, sin_cos};
+use crate::simd::{LANES, Lane, LaneKernel, sin_cos};
 use crate::state::{BodyState, Wrench};
 
 /// Which of the four kick–drift methods a kernel runs.
@@ -55,21 +55,6 @@ impl KickDrift {
             _ => None,
         }
     }
-}
-
-/// A body as a method's kick sees it, in its principal frame.
-pub(super) struct PrincipalBody<T: Lane> {
-    /// Body rates `b = Qᵀ ω`.
-    pub omega: Vec3L<T>,
-    /// Body torque `t = Qᵀ τ`.
-    pub torque: Vec3L<T>,
-    /// Principal moments `I` (0 on a locked axis).
-    pub inertia: Vec3L<T>,
-    /// Reciprocal moments `r` (0 on a locked axis).
-    pub r: Vec3L<T>,
-    /// Set in the lanes whose body is not spherical (a spherical body has no gyroscopic term,
-    /// and its methods skip it exactly).
-    pub gyroscopic: T::Mask,
 }
 
 /// `normalize(exp(½ h ω) q)`: the exact turn by `ω` over `h` (the identity for `ω = 0`).
@@ -194,36 +179,14 @@ pub(super) fn kick_drift_step(
         kick_drift_one(&kick_drift_input(state, mass, wrench.torque), h, method);
 }
 
-/// [`LANES`] bodies through the kernel at once, each over its own `h`, on the `kernel`'s
-/// instruction set; lane `i` of the result is bit-identical to
-/// [`kick_drift_one`]`(&inputs.get(i), h[i], method)` on every path.
-// Not inlined, for the reason `rotate_symmetric_lanes` is not.
-#[inline(never)]
-pub(super) fn kick_drift_lanes(
-    kernel: Kernel,
-    inputs: &LaneInputs,
-    h: [Real; LANES],
-    method: KickDrift,
-) -> RotatedLanes {
-    // One compilation of the kernel per method, its method a constant (as for the symmetric
-    // kernel's flows).
-    match method {
-        KickDrift::Explicit => run_on(kernel, KickDriftLanes::<EXPLICIT> { inputs, h }),
-        KickDrift::ExplicitLinear => {
-            run_on(kernel, KickDriftLanes::<EXPLICIT_LINEAR> { inputs, h })
-        }
-        KickDrift::Clamped => run_on(kernel, KickDriftLanes::<CLAMPED> { inputs, h }),
-        KickDrift::Implicit => run_on(kernel, KickDriftLanes::<IMPLICIT> { inputs, h }),
-    }
-}
+/// The methods as constants: one compilation of the kernel per method, its method a constant
+/// (as for the free flows' kinds, see `symmetric_kernel`).
+pub(super) const EXPLICIT: u8 = 0;
+pub(super) const EXPLICIT_LINEAR: u8 = 1;
+pub(super) const CLAMPED: u8 = 2;
+pub(super) const IMPLICIT: u8 = 3;
 
-/// The methods as constants (a kernel compiled for each).
-const EXPLICIT: u8 = 0;
-const EXPLICIT_LINEAR: u8 = 1;
-const CLAMPED: u8 = 2;
-const IMPLICIT: u8 = 3;
-
-/// The method `METHOD` (see [`kick_drift_lanes`]).
+/// The method `METHOD`.
 #[inline(always)]
 fn method_of<const METHOD: u8>() -> KickDrift {
     match METHOD {
@@ -234,10 +197,14 @@ fn method_of<const METHOD: u8>() -> KickDrift {
     }
 }
 
-/// The batch of [`kick_drift_lanes`] for the method `METHOD`.
-struct KickDriftLanes<'a, const METHOD: u8> {
-    inputs: &'a LaneInputs,
-    h: [Real; LANES],
+/// [`LANES`] bodies' kick–drift rotations by the method `METHOD` (SIMD lanes), each over its
+/// own `h`, run on a kernel path by [`run_on`](crate::simd::run_on): lane `i` of the result is
+/// bit-identical to [`kick_drift_one`]`(&inputs.get(i), h[i], method)` on every path.
+pub(super) struct KickDriftLanes<'a, const METHOD: u8> {
+    /// The bodies, their torques as the load.
+    pub(super) inputs: &'a LaneInputs,
+    /// Each body's span.
+    pub(super) h: [Real; LANES],
 }
 
 impl<const METHOD: u8> LaneKernel for KickDriftLanes<'_, METHOD> {
@@ -266,7 +233,26 @@ mod tests {
     use super::*;
     use crate::integrate::KernelPath;
     use crate::mass::Mass;
+    use crate::simd::{Kernel, run_on};
     use glam::{DMat3, DQuat, DVec3};
+
+    /// The lanes of `method` on `kernel`, through the compilation of that method (as a batch's
+    /// queue runs them).
+    fn kick_drift_lanes(
+        kernel: Kernel,
+        inputs: &LaneInputs,
+        h: [Real; LANES],
+        method: KickDrift,
+    ) -> RotatedLanes {
+        match method {
+            KickDrift::Explicit => run_on(kernel, KickDriftLanes::<EXPLICIT> { inputs, h }),
+            KickDrift::ExplicitLinear => {
+                run_on(kernel, KickDriftLanes::<EXPLICIT_LINEAR> { inputs, h })
+            }
+            KickDrift::Clamped => run_on(kernel, KickDriftLanes::<CLAMPED> { inputs, h }),
+            KickDrift::Implicit => run_on(kernel, KickDriftLanes::<IMPLICIT> { inputs, h }),
+        }
+    }
 
     const METHODS: [KickDrift; 4] = [
         KickDrift::Explicit,

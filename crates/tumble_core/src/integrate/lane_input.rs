@@ -236,7 +236,7 @@ pub(super) fn to_real(q: [f64; 4], w: [f64; 3]) -> (Quat, Vec3) {
     )
 }
 
-/// The results of [`rotate_symmetric_lanes`], component by component (structure of arrays,
+/// The results of a lane kernel, component by component (structure of arrays,
 /// already rounded to the engine precision): the kernel stores each component of a run of
 /// bodies with one vector store, and a reader that picks one body's scalars out of them is
 /// served by store forwarding (four scalar stores read back as one vector stall instead).

@@ -95,3 +95,18 @@ pub(super) fn normalize<T: Lane>(q: Quat4<T>) -> Quat4<T> {
     let inv = T::splat(w.cpu(), 1.0) / (x * x + y * y + z * z + w * w).sqrt();
     [x * inv, y * inv, z * inv, w * inv]
 }
+
+/// A body as a kick–drift method's kick sees it, in its principal frame.
+pub(super) struct PrincipalBody<T: Lane> {
+    /// Body rates `b = Qᵀ ω`.
+    pub omega: Vec3L<T>,
+    /// Body torque `t = Qᵀ τ`.
+    pub torque: Vec3L<T>,
+    /// Principal moments `I` (0 on a locked axis).
+    pub inertia: Vec3L<T>,
+    /// Reciprocal moments `r` (0 on a locked axis).
+    pub r: Vec3L<T>,
+    /// Set in the lanes whose body is not spherical (a spherical body has no gyroscopic term,
+    /// and its methods skip it exactly).
+    pub gyroscopic: T::Mask,
+}

@@ -12,7 +12,7 @@
 //! reference point of what other engines do. The rotation runs on the kick–drift kernel
 //! (`kick_drift_kernel`).
 
-use super::kick_drift_kernel::PrincipalBody;
+use super::lanes::PrincipalBody;
 use super::lanes::{Vec3L, cross};
 use crate::simd::Lane;
 

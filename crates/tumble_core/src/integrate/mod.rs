@@ -40,6 +40,7 @@ pub use free_flow::{
     SPLIT_ERROR_LIMIT, split_orbit_error, split_rotation_drift, split_rotation_error,
 };
 mod implicit_gyroscopic;
+mod kick_drift;
 mod kick_drift_kernel;
 mod lane_input;
 mod lanes;

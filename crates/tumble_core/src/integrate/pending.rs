@@ -4,91 +4,46 @@
 
 use crate::mass::MassProperties;
 use crate::math::{Quat, Real, Vec3};
-use crate::simd::{Kernel, LANES};
-use crate::state::BodyState;
+use crate::simd::{Kernel, LANES, run_on};
+use crate::state::{BodyState, Wrench};
 
-use super::BodyBatch;
-use super::body_batch::commit;
-use super::kick_drift_kernel::{KickDrift, kick_drift_lanes, kick_drift_one};
-use super::lane_input::{LaneInputs, RotatedLanes};
-use super::symmetric_kernel::{LaneFlow, rotate_symmetric_lanes, rotate_symmetric_one};
+use super::ExactSwitch;
+use super::body_batch::{BodyBatch, PREFETCH_AHEAD, commit};
+use super::kick_drift_kernel::{
+    CLAMPED, EXPLICIT, EXPLICIT_LINEAR, IMPLICIT, KickDrift, KickDriftLanes, kick_drift_one,
+};
+use super::lane_input::{LaneInput, LaneInputs};
+use super::symmetric_kernel::{
+    COMPOSED, LaneFlow, RK4, SYMMETRIC, SymmetricLanes, XYZ, rotate_symmetric_one,
+};
 
-/// A lane kernel's inputs for [`LANES`] bodies, as a batch queues them: the rotation each of
-/// them is waiting for.
-pub(super) trait QueuedLanes {
-    /// The inputs.
-    fn inputs(&mut self) -> &mut LaneInputs;
+/// The rotation a batch's queued bodies wait for.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) enum QueuedRotation {
+    /// A free flow: `splitting`'s, `splitting-xyz`'s or `rk4`'s (after the kick of each body's
+    /// angular impulse, for a flow that kicks), or a composed step's.
+    Free(LaneFlow),
+    /// A kick–drift method's rotation under each body's torque.
+    KickDrift(KickDrift),
+}
+
+impl QueuedRotation {
     /// True when the kernel works in the relabelled frame (see [`LaneFlow::relabels`]).
-    fn relabels(&self) -> bool;
-    /// Lane `lane` rotated alone, through the kernel on `f64`: its new `(q, ω)`.
-    fn one(&mut self, lane: usize, h: Real) -> (Quat, Vec3);
-    /// Every lane rotated at once on `kernel`'s instruction set (the same bits as [`one`](Self::one)).
-    fn all(&mut self, kernel: Kernel, h: [Real; LANES]) -> RotatedLanes;
+    #[inline(always)]
+    fn relabels(self) -> bool {
+        match self {
+            QueuedRotation::Free(flow) => flow.relabels(),
+            QueuedRotation::KickDrift(_) => false,
+        }
+    }
 
-    /// Puts the body `state` (already translated) into lane `lane`, under `load`: the angular
-    /// impulse of its kick for a free flow, its torque for a kick–drift method.
+    /// One body's rotation through the kernel on `f64` (the bits of its lane): its new `(q, ω)`.
     #[inline(always)]
-    fn set(&mut self, lane: usize, state: &BodyState, mass: &MassProperties, load: Vec3) {
-        let relabels = self.relabels();
-        self.inputs().set(
-            lane,
-            state.rotation,
-            state.angular_velocity,
-            mass,
-            load,
-            relabels,
-        );
-    }
-}
-
-/// The free flows of `splitting`, `splitting-xyz`, `rk4` (after their kicks) or of a composed
-/// step.
-pub(super) struct SymmetricQueue {
-    pub(super) inputs: LaneInputs,
-    pub(super) flow: LaneFlow,
-}
-
-impl QueuedLanes for SymmetricQueue {
-    #[inline(always)]
-    fn inputs(&mut self) -> &mut LaneInputs {
-        &mut self.inputs
-    }
-    #[inline(always)]
-    fn relabels(&self) -> bool {
-        self.flow.relabels()
-    }
-    #[inline(always)]
-    fn one(&mut self, lane: usize, h: Real) -> (Quat, Vec3) {
-        rotate_symmetric_one(&self.inputs.get(lane), h, self.flow)
-    }
-    #[inline(always)]
-    fn all(&mut self, kernel: Kernel, h: [Real; LANES]) -> RotatedLanes {
-        rotate_symmetric_lanes(kernel, &self.inputs, h, self.flow)
-    }
-}
-
-/// The rotations of a kick–drift method.
-pub(super) struct KickDriftQueue {
-    pub(super) inputs: LaneInputs,
-    pub(super) method: KickDrift,
-}
-
-impl QueuedLanes for KickDriftQueue {
-    #[inline(always)]
-    fn inputs(&mut self) -> &mut LaneInputs {
-        &mut self.inputs
-    }
-    #[inline(always)]
-    fn relabels(&self) -> bool {
-        false
-    }
-    #[inline(always)]
-    fn one(&mut self, lane: usize, h: Real) -> (Quat, Vec3) {
-        kick_drift_one(&self.inputs.get(lane), h, self.method)
-    }
-    #[inline(always)]
-    fn all(&mut self, kernel: Kernel, h: [Real; LANES]) -> RotatedLanes {
-        kick_drift_lanes(kernel, &self.inputs, h, self.method)
+    fn one(self, input: &LaneInput, h: Real) -> (Quat, Vec3) {
+        match self {
+            QueuedRotation::Free(flow) => rotate_symmetric_one(input, h, flow),
+            QueuedRotation::KickDrift(method) => kick_drift_one(input, h, method),
+        }
     }
 }
 
@@ -96,31 +51,35 @@ impl QueuedLanes for KickDriftQueue {
 /// body's translated position and velocity, and its kernel inputs component by component so
 /// that the kernel loads them as vectors. (`h` is written once, not per body: scalar stores
 /// read back at once by a vector load stall store forwarding.)
-pub(super) struct PendingRotations<L> {
+pub(super) struct PendingRotations {
     index: [usize; LANES],
     /// Each queued body's `(position, linear_velocity)`: the rest of its state is the kernel's.
     translated: [(Vec3, Vec3); LANES],
-    lanes: L,
+    /// Each queued body's rotation, orientation, inertia and load.
+    inputs: LaneInputs,
+    rotation: QueuedRotation,
     h: [Real; LANES],
     len: usize,
     kernel: Kernel,
 }
 
-impl<L: QueuedLanes> PendingRotations<L> {
-    /// No bodies yet; all of them will rotate over `h`, `LANES` at a time on `kernel`.
-    pub(super) fn new(h: Real, kernel: Kernel, lanes: L) -> Self {
+impl PendingRotations {
+    /// No bodies yet; all of them will take `rotation` over `h`, `LANES` at a time on `kernel`.
+    pub(super) fn new(h: Real, kernel: Kernel, rotation: QueuedRotation) -> Self {
         Self {
             index: [0; LANES],
             translated: [(Vec3::ZERO, Vec3::ZERO); LANES],
-            lanes,
+            inputs: LaneInputs::default(),
+            rotation,
             h: [h; LANES],
             len: 0,
             kernel,
         }
     }
 
-    /// Queues body `index` (already translated, as `state`) for its rotation under `load` (see
-    /// [`QueuedLanes::set`]); returns true when the batch is full and must be flushed.
+    /// Queues body `index` (already translated, as `state`) for its rotation under `load` (the
+    /// angular impulse of its kick for a free flow, its torque for a kick–drift method);
+    /// returns true when the batch is full and must be flushed.
     #[inline(always)]
     pub(super) fn queue(
         &mut self,
@@ -130,7 +89,9 @@ impl<L: QueuedLanes> PendingRotations<L> {
         load: Vec3,
     ) -> bool {
         let lane = self.len;
-        self.lanes.set(lane, state, mass, load);
+        let relabels = self.rotation.relabels();
+        let (rotation, omega) = (state.rotation, state.angular_velocity);
+        self.inputs.set(lane, rotation, omega, mass, load, relabels);
         self.index[lane] = index;
         self.translated[lane] = (state.position, state.linear_velocity);
         self.len = lane + 1;
@@ -145,12 +106,49 @@ impl<L: QueuedLanes> PendingRotations<L> {
         match self.len {
             0 => {}
             1 => {
-                let (rotation, omega) = self.lanes.one(0, self.h[0]);
+                let (rotation, omega) = self.rotation.one(&self.inputs.get(0), self.h[0]);
                 self.finish(0, rotation, omega, bodies);
             }
             len => {
-                self.lanes.inputs().fill_from_first(len);
-                let rotated = self.lanes.all(self.kernel, self.h);
+                self.inputs.fill_from_first(len);
+                let (kernel, inputs, h) = (self.kernel, &self.inputs, self.h);
+                // Every lane at once on the kernel path, through the compilation of the
+                // kernel for the queued rotation's kind (a constant in each).
+                let rotated = match self.rotation {
+                    QueuedRotation::Free(flow) => {
+                        let kicks = flow.kicks();
+                        match flow {
+                            LaneFlow::Symmetric { .. } => run_on(
+                                kernel,
+                                SymmetricLanes::<SYMMETRIC>::new(inputs, h, kicks, &[]),
+                            ),
+                            LaneFlow::Composed(weights) => run_on(
+                                kernel,
+                                SymmetricLanes::<COMPOSED>::new(inputs, h, kicks, weights),
+                            ),
+                            LaneFlow::Xyz { .. } => {
+                                run_on(kernel, SymmetricLanes::<XYZ>::new(inputs, h, kicks, &[]))
+                            }
+                            LaneFlow::Rk4 { .. } => {
+                                run_on(kernel, SymmetricLanes::<RK4>::new(inputs, h, kicks, &[]))
+                            }
+                        }
+                    }
+                    QueuedRotation::KickDrift(method) => match method {
+                        KickDrift::Explicit => {
+                            run_on(kernel, KickDriftLanes::<EXPLICIT> { inputs, h })
+                        }
+                        KickDrift::ExplicitLinear => {
+                            run_on(kernel, KickDriftLanes::<EXPLICIT_LINEAR> { inputs, h })
+                        }
+                        KickDrift::Clamped => {
+                            run_on(kernel, KickDriftLanes::<CLAMPED> { inputs, h })
+                        }
+                        KickDrift::Implicit => {
+                            run_on(kernel, KickDriftLanes::<IMPLICIT> { inputs, h })
+                        }
+                    },
+                };
                 for lane in 0..len {
                     let (rotation, omega) = rotated.lane(lane);
                     self.finish(lane, rotation, omega, bodies);
@@ -175,4 +173,51 @@ impl<L: QueuedLanes> PendingRotations<L> {
         };
         commit(bodies, self.index[lane], &next);
     }
+}
+
+/// Where a queued batch puts a body once `route` has advanced what runs first (see
+/// [`queued`]).
+pub(super) enum Route {
+    /// It is stepped and ready to commit.
+    Done,
+    /// Queue its rotation under this load (see [`PendingRotations::queue`]).
+    Queue(Vec3),
+}
+
+/// The loop of a batch whose rotations run in lanes: reads each body, steps it by `exact` where
+/// the exact switch applies to it (judged once), else lets `route` advance what runs first and
+/// say where the body goes; queued rotations are flushed eight (`LANES`) at a time.
+#[inline(always)]
+pub(super) fn queued(
+    mut pending: PendingRotations,
+    bodies: &mut impl BodyBatch,
+    switch: Option<ExactSwitch>,
+    mut exact: impl FnMut(ExactSwitch, &mut BodyState, &MassProperties, &Wrench),
+    mut route: impl FnMut(&mut BodyState, &MassProperties, &Wrench) -> Route,
+) {
+    let mut next = BodyState::ZEROED;
+    for i in 0..bodies.len() {
+        bodies.prefetch(i + PREFETCH_AHEAD);
+        let Some(wrench) = bodies.read(i, &mut next) else {
+            continue;
+        };
+        let mass = bodies.mass(i);
+        if let Some(switch) = switch
+            && switch.applies_turned(&next, mass, bodies.spring_turn_rate(i))
+        {
+            let mut single = next;
+            exact(switch, &mut single, mass, &wrench);
+            commit(bodies, i, &single);
+            continue;
+        }
+        match route(&mut next, mass, &wrench) {
+            Route::Done => commit(bodies, i, &next),
+            Route::Queue(load) => {
+                if pending.queue(i, &next, mass, load) {
+                    pending.flush(bodies);
+                }
+            }
+        }
+    }
+    pending.flush(bodies);
 }

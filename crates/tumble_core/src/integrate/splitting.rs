@@ -53,12 +53,15 @@
 use crate::math::{Narrow, Real, Vec3, Widen};
 use glam::{DQuat, DVec3};
 
-use super::StepPhase;
+use super::body_batch::{BodyBatch, PREFETCH_AHEAD, commit};
 use super::frame::{reciprocal, rotate64};
 use super::lane_input::LaneInput;
+use super::pending::{PendingRotations, QueuedRotation, Route, queued};
 use super::symmetric_kernel::{LaneFlow, rotate_symmetric_one};
+use super::{ExactSwitch, StepPhase};
 use crate::mass::MassProperties;
 use crate::rotation::rotate_exact;
+use crate::simd::Kernel;
 use crate::state::{BodyState, Wrench};
 
 /// The state a free flow advances: principal orientation `Q` (principal → world) and body
@@ -323,4 +326,95 @@ pub(super) fn symmetric_free_flow(body: &mut FreeBody, r: DVec3, odd: usize, h: 
     body.momentum_flow(r[b], h);
     body.axis_flow(a, r[a] - r[b], h);
     body.axis_flow(c, residual, 0.5 * h);
+}
+
+/// The `splitting` batch: each body's drift–kick–drift translation and linear kick, then its
+/// free rotation (which takes the angular kick, in `Finish`), queued for the SIMD kernel
+/// ([`PendingRotations`]), or stepped whole by `alone` when its translation cannot run first
+/// (a whole step under a torque).
+#[inline(always)]
+pub(super) fn drift_kick_drift_batch(
+    kernel: Kernel,
+    flow: LaneFlow,
+    phase: StepPhase,
+    bodies: &mut impl BodyBatch,
+    dt: Real,
+    switch: Option<ExactSwitch>,
+    mut alone: impl FnMut(&mut BodyState, &MassProperties, &Wrench, Real),
+) {
+    let h = free_rotation_span(phase, dt);
+    let flow = flow.with_kick(phase == StepPhase::Finish);
+    let mut pending = PendingRotations::new(h, kernel, QueuedRotation::Free(flow));
+    let mut next = BodyState::ZEROED;
+    for i in 0..bodies.len() {
+        bodies.prefetch(i + PREFETCH_AHEAD);
+        let Some(wrench) = bodies.read(i, &mut next) else {
+            continue;
+        };
+        let mass = bodies.mass(i);
+        if let Some(switch) = switch
+            && switch.applies_turned(&next, mass, bodies.spring_turn_rate(i))
+        {
+            let mut single = next;
+            switch.exact().stage(phase, &mut single, mass, &wrench, dt);
+            commit(bodies, i, &single);
+            continue;
+        }
+        match drift_kick_drift_linear(phase, &mut next, mass, &wrench, dt) {
+            Some(impulse) if mass.is_spherical() => {
+                kick_angular(&mut next, mass, impulse);
+                next.rotation = rotate_exact(next.rotation, next.angular_velocity, h);
+                commit(bodies, i, &next);
+            }
+            Some(impulse) => {
+                if pending.queue(i, &next, mass, impulse) {
+                    pending.flush(bodies);
+                }
+            }
+            None => {
+                // A copy, so that `next` never escapes into the (not inlined) scalar step and
+                // stays in registers on the hot path.
+                let mut single = next;
+                alone(&mut single, mass, &wrench, bodies.spring_turn_rate(i));
+                commit(bodies, i, &single);
+            }
+        }
+    }
+    pending.flush(bodies);
+}
+
+/// The batch of whole composed steps (`yoshida4`): a body without torque takes the exact
+/// translation over `dt` and its stages' free rotations in sequence, queued for the SIMD kernel
+/// (as [`Integrator::step`] does alone); a spherical body turns exactly; a body under a torque
+/// is stepped whole by `own` (the method's single-body step), stage by stage.
+#[inline(always)]
+pub(super) fn composed_step_batch(
+    kernel: Kernel,
+    weights: &'static [Real],
+    bodies: &mut impl BodyBatch,
+    dt: Real,
+    switch: Option<ExactSwitch>,
+    mut own: impl FnMut(&mut BodyState, &MassProperties, &Wrench),
+) {
+    let flow = LaneFlow::Composed(weights);
+    let pending = PendingRotations::new(dt, kernel, QueuedRotation::Free(flow));
+    let exact = |switch: ExactSwitch, s: &mut BodyState, m: &MassProperties, w: &Wrench| {
+        switch.exact().step(s, m, w, dt);
+    };
+    queued(pending, bodies, switch, exact, |next, mass, wrench| {
+        if wrench.torque != Vec3::ZERO {
+            // A copy, so that `next` never escapes into the (not inlined) scalar step.
+            let mut single = *next;
+            own(&mut single, mass, wrench);
+            *next = single;
+            return Route::Done;
+        }
+        drift_kick_drift_translation(StepPhase::Whole, next, mass, wrench, dt);
+        if mass.is_spherical() {
+            next.rotation = rotate_exact(next.rotation, next.angular_velocity, dt);
+            Route::Done
+        } else {
+            Route::Queue(Vec3::ZERO)
+        }
+    });
 }

@@ -27,7 +27,7 @@ use super::lanes::{Quat4, Rotor, Vec3L, conjugate, mul, rotate};
 use super::rk4::rk4_flow;
 use crate::mass::MassProperties;
 use crate::math::{Quat, Real, Vec3, Widen};
-use crate::simd::{Counted, Kernel, LANES, Lane, LaneKernel, OpCounts, counted, run_on, sin_cos};
+use crate::simd::{Counted, LANES, Lane, LaneKernel, OpCounts, counted, sin_cos};
 
 /// `(sin θ/2, cos θ/2)` of `angle` θ, and `(cos θ, sin θ)` from them by the double-angle
 /// formulas.
@@ -104,7 +104,7 @@ impl<T: Lane> Flowing<T> {
     pub(super) fn start(input: &LaneInput<T>, kicks: bool) -> Self {
         let inertia = input.inertia;
         // Written out, not `inertia.map(reciprocal)`: inside a `#[target_feature]` function
-        // every helper must inline, and `map` need not (see `rotate_run`).
+        // every helper must inline, and `map` need not.
         let r = [
             reciprocal(inertia[0]),
             reciprocal(inertia[1]),
@@ -189,17 +189,6 @@ impl<T: Lane> Flowing<T> {
             LaneFlow::Rk4 { .. } => rk4_flow(&mut self.free.q, &mut self.free.m, self.r, h),
         }
     }
-
-    /// The new orientation (unit, f64) and world angular velocity: `ω' = Q (r ⊙ m)`,
-    /// `q' = normalize(Q F'ᵀ)`.
-    #[inline(always)]
-    pub(super) fn finish(self) -> (Quat4<T>, Vec3L<T>) {
-        let (Free { q, m }, r) = (self.free, self.r);
-        let omega = rotate(q, [r[0] * m[0], r[1] * m[1], r[2] * m[2]]);
-        let [x, y, z, w] = mul(q, conjugate(self.frame));
-        let inv = T::splat(w.cpu(), 1.0) / (x * x + y * y + z * z + w * w).sqrt();
-        ([x * inv, y * inv, z * inv, w * inv], omega)
-    }
 }
 
 /// Which free flow a kernel call runs: `splitting`'s symmetric-top flow (alone, or composed as
@@ -261,8 +250,9 @@ impl LaneFlow {
     }
 }
 
-/// The free rotation of `flow` over `h`, in lanes: returns the new orientation (unit, f64) and
-/// world angular velocity. See the module documentation for the sequence.
+/// The free rotation of `flow` over `h`, in lanes: the kick (when the flow has one), the flow,
+/// then the new world angular velocity `ω' = Q (r ⊙ m)` and orientation
+/// `q' = normalize(Q F'ᵀ)` (unit, f64). See the module documentation for the sequence.
 #[inline(always)]
 pub(super) fn symmetric_rotation<T: Lane>(
     input: &LaneInput<T>,
@@ -271,7 +261,15 @@ pub(super) fn symmetric_rotation<T: Lane>(
 ) -> (Quat4<T>, Vec3L<T>) {
     let mut flowing = Flowing::start(input, flow.kicks());
     flowing.flow(h, flow);
-    flowing.finish()
+    let Flowing {
+        free: Free { q, m },
+        r,
+        frame,
+    } = flowing;
+    let omega = rotate(q, [r[0] * m[0], r[1] * m[1], r[2] * m[2]]);
+    let [x, y, z, w] = mul(q, conjugate(frame));
+    let inv = T::splat(w.cpu(), 1.0) / (x * x + y * y + z * z + w * w).sqrt();
+    ([x * inv, y * inv, z * inv, w * inv], omega)
 }
 
 /// The floating-point operations of one body's free rotation through this kernel (after a kick
@@ -327,44 +325,15 @@ pub(super) fn rotate_symmetric_one(input: &LaneInput, h: Real, flow: LaneFlow) -
     to_real(q, w)
 }
 
-/// [`LANES`] bodies through the kernel at once (SIMD lanes), each over its own `h` (after the
-/// kick of its impulse for a kicking `flow`), on the `kernel`'s instruction set; lane `i` of the
-/// result is bit-identical to [`rotate_symmetric_one`]`(&inputs[i], h[i], flow)` on every path.
-// Not inlined: the portable kernel compiles into this function, and inlined into the batch
-// loops (three of them, one per phase) it bloats them past what the instruction cache and the
-// register allocator handle well; one call per eight bodies costs nothing in comparison.
-#[inline(never)]
-pub(super) fn rotate_symmetric_lanes(
-    kernel: Kernel,
-    inputs: &LaneInputs,
-    h: [Real; LANES],
-    flow: LaneFlow,
-) -> RotatedLanes {
-    // One compilation of the kernel per kind of flow, its kind a constant: one compilation
-    // holding every kind's code runs the hot `splitting` flow measurably slower (the free-body
-    // rows of `tumble bench`).
-    let kicks = flow.kicks();
-    match flow {
-        LaneFlow::Symmetric { .. } => run_on(
-            kernel,
-            SymmetricLanes::<SYMMETRIC>::new(inputs, h, kicks, &[]),
-        ),
-        LaneFlow::Composed(weights) => run_on(
-            kernel,
-            SymmetricLanes::<COMPOSED>::new(inputs, h, kicks, weights),
-        ),
-        LaneFlow::Xyz { .. } => run_on(kernel, SymmetricLanes::<XYZ>::new(inputs, h, kicks, &[])),
-        LaneFlow::Rk4 { .. } => run_on(kernel, SymmetricLanes::<RK4>::new(inputs, h, kicks, &[])),
-    }
-}
+/// The kinds of [`LaneFlow`] as constants: one compilation of the kernel per kind of flow, its
+/// kind a constant (one compilation holding every kind's code runs the hot `splitting` flow
+/// measurably slower: the free-body rows of `tumble bench`).
+pub(super) const SYMMETRIC: u8 = 0;
+pub(super) const COMPOSED: u8 = 1;
+pub(super) const XYZ: u8 = 2;
+pub(super) const RK4: u8 = 3;
 
-/// The kinds of [`LaneFlow`] as constants (a kernel compiled for each).
-const SYMMETRIC: u8 = 0;
-const COMPOSED: u8 = 1;
-const XYZ: u8 = 2;
-const RK4: u8 = 3;
-
-/// The flow of kind `KIND` (see [`rotate_symmetric_lanes`]).
+/// The flow of kind `KIND`.
 #[inline(always)]
 fn flow_of<const KIND: u8>(kicks: bool, weights: &'static [Real]) -> LaneFlow {
     match KIND {
@@ -375,8 +344,11 @@ fn flow_of<const KIND: u8>(kicks: bool, weights: &'static [Real]) -> LaneFlow {
     }
 }
 
-/// The batch of [`rotate_symmetric_lanes`] for the flows of kind `KIND`.
-struct SymmetricLanes<'a, const KIND: u8> {
+/// [`LANES`] bodies' free rotations of kind `KIND` (SIMD lanes), each over its own `h` (after
+/// the kick of its impulse for a kicking flow), run on a kernel path by
+/// [`run_on`](crate::simd::run_on): lane `i` of the result is bit-identical to
+/// [`rotate_symmetric_one`]`(&inputs.get(i), h[i], flow)` on every path.
+pub(super) struct SymmetricLanes<'a, const KIND: u8> {
     inputs: &'a LaneInputs,
     h: [Real; LANES],
     kicks: bool,
@@ -384,8 +356,10 @@ struct SymmetricLanes<'a, const KIND: u8> {
 }
 
 impl<'a, const KIND: u8> SymmetricLanes<'a, KIND> {
+    /// The rotations of `inputs` over `h`, `kicks` (when the kind has a kick) and the composed
+    /// flow's `weights` (`&[]` for the other kinds).
     #[inline(always)]
-    fn new(
+    pub(super) fn new(
         inputs: &'a LaneInputs,
         h: [Real; LANES],
         kicks: bool,
@@ -403,34 +377,22 @@ impl<'a, const KIND: u8> SymmetricLanes<'a, KIND> {
 impl<const KIND: u8> LaneKernel for SymmetricLanes<'_, KIND> {
     type Output = RotatedLanes;
 
-    /// Runs the kernel over the batch in runs of `T::WIDTH` bodies: loads each input component
-    /// of a run with one vector load, rotates, rounds the results to the engine precision.
+    /// Rotates the bodies in runs of `T::WIDTH`: loads each input component of a run with one
+    /// vector load, rotates, rounds the results to the engine precision.
     #[inline(always)]
     fn run<T: Lane>(self, cpu: T::Cpu) -> RotatedLanes {
         let flow = flow_of::<KIND>(self.kicks, self.weights);
         let mut out = RotatedLanes::new();
         let mut start = 0;
         while start < LANES {
-            rotate_run::<T>(cpu, self.inputs, &self.h, start, flow, &mut out);
+            let input = self.inputs.load::<T>(cpu, start, true, flow.kicks(), false);
+            let h = T::load_real(cpu, &self.h[start..]);
+            let (q, omega) = symmetric_rotation::<T>(&input, h, flow);
+            out.store(start, q, omega);
             start += T::WIDTH;
         }
         out
     }
-}
-
-/// The kernel on bodies `start .. start + T::WIDTH` of the batch.
-#[inline(always)]
-fn rotate_run<T: Lane>(
-    cpu: T::Cpu,
-    inputs: &LaneInputs,
-    h: &[Real; LANES],
-    start: usize,
-    flow: LaneFlow,
-    out: &mut RotatedLanes,
-) {
-    let input = inputs.load::<T>(cpu, start, true, flow.kicks(), false);
-    let (q, w) = symmetric_rotation::<T>(&input, T::load_real(cpu, &h[start..]), flow);
-    out.store(start, q, w);
 }
 
 #[cfg(test)]
@@ -439,6 +401,34 @@ mod tests {
     use super::*;
     use crate::integrate::KernelPath;
     use crate::mass::Mass;
+    use crate::simd::{Kernel, run_on};
+
+    /// The lanes of `flow` on `kernel`, through the compilation of its kind (as a batch's
+    /// queue runs them).
+    fn rotate_symmetric_lanes(
+        kernel: Kernel,
+        inputs: &LaneInputs,
+        h: [Real; LANES],
+        flow: LaneFlow,
+    ) -> RotatedLanes {
+        let kicks = flow.kicks();
+        match flow {
+            LaneFlow::Symmetric { .. } => run_on(
+                kernel,
+                SymmetricLanes::<SYMMETRIC>::new(inputs, h, kicks, &[]),
+            ),
+            LaneFlow::Composed(weights) => run_on(
+                kernel,
+                SymmetricLanes::<COMPOSED>::new(inputs, h, kicks, weights),
+            ),
+            LaneFlow::Xyz { .. } => {
+                run_on(kernel, SymmetricLanes::<XYZ>::new(inputs, h, kicks, &[]))
+            }
+            LaneFlow::Rk4 { .. } => {
+                run_on(kernel, SymmetricLanes::<RK4>::new(inputs, h, kicks, &[]))
+            }
+        }
+    }
 
     /// Every compilation of the lane kernel the CPU runs (portable, and AVX2 or AVX-512 where
     /// it has them) and the scalar kernel agree bit for bit, on bodies that exercise every

@@ -14,7 +14,7 @@
 //! Under constant force the position carries the known bias `½ F/m Δt t`:
 //! `x_n = x₀ + v₀ nΔt + F/m Δt² n(n+1)/2`.
 
-use super::kick_drift_kernel::PrincipalBody;
+use super::lanes::PrincipalBody;
 use super::lanes::{Vec3L, cross};
 use crate::simd::Lane;
 

@@ -232,11 +232,13 @@ fn every_kernel_path_the_cpu_has_gives_the_same_bits_as_the_scalar_step() {
         let scalar = scalar_rounds(integrator, dt, 20);
         for &kernel in &kernels {
             let mut batch = population();
-            for _ in 0..20 {
-                integrator.step_batch_on(kernel, &mut batch, dt, None);
-                integrator.stage_batch_on(kernel, StepPhase::Begin, &mut batch, dt, None);
-                integrator.stage_batch_on(kernel, StepPhase::Finish, &mut batch, dt, None);
-            }
+            kernel.forced(|| {
+                for _ in 0..20 {
+                    integrator.step_batch(&mut batch, dt);
+                    integrator.stage_batch(StepPhase::Begin, &mut batch, dt);
+                    integrator.stage_batch(StepPhase::Finish, &mut batch, dt);
+                }
+            });
             let mut diverged = batch.diverged.clone();
             diverged.sort_unstable();
             diverged.dedup();
@@ -343,14 +345,17 @@ fn switch_steps_each_body_as_its_choice(turn: Real) {
         );
         for kernel in Kernel::available() {
             let mut batch = with_turns(population(), turn);
-            for _ in 0..20 {
-                integrator.step_batch_switched(&mut batch, dt, Some(switch));
-                if let [c] = integrator.composition() {
-                    for phase in [StepPhase::Begin, StepPhase::Finish] {
-                        integrator.stage_batch_on(kernel, phase, &mut batch, c * dt, Some(switch));
+            kernel.forced(|| {
+                for _ in 0..20 {
+                    integrator.step_batch_switched(&mut batch, dt, Some(switch));
+                    if let [c] = integrator.composition() {
+                        for phase in [StepPhase::Begin, StepPhase::Finish] {
+                            let h = c * dt;
+                            integrator.stage_batch_switched(phase, &mut batch, h, Some(switch));
+                        }
                     }
                 }
-            }
+            });
             assert!(batch.diverged.is_empty());
             assert_eq!(
                 bits(&batch.states),

@@ -25,7 +25,7 @@ pub(crate) fn run_on<K: LaneKernel>(kernel: Kernel, kernel_fn: K) -> K::Output {
         // Not paired: `wide`'s `f64x4` is already two SSE2 registers side by side, and a pair of
         // them spills so many values to the stack that it loses to one run of four (the kernel
         // rows of `tumble bench`).
-        Kernel::Portable => kernel_fn.run::<F64x4>(Portable),
+        Kernel::Portable => on_portable(kernel_fn),
         #[cfg(target_arch = "x86_64")]
         #[expect(
             unsafe_code,
@@ -43,6 +43,15 @@ pub(crate) fn run_on<K: LaneKernel>(kernel: Kernel, kernel_fn: K) -> K::Output {
         // calling a function compiled with `#[target_feature(enable = "avx512f")]`.
         Kernel::Avx512(cpu) => unsafe { on_avx512(cpu, kernel_fn) },
     }
+}
+
+/// The kernel on the x86_64 baseline (or any other target), four bodies a value. Not inlined,
+/// as the other paths' functions cannot be: inlined into a batch loop (one per phase and
+/// method), the kernel would bloat each past what the instruction cache and the register
+/// allocator handle well, while one call per eight bodies costs nothing in comparison.
+#[inline(never)]
+fn on_portable<K: LaneKernel>(kernel_fn: K) -> K::Output {
+    kernel_fn.run::<F64x4>(Portable)
 }
 
 /// The kernel compiled with AVX-512F enabled, on one 512-bit register ([`Avx8`]).

@@ -113,6 +113,12 @@ fn list(paths: &[KernelPath]) -> String {
         .join(", ")
 }
 
+#[cfg(test)]
+thread_local! {
+    /// The kernel [`Kernel::forced`] makes this thread's batches take.
+    static FORCED: std::cell::Cell<Option<Kernel>> = const { std::cell::Cell::new(None) };
+}
+
 /// A kernel path with the proof that this CPU runs it: what the batch loop dispatches on.
 #[derive(Debug, Clone, Copy)]
 pub(crate) enum Kernel {
@@ -167,10 +173,24 @@ impl Kernel {
     /// With the [`KernelError`]'s message when [`KERNEL_ENV`] cannot be followed.
     #[inline]
     pub(crate) fn selected() -> Kernel {
+        #[cfg(test)]
+        if let Some(kernel) = FORCED.get() {
+            return kernel;
+        }
         match Kernel::selection() {
             Ok(kernel) => *kernel,
             Err(error) => panic!("{error}"),
         }
+    }
+
+    /// Runs `f` with [`selected`](Self::selected) returning this kernel on this thread: unit
+    /// tests step batches on every path the CPU has in one process.
+    #[cfg(test)]
+    pub(crate) fn forced<R>(self, f: impl FnOnce() -> R) -> R {
+        let before = FORCED.replace(Some(self));
+        let result = f();
+        FORCED.set(before);
+        result
     }
 
     /// [`KERNEL_ENV`], read and checked once per process.

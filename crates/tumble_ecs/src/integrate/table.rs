@@ -393,9 +393,21 @@ pub(crate) fn damp(damping: &Damping, tau: Real, linear: &mut Vec3, angular: &mu
     *angular -= decrement(damping.angular * tau) * *angular;
 }
 
-/// Steps every body of `bodies` through the stage's phase with the core's batched step
-/// (bit-identical to stepping each body alone). Errors are appended sorted by entity.
-fn step_bodies(stage: &StageTiming, mut bodies: Bodies<'_>, errors: &mut Vec<BodyError>) {
+/// Steps one table's bodies through the stage's phase with the core's batched step
+/// (bit-identical to stepping each body alone), split over the compute pool's threads when
+/// [`Parallelism`] says the table is big enough. Each body is stepped by the same code in any
+/// split, so the result does not depend on the number of threads. Errors are appended sorted
+/// by entity.
+pub(crate) fn step_table(
+    stage: &StageTiming,
+    parallelism: &Parallelism,
+    mut bodies: Bodies<'_>,
+    errors: &mut Vec<BodyError>,
+) {
+    let threads = parallelism.threads_for(bodies.len());
+    if threads > 1 {
+        return step_in_parts(stage, split_evenly(bodies, threads), errors);
+    }
     let found = errors.len();
     let turns = bodies.turns.take();
     let mut batch = TableBatch {
@@ -406,54 +418,35 @@ fn step_bodies(stage: &StageTiming, mut bodies: Bodies<'_>, errors: &mut Vec<Bod
         integrator: stage.integrator,
         errors,
     };
+    let (integrator, phase, h, switch) = (stage.integrator, stage.phase, stage.h, stage.switch);
     match turns {
-        None => step_batch(stage, &mut batch),
-        Some(turns) => step_batch(
-            stage,
-            &mut TurnedBatch {
+        None if stage.whole_substep => integrator.step_batch_switched(&mut batch, h, switch),
+        None => integrator.stage_batch_switched(phase, &mut batch, h, switch),
+        Some(turns) => {
+            let mut turned = TurnedBatch {
                 batch: &mut batch,
                 turns,
-            },
-        ),
+            };
+            if stage.whole_substep {
+                integrator.step_batch_switched(&mut turned, h, switch);
+            } else {
+                integrator.stage_batch_switched(phase, &mut turned, h, switch);
+            }
+        }
     }
-    errors[found..].sort_by_key(|e| e.entity);
+    batch.errors[found..].sort_by_key(|e| e.entity);
 }
 
-/// The stage's phase (or its whole substep) of every body of `batch`.
-fn step_batch(stage: &StageTiming, batch: &mut impl BodyBatch) {
-    if stage.whole_substep {
-        stage
-            .integrator
-            .step_batch_switched(batch, stage.h, stage.switch);
-    } else {
-        stage
-            .integrator
-            .stage_batch_switched(stage.phase, batch, stage.h, stage.switch);
-    }
-}
-
-/// Steps one table's bodies, split over the compute pool's threads when [`Parallelism`] says
-/// the table is big enough. Each body is stepped by the same code in any split, so the result
-/// does not depend on the number of threads. Errors are returned sorted by entity.
-pub(crate) fn step_table(
-    stage: &StageTiming,
-    parallelism: &Parallelism,
-    bodies: Bodies<'_>,
-    errors: &mut Vec<BodyError>,
-) {
-    let threads = parallelism.threads_for(bodies.len());
-    if threads <= 1 {
-        step_bodies(stage, bodies, errors);
-        return;
-    }
-    let parts = split_evenly(bodies, threads);
+/// Steps each part on a thread of the compute pool ([`step_table`] on one thread each) and
+/// appends their errors sorted by entity.
+fn step_in_parts(stage: &StageTiming, parts: Vec<Bodies<'_>>, errors: &mut Vec<BodyError>) {
     let found = Mutex::new(Vec::new());
     crate::parallel::scope(|spawn| {
         for part in parts {
             let found = &found;
             spawn(Box::new(move || {
                 let mut local = Vec::new();
-                step_bodies(stage, part, &mut local);
+                step_table(stage, &Parallelism::SINGLE_THREAD, part, &mut local);
                 if !local.is_empty() {
                     found
                         .lock()
