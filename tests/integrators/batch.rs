@@ -171,7 +171,7 @@ impl BodyBatch for Recording {
         self.states.len()
     }
 
-    fn read(&mut self, i: usize, state: &mut BodyState) -> Option<Wrench> {
+    fn take(&mut self, i: usize, state: &mut BodyState) -> Option<Wrench> {
         self.reads.push(i);
         if i % 3 == 2 {
             return None;

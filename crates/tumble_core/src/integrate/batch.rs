@@ -34,7 +34,7 @@ fn each_alone(
     let mut next = BodyState::ZEROED;
     for i in 0..bodies.len() {
         bodies.prefetch(i + PREFETCH_AHEAD);
-        let Some(wrench) = bodies.read(i, &mut next) else {
+        let Some(wrench) = bodies.take(i, &mut next) else {
             continue;
         };
         single(

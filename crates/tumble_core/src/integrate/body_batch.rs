@@ -10,11 +10,11 @@ use crate::state::{BodyState, Wrench};
 
 /// Where a batched step finds its bodies and puts them back.
 ///
-/// [`Integrator::stage_batch`](super::Integrator::stage_batch) calls [`read`](Self::read) once for every index in `0..len()`,
-/// in increasing order, then exactly one of [`write`](Self::write) (the new state is valid:
-/// finite, with a unit rotation, [`BodyState::is_valid`]) or [`diverged`](Self::diverged) (it is
-/// not: the body keeps its old state) for every body that `read` returned, not necessarily in
-/// order.
+/// [`Integrator::stage_batch`](super::Integrator::stage_batch) calls [`take`](Self::take) once
+/// for every index in `0..len()`, in increasing order, then exactly one of
+/// [`write`](Self::write) (the new state is valid: finite, with a unit rotation,
+/// [`BodyState::is_valid`]) or [`diverged`](Self::diverged) (it is not: the body keeps its old
+/// state) for every body that `take` returned, not necessarily in order.
 ///
 /// Bodies kept in your own layout, here one struct per body with a frozen flag:
 ///
@@ -27,7 +27,7 @@ use crate::state::{BodyState, Wrench};
 ///
 /// impl BodyBatch for Crates {
 ///     fn len(&self) -> usize { self.0.len() }
-///     fn read(&mut self, i: usize, state: &mut BodyState) -> Option<Wrench> {
+///     fn take(&mut self, i: usize, state: &mut BodyState) -> Option<Wrench> {
 ///         let c = &self.0[i];
 ///         if c.frozen { return None; }
 ///         state.copy_fields_from(&c.state);
@@ -53,11 +53,13 @@ pub trait BodyBatch {
     fn is_empty(&self) -> bool {
         self.len() == 0
     }
-    /// Writes body `i`'s state into `state` and returns its load; or returns `None` when the
-    /// body must not be stepped (the implementation records why). `state` is a scratch value
-    /// whose padding bytes are zero: assign it with
+    /// Takes body `i` for its step: writes its state into `state` and hands over its load for
+    /// the stage, once — the place a batch over game data consumes the forces it was given
+    /// (tumble's ECS table reads and zeroes each body's `ForceAccumulator` here). Returns
+    /// `None` when the body must not be stepped (the implementation records why). `state` is a
+    /// scratch value whose padding bytes are zero: assign it with
     /// [`BodyState::copy_fields_from`], not as a whole struct (see there why).
-    fn read(&mut self, i: usize, state: &mut BodyState) -> Option<Wrench>;
+    fn take(&mut self, i: usize, state: &mut BodyState) -> Option<Wrench>;
     /// Body `i`'s mass properties.
     fn mass(&self, i: usize) -> &MassProperties;
     /// Stores body `i`'s new, valid state.
@@ -74,7 +76,7 @@ pub trait BodyBatch {
         let _ = i;
         0.0
     }
-    /// A hint: body `i` (possibly beyond the last) will be read soon; fetch its memory with
+    /// A hint: body `i` (possibly beyond the last) will be taken soon; fetch its memory with
     /// [`prefetch`](crate::prefetch::prefetch). The batch loops call it a few dozen bodies
     /// ahead, far enough for the memory to arrive before the body is read. Default: nothing.
     #[inline(always)]
@@ -138,7 +140,7 @@ impl<M: Borrow<MassProperties>> BodyBatch for Slices<'_, M> {
     }
 
     #[inline(always)]
-    fn read(&mut self, i: usize, state: &mut BodyState) -> Option<Wrench> {
+    fn take(&mut self, i: usize, state: &mut BodyState) -> Option<Wrench> {
         state.copy_fields_from(&self.states[i]);
         Some(self.wrenches.map_or(Wrench::ZERO, |w| w[i]))
     }

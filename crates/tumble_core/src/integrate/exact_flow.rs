@@ -523,7 +523,7 @@ pub(super) fn exact_flow_batch(
     let mut waiting: Option<(usize, BodyState)> = None;
     for i in 0..bodies.len() {
         bodies.prefetch(i + PREFETCH_AHEAD);
-        let Some(wrench) = bodies.read(i, &mut next) else {
+        let Some(wrench) = bodies.take(i, &mut next) else {
             continue;
         };
         let mass = bodies.mass(i);

@@ -348,7 +348,7 @@ pub(super) fn drift_kick_drift_batch(
     let mut next = BodyState::ZEROED;
     for i in 0..bodies.len() {
         bodies.prefetch(i + PREFETCH_AHEAD);
-        let Some(wrench) = bodies.read(i, &mut next) else {
+        let Some(wrench) = bodies.take(i, &mut next) else {
             continue;
         };
         let mass = bodies.mass(i);

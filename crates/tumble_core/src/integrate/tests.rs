@@ -125,7 +125,7 @@ impl BodyBatch for Bodies {
     fn len(&self) -> usize {
         self.states.len()
     }
-    fn read(&mut self, i: usize, state: &mut BodyState) -> Option<Wrench> {
+    fn take(&mut self, i: usize, state: &mut BodyState) -> Option<Wrench> {
         state.copy_fields_from(&self.states[i]);
         Some(self.wrenches[i])
     }

@@ -263,7 +263,7 @@ impl BodyBatch for TableBatch<'_, '_> {
     }
 
     #[inline(always)]
-    fn read(&mut self, i: usize, state: &mut BodyState) -> Option<Wrench> {
+    fn take(&mut self, i: usize, state: &mut BodyState) -> Option<Wrench> {
         let bodies = &mut self.bodies;
         let (transform, velocity) = (&bodies.transforms[i], &bodies.velocities[i]);
         let mass = &bodies.masses[i];
@@ -355,8 +355,8 @@ impl BodyBatch for TurnedBatch<'_, '_, '_> {
     }
 
     #[inline(always)]
-    fn read(&mut self, i: usize, state: &mut BodyState) -> Option<Wrench> {
-        self.batch.read(i, state)
+    fn take(&mut self, i: usize, state: &mut BodyState) -> Option<Wrench> {
+        self.batch.take(i, state)
     }
 
     #[inline(always)]
@@ -386,7 +386,7 @@ impl BodyBatch for TurnedBatch<'_, '_, '_> {
 
 /// [`Damping`]'s flow over `τ`: `v ← decay(c_lin τ) v`, `ω ← decay(c_ang τ) ω`, written as
 /// `v − decrement(c τ) v` (see [`tumble_core::damping`]). Outside the core's step, in the
-/// adapter's `read` and `write`, so every kernel path of the batch sees the same bits.
+/// adapter's `take` and `write`, so every kernel path of the batch sees the same bits.
 #[inline(always)]
 pub(crate) fn damp(damping: &Damping, tau: Real, linear: &mut Vec3, angular: &mut Vec3) {
     *linear -= decrement(damping.linear * tau) * *linear;
