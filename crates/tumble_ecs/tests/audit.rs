@@ -386,3 +386,68 @@ fn the_account_does_not_depend_on_the_tables_bodies_sit_in() {
     assert_eq!(alone, account(false, true));
     assert_eq!(alone, account(true, true));
 }
+
+#[derive(Component)]
+struct Breaks;
+
+/// Game code that breaks a body's rotation inside the force stage, after the stage's first
+/// half drift: the integrate system refuses the body in the stage's last phase.
+fn break_rotation(mut bodies: Query<&mut Pose, With<Breaks>>) {
+    for mut pose in &mut bodies {
+        pose.rotation *= 2.0;
+    }
+}
+
+/// A body refused in a step's last stage keeps its state (the broken one game code left); the
+/// audit must not judge its group's energy across the refusal and quarantine the partner (it
+/// did: the refusal is a deferred command, so the audit's end pass still saw the body, with the
+/// energy of its broken rotation). One stage a step (`splitting`, `symplectic-euler`, and
+/// `splitting` with the spring solved implicitly, whose step leaves the body out of its group)
+/// and three (`yoshida4`, whose first stage refuses).
+#[test]
+fn a_body_refused_in_the_last_stage_does_not_quarantine_its_partner() {
+    for (integrator, springs) in [
+        (Integrator::Splitting, SpringSolver::Explicit),
+        (Integrator::SymplecticEuler, SpringSolver::Explicit),
+        (Integrator::Yoshida4, SpringSolver::Explicit),
+        (Integrator::Splitting, SpringSolver::Implicit),
+    ] {
+        let mut w = audited_world(integrator);
+        let settings = w
+            .resource::<PhysicsSettings>()
+            .clone()
+            .with_springs(springs);
+        w.insert_resource(settings);
+        let a = body(&mut w, 0.0, ASYMMETRIC, Vec3::new(0.3, 1.0, 0.2));
+        let b = body(&mut w, 1.0, ASYMMETRIC, Vec3::new(0.0, 0.5, 0.0));
+        let end = SpringEnd::on_body(b, Vec3::new(0.0, 0.1, 0.0));
+        w.spawn(Spring::new(a, Vec3::new(0.2, 0.0, 0.0), end, 50.0, 0.5));
+        let mut forces = ForceSystems::default();
+        forces.add(break_rotation);
+        w.insert_resource(forces);
+        let mut physics = PhysicsRunner::new(&mut w);
+        for step in 0..20 {
+            if step == 10 {
+                w.entity_mut(a).insert(Breaks);
+            }
+            physics.step(&mut w);
+            w.clear_trackers();
+        }
+        let refused = w.get::<Rejected>(a).expect("the broken body is refused");
+        assert!(
+            matches!(
+                refused.0.kind,
+                BodyErrorKind::Invalid {
+                    component: "Pose",
+                    ..
+                }
+            ),
+            "{integrator}: {}",
+            refused.0
+        );
+        if let Some(r) = w.get::<Rejected>(b) {
+            panic!("{integrator}: the partner was refused: {}", r.0);
+        }
+        assert_eq!(errors(&w).len(), 1, "{integrator}: {:?}", errors(&w));
+    }
+}

@@ -141,9 +141,10 @@ pub(super) struct GroupStep {
     pub(super) springs: usize,
     pub(super) key: Option<Entity>,
     pub(super) kinematic: bool,
-    /// A member left the audited bodies during the step (refused by a check in an earlier
-    /// stage, or despawned): its springs stopped acting part-way, so the balance does not
-    /// measure the integrator, and the group gets no verdict this step.
+    /// A member left the audited bodies during the step (refused by a check in any stage, or
+    /// despawned): its springs stopped acting part-way, or it kept a state (bad data included)
+    /// the step did not give it, so the balance does not measure the integrator, and the group
+    /// gets no verdict this step.
     pub(super) left: bool,
     /// `(T + V)` at the start.
     pub(super) start: f64,

@@ -10,7 +10,7 @@ use super::ledger::{
 use super::memo::BodyMemo;
 use crate::components::{
     BodyError, BodyErrorKind, Dynamic, ForceAccumulator, Gravity, GravityScale, ImplicitBody,
-    MassProps, PhysicsSettings, Pose, Velocity, dense, reject,
+    MassProps, PhysicsSettings, Pose, StepRefusals, Velocity, dense, reject,
 };
 use crate::integrate::StageCursor;
 use crate::parallel::{Parallelism, in_runs};
@@ -24,11 +24,15 @@ pub fn audit_energy_start(
     parallelism: Option<Res<Parallelism>>,
     bodies: AuditedBodies,
     ends: Ends,
-    springs: AuditedSprings,
+    (springs, refusals): (AuditedSprings, Option<ResMut<StepRefusals>>),
 ) {
     let ledger = &mut *ledger;
     if !cursor.span(&settings).opens_step {
         return;
+    }
+    // Refusals from before this step (one cut short) are not this step's.
+    if let Some(mut refusals) = refusals {
+        refusals.drain();
     }
     // Bodies and springs in entity index order, so that every sum over a group follows it.
     ledger.spring_order.refresh(&springs);
@@ -252,7 +256,7 @@ pub fn audit_energy(
     mut ledger: ResMut<EnergyLedger>,
     gravity: Option<Res<Gravity>>,
     parallelism: Option<Res<Parallelism>>,
-    bodies: EndBodies,
+    (bodies, refusals): (EndBodies, Option<ResMut<StepRefusals>>),
     mut commands: Commands,
 ) {
     let ledger = &mut *ledger;
@@ -290,6 +294,17 @@ pub fn audit_energy(
         g.end += energy;
         g.work += work;
         g.magnitude += energy + work.abs();
+    }
+    // A body refused in this step's last stage is still measured (its quarantine is a deferred
+    // command), with the state it kept: its group has no verdict this step, as one refused in
+    // an earlier stage.
+    if let Some(mut refusals) = refusals {
+        for entity in refusals.drain() {
+            if let Some(i) = ledger.slot(entity) {
+                let group = ledger.bodies[i].group;
+                ledger.groups[group].left = true;
+            }
+        }
     }
     ledger.measure_springs_at_end(pass, &parallelism);
     ledger.rekey_restored_accounts();

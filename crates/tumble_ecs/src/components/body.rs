@@ -7,7 +7,9 @@ use tumble_core::error::is_clearly_unit;
 use tumble_core::math::{Quat, Real, Vec3, Widen, quat_rotate};
 use tumble_core::{BodyState, InvalidInput, MassProperties};
 
-use super::errors::{BodyError, BodyErrorKind, PhysicsErrors, Rejected};
+use bevy_ecs::system::SystemParam;
+
+use super::errors::{BodyError, BodyErrorKind, PhysicsErrors, Rejected, StepRefusals};
 
 /// Marks an entity as a rigid body. Only entities with this marker are touched by the physics
 /// systems, so resources and other entities never are.
@@ -525,8 +527,28 @@ fn check_accumulator_in_detail(acc: &ForceAccumulator) -> Result<(), BodyErrorKi
     check_finite_vec3("torque", acc.torque).map_err(invalid)
 }
 
+/// How a step's system refuses a body: the quarantine ([`Rejected`] and the [`PhysicsErrors`]
+/// record) as a deferred command, and
+/// the entity at once in [`StepRefusals`] where the energy audit keeps one, so that the audit's
+/// verdict later in the same step already knows.
+#[derive(SystemParam)]
+pub struct Refusals<'w, 's> {
+    commands: Commands<'w, 's>,
+    step: Option<ResMut<'w, StepRefusals>>,
+}
+
+impl Refusals<'_, '_> {
+    /// Refuses the body `error` names.
+    pub(crate) fn refuse(&mut self, error: BodyError) {
+        if let Some(step) = self.step.as_mut() {
+            step.push(error.entity);
+        }
+        reject(&mut self.commands, error);
+    }
+}
+
 /// Quarantines `entity`: logs the error, records it in [`PhysicsErrors`] and inserts
-/// [`Rejected`]. Used by the hooks and the integrate systems.
+/// [`Rejected`]. Used by the hooks and (through [`Refusals`]) the step's systems.
 ///
 /// One incident is one record: a body already quarantined for the same reason (several hooks
 /// of one insertion see the same bad data) is neither logged nor recorded again.

@@ -63,6 +63,26 @@ pub struct BodyError {
 #[derive(Component, Debug, Clone, PartialEq)]
 pub struct Rejected(pub BodyError);
 
+/// The bodies refused during the current step. Their [`Rejected`] is a deferred command (a
+/// schedule run applies its commands once, at its end), so the energy audit's verdict at the
+/// end of the step reads them here: a refused body keeps its state, and any bad data game code
+/// wrote into it, while its springs' partners move on, so its group gets no verdict that step.
+/// Present while the audit is planned; the audit empties it every step.
+#[derive(Resource, Debug, Default)]
+pub struct StepRefusals(Vec<Entity>);
+
+impl StepRefusals {
+    /// Records that `entity` was refused.
+    pub(crate) fn push(&mut self, entity: Entity) {
+        self.0.push(entity);
+    }
+
+    /// The refused bodies since the last call, emptying the record.
+    pub(crate) fn drain(&mut self) -> std::vec::Drain<'_, Entity> {
+        self.0.drain(..)
+    }
+}
+
 /// Every error raised so far, oldest first, one record per incident. Exists from the first
 /// plan on ([`PhysicsPlan::for_world`](crate::schedule::PhysicsPlan::for_world)); game code
 /// may drain it.

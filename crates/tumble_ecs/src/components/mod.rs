@@ -64,3 +64,8 @@ pub(crate) use order::IndexedQuery;
 // not for game code.
 #[doc(hidden)]
 pub use order::IndexOrder;
+// How the step's systems refuse bodies, in their signatures; not for game code.
+#[doc(hidden)]
+pub use body::Refusals;
+#[doc(hidden)]
+pub use errors::StepRefusals;

@@ -10,8 +10,8 @@ use tumble_core::StepPhase;
 use super::table::{Bodies, Loads, StageTiming, step_table};
 use crate::components::{
     BodyError, Dynamic, ForceAccumulator, Gravity, GravityScale, ImplicitBody, Kinematic,
-    PhysicsSettings, Pose, Rejected, RigidBody, Static, Stepped, Velocity, check_body, dense,
-    reject,
+    PhysicsSettings, Pose, Refusals, Rejected, RigidBody, Static, Stepped, Velocity, check_body,
+    dense,
 };
 use crate::parallel::Parallelism;
 
@@ -21,7 +21,7 @@ use crate::parallel::Parallelism;
 /// component's contiguous column as a type of its own that borrows the query table by table,
 /// which a closure parameter of a function cannot name.
 macro_rules! step_each_table {
-    ($bodies:ident, $stage:ident, $parallelism:ident, $commands:ident, |$load:pat_param| $loads:expr) => {{
+    ($bodies:ident, $stage:ident, $parallelism:ident, $refusals:ident, |$load:pat_param| $loads:expr) => {{
         let parallelism = $parallelism.map_or_else(Parallelism::default, |p| *p);
         let mut errors = Vec::new();
         for (entities, mut t, mut v, masses, $load, dampings, turns) in
@@ -38,15 +38,15 @@ macro_rules! step_each_table {
             };
             step_table(&$stage, &parallelism, bodies, &mut errors);
         }
-        reject_all(&mut $commands, errors);
+        refuse_all(&mut $refusals, errors);
     }};
 }
 
 /// Quarantines the bodies in `errors` (in the order found: table by table, entity order
 /// within a table).
-fn reject_all(commands: &mut Commands, errors: Vec<BodyError>) {
+fn refuse_all(refusals: &mut Refusals, errors: Vec<BodyError>) {
     for error in errors {
-        reject(commands, error);
+        refusals.refuse(error);
     }
 }
 
@@ -73,7 +73,7 @@ pub fn discard_fixed_body_forces(
 /// a bad end in the step it is found, see `apply_springs`, the dampers and the implicit step.)
 /// In the plan of a world with springs and such bodies.
 pub fn check_fixed_bodies(
-    mut commands: Commands,
+    mut refusals: Refusals,
     bodies: Query<
         (Entity, &Pose, Option<&Velocity>),
         (
@@ -85,7 +85,7 @@ pub fn check_fixed_bodies(
 ) {
     for (entity, pose, velocity) in &bodies {
         if let Err(kind) = check_body(pose, velocity.unwrap_or(&Velocity::ZERO), None) {
-            reject(&mut commands, BodyError { entity, kind });
+            refusals.refuse(BodyError { entity, kind });
         }
     }
 }
@@ -108,7 +108,7 @@ pub fn begin_stage(
     parallelism: Option<Res<Parallelism>>,
     mut drifted: ResMut<HalfDrifted>,
     gravity: Option<Res<Gravity>>,
-    mut commands: Commands,
+    mut refusals: Refusals,
     mut bodies: Query<
         Stepped<(&ForceAccumulator, Option<&GravityScale>)>,
         (Dynamic, Without<ImplicitBody>),
@@ -120,7 +120,7 @@ pub fn begin_stage(
     drifted.0 = true;
     let stage = StageTiming::new(&settings, *cursor, StepPhase::Begin);
     let weighed = gravity_applies(gravity);
-    step_each_table!(bodies, stage, parallelism, commands, |(accs, scales)| {
+    step_each_table!(bodies, stage, parallelism, refusals, |(accs, scales)| {
         Loads::Checked {
             accs,
             scales: scales.filter(|_| weighed),
@@ -141,7 +141,7 @@ pub fn integrate_with_forces(
     parallelism: Option<Res<Parallelism>>,
     mut drifted: ResMut<HalfDrifted>,
     (mut warned, gravity): (Local<bool>, Option<Res<Gravity>>),
-    mut commands: Commands,
+    mut refusals: Refusals,
     mut bodies: Query<
         Stepped<(&mut ForceAccumulator, Option<&GravityScale>)>,
         (Dynamic, Without<ImplicitBody>),
@@ -163,7 +163,7 @@ pub fn integrate_with_forces(
     drifted.0 = false;
     let stage = StageTiming::new(&settings, *cursor, phase);
     let weighed = gravity_applies(gravity);
-    step_each_table!(bodies, stage, parallelism, commands, |(
+    step_each_table!(bodies, stage, parallelism, refusals, |(
         mut accs,
         scales,
     )| {
@@ -190,14 +190,14 @@ pub fn integrate_without_forces(
     cursor: Res<crate::integrate::StageCursor>,
     parallelism: Option<Res<Parallelism>>,
     gravity: Option<Res<Gravity>>,
-    mut commands: Commands,
+    mut refusals: Refusals,
     mut bodies: Query<Stepped<Option<&GravityScale>>, (Dynamic, Without<ForceAccumulator>)>,
 ) {
     let gravity = gravity.and_then(|g| g.field());
     let Some(stage) = StageTiming::free_motion(&settings, *cursor) else {
         return;
     };
-    step_each_table!(bodies, stage, parallelism, commands, |scales| {
+    step_each_table!(bodies, stage, parallelism, refusals, |scales| {
         Loads::Field { gravity, scales }
     });
 }

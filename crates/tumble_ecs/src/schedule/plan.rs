@@ -242,7 +242,14 @@ impl PhysicsPlan {
         world.init_resource::<EnergyLedger>();
         // A new plan starts at the first stage of a step.
         world.insert_resource(StageCursor::default());
-        Self::of(world)
+        let plan = Self::of(world);
+        // The step's refusals are kept for the audit's verdict, and only while it is planned.
+        if plan.contains(PhysicsSystem::AuditEnergy) {
+            world.init_resource::<crate::components::StepRefusals>();
+        } else {
+            world.remove_resource::<crate::components::StepRefusals>();
+        }
+        plan
     }
 
     /// The plan for `world` as it is now, without side effects.

@@ -11,8 +11,8 @@ use tumble_core::springs::{GroupBody, GroupRotation, GroupSpring, ImplicitSpring
 use super::classify::{classification_span, ends_in, find};
 use crate::components::{
     BodyError, BodyErrorKind, Dynamic, ForceAccumulator, Gravity, GravityScale, ImplicitBody,
-    ImplicitSpring, PhysicsSettings, Pose, RigidBody, Spring, SpringEnd, SpringTurn, Stepped,
-    body_state, check_body, reject, write_body_state,
+    ImplicitSpring, PhysicsSettings, Pose, Refusals, RigidBody, Spring, SpringEnd, SpringTurn,
+    Stepped, body_state, check_body, write_body_state,
 };
 use crate::components::{IndexOrder, IndexedQuery};
 use crate::integrate::damp;
@@ -57,7 +57,7 @@ pub fn solve_implicit_springs(
     settings: Res<PhysicsSettings>,
     cursor: Res<crate::integrate::StageCursor>,
     (mut scratch, gravity): (Local<ImplicitScratch>, Option<Res<Gravity>>),
-    mut commands: Commands,
+    mut refusals: Refusals,
     springs: ImplicitSprings,
     mut bodies: ImplicitBodies,
     others: Query<&Pose, (With<RigidBody>, Without<ImplicitBody>)>,
@@ -65,7 +65,7 @@ pub fn solve_implicit_springs(
     let s = &mut *scratch;
     let span = cursor.span(&settings);
     let weighed = crate::integrate::gravity_applies(gravity);
-    s.gather_bodies(&settings, span, weighed, &mut bodies, &mut commands);
+    s.gather_bodies(&settings, span, weighed, &mut bodies, &mut refusals);
     s.sort_by_entity();
     let mut spring_order = std::mem::take(&mut s.spring_order);
     spring_order.refresh(&springs);
@@ -73,7 +73,7 @@ pub fn solve_implicit_springs(
     s.group_springs(&springs, &spring_order, &others, groups);
     s.spring_order = spring_order;
     for g in 0..groups {
-        s.step_group(g, span, &mut bodies, &mut commands);
+        s.step_group(g, span, &mut bodies, &mut refusals);
     }
 }
 
@@ -125,7 +125,7 @@ impl ImplicitScratch {
         span: StageSpan,
         weighed: bool,
         bodies: &mut ImplicitBodies,
-        commands: &mut Commands,
+        refusals: &mut Refusals,
     ) {
         self.index.clear();
         self.entities.clear();
@@ -155,7 +155,7 @@ impl ImplicitScratch {
                 .and_then(|()| damping.map_or(Ok(()), |d| d.check()));
             if let Err(kind) = checked {
                 implicit.take_load_moment();
-                reject(commands, BodyError { entity, kind });
+                refusals.refuse(BodyError { entity, kind });
                 continue;
             }
             // `Damping` is a flow of its own, half a substep before the substep and half after
@@ -189,7 +189,7 @@ impl ImplicitScratch {
         g: usize,
         span: StageSpan,
         bodies: &mut ImplicitBodies,
-        commands: &mut Commands,
+        refusals: &mut Refusals,
     ) {
         let members = self.member_start[g]..self.member_start[g + 1];
         self.bodies.clear();
@@ -201,13 +201,10 @@ impl ImplicitScratch {
             Err(error) => {
                 for &i in &self.members[members] {
                     let kind = BodyErrorKind::ImplicitSprings(error);
-                    reject(
-                        commands,
-                        BodyError {
-                            entity: self.entities[i],
-                            kind,
-                        },
-                    );
+                    refusals.refuse(BodyError {
+                        entity: self.entities[i],
+                        kind,
+                    });
                 }
                 return;
             }
