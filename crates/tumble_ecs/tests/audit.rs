@@ -413,10 +413,7 @@ fn a_body_refused_in_the_last_stage_does_not_quarantine_its_partner() {
         (Integrator::Splitting, SpringSolver::Implicit),
     ] {
         let mut w = audited_world(integrator);
-        let settings = w
-            .resource::<PhysicsSettings>()
-            .clone()
-            .with_springs(springs);
+        let settings = w.resource::<PhysicsSettings>().with_springs(springs);
         w.insert_resource(settings);
         let a = body(&mut w, 0.0, ASYMMETRIC, Vec3::new(0.3, 1.0, 0.2));
         let b = body(&mut w, 1.0, ASYMMETRIC, Vec3::new(0.0, 0.5, 0.0));

@@ -528,9 +528,8 @@ fn check_accumulator_in_detail(acc: &ForceAccumulator) -> Result<(), BodyErrorKi
 }
 
 /// How a step's system refuses a body: the quarantine ([`Rejected`] and the [`PhysicsErrors`]
-/// record) as a deferred command, and
-/// the entity at once in [`StepRefusals`] where the energy audit keeps one, so that the audit's
-/// verdict later in the same step already knows.
+/// record) as a deferred command, and the entity at once in [`StepRefusals`] where the energy
+/// audit keeps one, so that the audit's verdict later in the same step already knows.
 #[derive(SystemParam)]
 pub struct Refusals<'w, 's> {
     commands: Commands<'w, 's>,
@@ -538,35 +537,50 @@ pub struct Refusals<'w, 's> {
 }
 
 impl Refusals<'_, '_> {
-    /// Refuses the body `error` names.
+    /// Refuses the body `error` names. One incident is one record: a step's systems see only
+    /// bodies without [`Rejected`], so a body that has one when this command applies was
+    /// refused earlier in the same step (a stage's first phase, say, before the force stage
+    /// added to the bad force its second phase finds), and that first record stands.
     pub(crate) fn refuse(&mut self, error: BodyError) {
         if let Some(step) = self.step.as_mut() {
             step.push(error.entity);
         }
-        reject(&mut self.commands, error);
+        self.commands.queue(move |world: &mut World| {
+            if world.get::<Rejected>(error.entity).is_none() {
+                quarantine(world, error);
+            }
+        });
     }
 }
 
 /// Quarantines `entity`: logs the error, records it in [`PhysicsErrors`] and inserts
-/// [`Rejected`]. Used by the hooks and (through [`Refusals`]) the step's systems.
+/// [`Rejected`]. Used by the hooks (the step's systems refuse through [`Refusals`]).
 ///
 /// One incident is one record: a body already quarantined for the same reason (several hooks
 /// of one insertion see the same bad data) is neither logged nor recorded again.
 pub(crate) fn reject(commands: &mut Commands, error: BodyError) {
     commands.queue(move |world: &mut World| {
-        let Ok(mut entity) = world.get_entity_mut(error.entity) else {
-            return;
-        };
-        if entity.get::<Rejected>().is_some_and(|r| r.0 == error) {
-            return;
+        let same = world
+            .get::<Rejected>(error.entity)
+            .is_some_and(|r| r.0 == error);
+        if !same {
+            quarantine(world, error);
         }
-        tracing::warn!(entity = %error.entity, "{error}");
-        entity.insert(Rejected(error.clone()));
-        world
-            .get_resource_or_init::<PhysicsErrors>()
-            .bodies
-            .push(error);
     });
+}
+
+/// Logs `error`, inserts [`Rejected`] on its body and records it in [`PhysicsErrors`]; nothing
+/// for a despawned body.
+fn quarantine(world: &mut World, error: BodyError) {
+    let Ok(mut entity) = world.get_entity_mut(error.entity) else {
+        return;
+    };
+    tracing::warn!(entity = %error.entity, "{error}");
+    entity.insert(Rejected(error.clone()));
+    world
+        .get_resource_or_init::<PhysicsErrors>()
+        .bodies
+        .push(error);
 }
 
 /// Component hook: re-checks the whole body whenever one of its state components is inserted.

@@ -1002,3 +1002,42 @@ fn a_body_refused_mid_step_does_not_quarantine_its_stiff_partner() {
     }
     assert!(world.get::<Velocity>(partner).unwrap().linear.is_finite());
 }
+
+/// A non-finite force game code applies between steps is one incident, one record: the
+/// stage's first phase refuses the body, and the later phase that finds the same force (its
+/// quarantine still a deferred command) records nothing more. It was recorded twice: the two
+/// errors differ once the force stage adds to the bad force between the phases. With and
+/// without gravity and a constant force (which add to it), in one stage and in three.
+#[test]
+fn a_non_finite_force_is_recorded_once() {
+    for integrator in [
+        Integrator::Splitting,
+        Integrator::SymplecticEuler,
+        Integrator::Yoshida4,
+    ] {
+        for gravity in [false, true] {
+            let case = format!("{integrator}, loaded {gravity}");
+            let mut world = world_with(1.0 / 60.0, integrator);
+            let v = Velocity::linear(Vec3::new(0.5, 1.0, 0.0));
+            let body = spawn_bad(&mut world, Pose::default(), v, Some(Default::default()));
+            if gravity {
+                world.insert_resource(Gravity(Vec3::new(0.0, -9.81, 0.0)));
+                world.spawn(ConstantForce {
+                    body,
+                    force: Vec3::new(2.0, 0.0, 0.0),
+                    local_point: None,
+                });
+            }
+            let mut physics = PhysicsRunner::new(&mut world);
+            run_steps(&mut world, &mut physics, 2);
+            world
+                .entity_mut(body)
+                .apply_force(Vec3::new(0.0, Real::NAN, 0.0));
+            run_steps(&mut world, &mut physics, 2);
+            let refused = world.get::<Rejected>(body).expect("refused");
+            assert!(invalid("ForceAccumulator")(&refused.0.kind), "{case}");
+            let errors = &world.resource::<PhysicsErrors>().bodies;
+            assert_eq!(errors.len(), 1, "{case}: {errors:?}");
+        }
+    }
+}
