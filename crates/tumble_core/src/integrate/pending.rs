@@ -1,6 +1,7 @@
 //! Bodies waiting for their rotation in SIMD lanes: a batch translates each body, queues its
 //! rotation, and flushes [`LANES`] of them at a time through a lane kernel (the free-flow
-//! kernel, or the kick–drift one), committing each result.
+//! kernel, or the kick–drift one), committing each result; and `queued`, the batch loop that
+//! the composed and kick–drift batches route their bodies through.
 
 use crate::mass::MassProperties;
 use crate::math::{Quat, Real, Vec3};

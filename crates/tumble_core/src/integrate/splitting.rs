@@ -1,4 +1,6 @@
-//! Lie–Poisson splittings of the free rigid body, and the drift–kick–drift step built on them.
+//! Lie–Poisson splittings of the free rigid body, the drift–kick–drift step built on them, and
+//! its batch loops (`drift_kick_drift_batch` for `splitting`, `splitting-xyz` and `rk4`;
+//! `composed_step_batch` for `yoshida4`'s torque-free steps).
 //!
 //! The free-body Hamiltonian is `H = ½ Σᵢ rᵢ mᵢ²` with body momentum `m = Qᵀ L` and reciprocal
 //! moments `rᵢ = 1/Iᵢ` (`0` on a locked axis). Two splittings into exactly integrable pieces:
