@@ -103,6 +103,35 @@ fn step_all(c: &mut Criterion) {
             });
         });
     }
+    // What the switch costs where it applies: bodies spun ten times faster, which it hands to
+    // the exact flow (`exact`, or `exact4` for `yoshida4`), two at a time in the batch.
+    for (integrator, factor) in [(Integrator::Splitting, 10.0), (Integrator::Yoshida4, 40.0)] {
+        let spun: Vec<BodyState> = states0
+            .iter()
+            .map(|s| BodyState {
+                angular_velocity: s.angular_velocity * factor,
+                ..*s
+            })
+            .collect();
+        let switch = ExactSwitch::new(integrator, FreeFlow::Auto, 1.0 / 60.0);
+        let switched = spun
+            .iter()
+            .zip(&masses)
+            .filter(|(s, m)| switch.is_some_and(|sw| sw.applies(s, m)))
+            .count();
+        assert!(
+            switched > n / 2,
+            "{integrator}: only {switched} of {n} spun bodies switch"
+        );
+        let id = BenchmarkId::new("free_flow_spun", integrator);
+        group.bench_with_input(id, &switch, |b, &sw| {
+            let mut states = spun.clone();
+            let wrenches = vec![Wrench::ZERO; n];
+            b.iter(|| {
+                integrator.try_step_many_switched(&mut states, &masses, &wrenches, 1.0 / 60.0, sw)
+            });
+        });
+    }
     group.finish();
 }
 

@@ -69,7 +69,7 @@ use glam::{DQuat, DVec3};
 
 use super::StepPhase;
 use super::body_batch::{BodyBatch, PREFETCH_AHEAD, commit};
-use super::splitting::{
+use super::drift_kick_drift::{
     FreeBody, FreeState, drift_kick_drift_translation, free_rotation_span, rotate_freely,
 };
 use crate::elliptic::{
@@ -506,10 +506,54 @@ pub(crate) fn rotate_exactly_pair(
     fb.write(b);
 }
 
+/// Bodies translated for their exact free rotation over the same `h`, rotated two at a time
+/// ([`rotate_exactly_pair`]: their long dependency chains overlap) and committed; the same bits
+/// as [`rotate_exactly`] one by one.
+pub(super) struct ExactPairs {
+    h: Real,
+    /// A translated body waiting for a partner.
+    waiting: Option<(usize, BodyState)>,
+}
+
+impl ExactPairs {
+    /// No body waiting yet; rotations over `h`.
+    #[inline(always)]
+    pub(super) fn new(h: Real) -> Self {
+        Self { h, waiting: None }
+    }
+
+    /// Takes body `i` of `bodies`, translated as `state` (not spherical): it waits for a
+    /// partner, or rotates with the one waiting and both are committed.
+    #[inline(always)]
+    pub(super) fn rotate(&mut self, i: usize, state: BodyState, bodies: &mut impl BodyBatch) {
+        match self.waiting.take() {
+            None => self.waiting = Some((i, state)),
+            Some((j, mut first)) => {
+                let mut second = state;
+                rotate_exactly_pair(
+                    [&mut first, &mut second],
+                    [bodies.mass(j), bodies.mass(i)],
+                    self.h,
+                );
+                commit(bodies, j, &first);
+                commit(bodies, i, &second);
+            }
+        }
+    }
+
+    /// Rotates and commits the body left waiting, alone.
+    #[inline(always)]
+    pub(super) fn finish(self, bodies: &mut impl BodyBatch) {
+        if let Some((j, mut last)) = self.waiting {
+            rotate_exactly(&mut last, bodies.mass(j), self.h);
+            commit(bodies, j, &last);
+        }
+    }
+}
+
 /// The `exact` batch: each body's drift–kick–drift translation, then its free rotation, two
-/// bodies at a time ([`rotate_exactly_pair`]: their long dependency chains overlap), or stepped
-/// whole by `alone` when it is spherical or its translation cannot run first (a whole step
-/// under a torque).
+/// bodies at a time ([`ExactPairs`]), or stepped whole by `alone` when it is spherical or its
+/// translation cannot run first (a whole step under a torque).
 #[inline(always)]
 pub(super) fn exact_flow_batch(
     phase: StepPhase,
@@ -517,10 +561,8 @@ pub(super) fn exact_flow_batch(
     dt: Real,
     mut alone: impl FnMut(&mut BodyState, &MassProperties, &Wrench, Real),
 ) {
-    let h = free_rotation_span(phase, dt);
+    let mut pairs = ExactPairs::new(free_rotation_span(phase, dt));
     let mut next = BodyState::ZEROED;
-    // A translated body waiting for a partner.
-    let mut waiting: Option<(usize, BodyState)> = None;
     for i in 0..bodies.len() {
         bodies.prefetch(i + PREFETCH_AHEAD);
         let Some(wrench) = bodies.take(i, &mut next) else {
@@ -534,20 +576,9 @@ pub(super) fn exact_flow_batch(
             commit(bodies, i, &single);
             continue;
         }
-        match waiting.take() {
-            None => waiting = Some((i, next)),
-            Some((j, mut first)) => {
-                let mut second = next;
-                rotate_exactly_pair([&mut first, &mut second], [bodies.mass(j), mass], h);
-                commit(bodies, j, &first);
-                commit(bodies, i, &second);
-            }
-        }
+        pairs.rotate(i, next, bodies);
     }
-    if let Some((j, mut last)) = waiting {
-        rotate_exactly(&mut last, bodies.mass(j), h);
-        commit(bodies, j, &last);
-    }
+    pairs.finish(bodies);
 }
 
 #[cfg(test)]

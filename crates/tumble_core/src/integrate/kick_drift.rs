@@ -27,6 +27,7 @@ pub(super) fn kick_drift_batch(
     let pending = PendingRotations::new(h, kernel, QueuedRotation::KickDrift(method));
     let exact = |switch: ExactSwitch, s: &mut BodyState, m: &MassProperties, w: &Wrench| {
         switch.exact().stage(phase, s, m, w, h);
+        false
     };
     queued(pending, bodies, switch, exact, |next, mass, wrench| {
         kick_drift_translation(next, mass, wrench.force, h);

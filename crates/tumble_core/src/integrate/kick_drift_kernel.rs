@@ -198,7 +198,7 @@ fn method_of<const METHOD: u8>() -> KickDrift {
 }
 
 /// [`LANES`] bodies' kick–drift rotations by the method `METHOD` (SIMD lanes), each over its
-/// own `h`, run on a kernel path by [`run_on`](crate::simd::run_on): lane `i` of the result is
+/// own `h`, run on a kernel path by [`run_on!`](crate::simd::run_on): lane `i` of the result is
 /// bit-identical to [`kick_drift_one`]`(&inputs.get(i), h[i], method)` on every path.
 pub(super) struct KickDriftLanes<'a, const METHOD: u8> {
     /// The bodies, their torques as the load.
@@ -245,12 +245,12 @@ mod tests {
         method: KickDrift,
     ) -> RotatedLanes {
         match method {
-            KickDrift::Explicit => run_on(kernel, KickDriftLanes::<EXPLICIT> { inputs, h }),
+            KickDrift::Explicit => run_on!(kernel, KickDriftLanes::<EXPLICIT> { inputs, h }),
             KickDrift::ExplicitLinear => {
-                run_on(kernel, KickDriftLanes::<EXPLICIT_LINEAR> { inputs, h })
+                run_on!(kernel, KickDriftLanes::<EXPLICIT_LINEAR> { inputs, h })
             }
-            KickDrift::Clamped => run_on(kernel, KickDriftLanes::<CLAMPED> { inputs, h }),
-            KickDrift::Implicit => run_on(kernel, KickDriftLanes::<IMPLICIT> { inputs, h }),
+            KickDrift::Clamped => run_on!(kernel, KickDriftLanes::<CLAMPED> { inputs, h }),
+            KickDrift::Implicit => run_on!(kernel, KickDriftLanes::<IMPLICIT> { inputs, h }),
         }
     }
 

@@ -31,6 +31,7 @@
 
 mod batch;
 mod body_batch;
+mod drift_kick_drift;
 mod exact_flow;
 pub use body_batch::BodyBatch;
 mod frame;
@@ -70,13 +71,11 @@ use crate::state::{BodyState, Wrench};
 // operation count) and the two frame rotations the tests and reports measure with; each
 // method's functions are internal.
 pub use crate::simd::{KERNEL_ENV, KernelError, KernelPath, OpCounts, kernel_path};
+use drift_kick_drift::{Rotation, drift_kick_drift, drift_kick_drift_translation, kick_angular};
 use exact_flow::rotate_exactly;
 pub use frame::{rotate, rotate_inv};
 use kick_drift_kernel::{KickDrift, kick_drift_step};
-use splitting::{
-    Rotation, drift_kick_drift, drift_kick_drift_translation, kick_angular,
-    rotate_kicked_on_kernel, rotate_symmetric_kicked,
-};
+use splitting::{rotate_kicked_on_kernel, rotate_symmetric_kicked};
 use symmetric_kernel::LaneFlow;
 pub use symmetric_kernel::symmetric_rotation_flops;
 

@@ -11,8 +11,9 @@
 use glam::{DQuat, DVec3};
 
 use super::Integrator;
+use super::drift_kick_drift::FreeBody;
 use super::exact_flow::exact_free_flow;
-use super::splitting::{FreeBody, symmetric_free_flow};
+use super::splitting::symmetric_free_flow;
 use super::symmetric_kernel::{LaneFlow, turn_from_momentum};
 
 /// The turn `C` of `integrator`'s torque-free rotation over `h` (`Q₁ = Q₀ C`, in the principal

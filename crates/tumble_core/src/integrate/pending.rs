@@ -10,12 +10,13 @@ use crate::state::{BodyState, Wrench};
 
 use super::ExactSwitch;
 use super::body_batch::{BodyBatch, PREFETCH_AHEAD, commit};
+use super::exact_flow::ExactPairs;
 use super::kick_drift_kernel::{
     CLAMPED, EXPLICIT, EXPLICIT_LINEAR, IMPLICIT, KickDrift, KickDriftLanes, kick_drift_one,
 };
 use super::lane_input::{LaneInput, LaneInputs};
 use super::symmetric_kernel::{
-    COMPOSED, LaneFlow, RK4, SYMMETRIC, SymmetricLanes, XYZ, rotate_symmetric_one,
+    COMPOSED, LaneFlow, QueuedInputs, RK4, SYMMETRIC, SymmetricLanes, XYZ, rotate_symmetric_one,
 };
 
 /// The rotation a batch's queued bodies wait for.
@@ -117,36 +118,34 @@ impl PendingRotations {
                 // kernel for the queued rotation's kind (a constant in each).
                 let rotated = match self.rotation {
                     QueuedRotation::Free(flow) => {
-                        let kicks = flow.kicks();
+                        let queued = QueuedInputs { inputs, h };
                         match flow {
-                            LaneFlow::Symmetric { .. } => run_on(
-                                kernel,
-                                SymmetricLanes::<SYMMETRIC>::new(inputs, h, kicks, &[]),
-                            ),
-                            LaneFlow::Composed(weights) => run_on(
-                                kernel,
-                                SymmetricLanes::<COMPOSED>::new(inputs, h, kicks, weights),
-                            ),
+                            LaneFlow::Symmetric { .. } => {
+                                run_on!(kernel, SymmetricLanes::<_, SYMMETRIC>::new(queued, flow))
+                            }
+                            LaneFlow::Composed(_) => {
+                                run_on!(kernel, SymmetricLanes::<_, COMPOSED>::new(queued, flow))
+                            }
                             LaneFlow::Xyz { .. } => {
-                                run_on(kernel, SymmetricLanes::<XYZ>::new(inputs, h, kicks, &[]))
+                                run_on!(kernel, SymmetricLanes::<_, XYZ>::new(queued, flow))
                             }
                             LaneFlow::Rk4 { .. } => {
-                                run_on(kernel, SymmetricLanes::<RK4>::new(inputs, h, kicks, &[]))
+                                run_on!(kernel, SymmetricLanes::<_, RK4>::new(queued, flow))
                             }
                         }
                     }
                     QueuedRotation::KickDrift(method) => match method {
                         KickDrift::Explicit => {
-                            run_on(kernel, KickDriftLanes::<EXPLICIT> { inputs, h })
+                            run_on!(kernel, KickDriftLanes::<EXPLICIT> { inputs, h })
                         }
                         KickDrift::ExplicitLinear => {
-                            run_on(kernel, KickDriftLanes::<EXPLICIT_LINEAR> { inputs, h })
+                            run_on!(kernel, KickDriftLanes::<EXPLICIT_LINEAR> { inputs, h })
                         }
                         KickDrift::Clamped => {
-                            run_on(kernel, KickDriftLanes::<CLAMPED> { inputs, h })
+                            run_on!(kernel, KickDriftLanes::<CLAMPED> { inputs, h })
                         }
                         KickDrift::Implicit => {
-                            run_on(kernel, KickDriftLanes::<IMPLICIT> { inputs, h })
+                            run_on!(kernel, KickDriftLanes::<IMPLICIT> { inputs, h })
                         }
                     },
                 };
@@ -187,15 +186,19 @@ pub(super) enum Route {
 
 /// The loop of a batch whose rotations run in lanes: reads each body, steps it by `exact` where
 /// the exact switch applies to it (judged once), else lets `route` advance what runs first and
-/// say where the body goes; queued rotations are flushed eight (`LANES`) at a time.
+/// say where the body goes; queued rotations are flushed eight (`LANES`) at a time. `exact`
+/// returns true when it only translated the body, leaving its exact free rotation over the
+/// queue's span to be run two bodies at a time ([`ExactPairs`]), false when it stepped the body
+/// whole.
 #[inline(always)]
 pub(super) fn queued(
     mut pending: PendingRotations,
     bodies: &mut impl BodyBatch,
     switch: Option<ExactSwitch>,
-    mut exact: impl FnMut(ExactSwitch, &mut BodyState, &MassProperties, &Wrench),
+    mut exact: impl FnMut(ExactSwitch, &mut BodyState, &MassProperties, &Wrench) -> bool,
     mut route: impl FnMut(&mut BodyState, &MassProperties, &Wrench) -> Route,
 ) {
+    let mut pairs = ExactPairs::new(pending.h[0]);
     let mut next = BodyState::ZEROED;
     for i in 0..bodies.len() {
         bodies.prefetch(i + PREFETCH_AHEAD);
@@ -207,8 +210,11 @@ pub(super) fn queued(
             && switch.applies_turned(&next, mass, bodies.spring_turn_rate(i))
         {
             let mut single = next;
-            exact(switch, &mut single, mass, &wrench);
-            commit(bodies, i, &single);
+            if exact(switch, &mut single, mass, &wrench) {
+                pairs.rotate(i, single, bodies);
+            } else {
+                commit(bodies, i, &single);
+            }
             continue;
         }
         match route(&mut next, mass, &wrench) {
@@ -221,4 +227,5 @@ pub(super) fn queued(
         }
     }
     pending.flush(bodies);
+    pairs.finish(bodies);
 }

@@ -42,82 +42,31 @@
 //! **Where the code is.** The `splitting` flow is written once, lane-generic, in
 //! `symmetric_kernel` (`Flowing::symmetric_flow`): one body runs it in `f64`, a batch in SIMD
 //! lanes (`yoshida4` is a composition of whole `splitting` steps, see `stages`). `splitting-xyz`'s
-//! axis-by-axis flow and `rk4`'s run on the same lanes; `exact`'s advances a [`FreeBody`]. The drift–kick–drift phases are
-//! [`drift_kick_drift_translation`] plus the method's free rotation, on both the scalar and the
-//! batched paths.
+//! axis-by-axis flow and `rk4`'s run on the same lanes; `exact`'s advances a [`FreeBody`].
 //!
-//! With external load the step is the symmetric drift–kick–drift
-//! `D(h/2) ∘ K(h) ∘ D(h/2)`: `D` moves `x += ½h v` and applies the free flow, `K` kicks
-//! `v += h F/m` and `L += h τ`. Forces are sampled once, between the two drifts (the ECS runs the
-//! first drift before the force systems), so constant forces are integrated exactly and springs
-//! get the second-order, symplectic position-Verlet scheme.
+//! With external load the step is the symmetric drift–kick–drift `D(h/2) ∘ K(h) ∘ D(h/2)` of
+//! `drift_kick_drift` (its translation and kicks, shared with `exact`), the method's free
+//! rotation completing each drift, on both the scalar and the batched paths. In the batch, the
+//! bodies [`FreeFlow::Auto`](super::FreeFlow::Auto) gives the exact flow take `exact`'s
+//! rotation two at a time (`ExactPairs`), with the bits of stepping each alone.
 
-use crate::math::{Narrow, Real, Vec3, Widen};
+use crate::math::{Real, Vec3};
 use glam::{DQuat, DVec3};
 
 use super::body_batch::{BodyBatch, PREFETCH_AHEAD, commit};
-use super::frame::{reciprocal, rotate64};
+use super::drift_kick_drift::{
+    FreeBody, drift_kick_drift_linear, drift_kick_drift_translation, free_rotation_span,
+    kick_angular,
+};
+use super::exact_flow::ExactPairs;
 use super::lane_input::LaneInput;
 use super::pending::{PendingRotations, QueuedRotation, Route, queued};
 use super::symmetric_kernel::{LaneFlow, rotate_symmetric_one};
-use super::{ExactSwitch, StepPhase};
+use super::{ExactSwitch, Integrator, StepPhase};
 use crate::mass::MassProperties;
 use crate::rotation::rotate_exact;
 use crate::simd::Kernel;
 use crate::state::{BodyState, Wrench};
-
-/// The state a free flow advances: principal orientation `Q` (principal → world) and body
-/// momentum `m = Qᵀ L`, both f64.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(super) struct FreeBody {
-    /// Principal orientation `Q`.
-    pub q: DQuat,
-    /// Body momentum `m` in the principal frame.
-    pub m: DVec3,
-}
-
-impl FreeBody {
-    /// Rotates the body by `angle` about its principal axis `axis` (0, 1, 2): `Q ← Q exp(θ eₐ)`,
-    /// and the body momentum the opposite way, `m ← exp(−θ eₐ) m`, so `L = Q m` is unchanged.
-    #[inline]
-    pub(super) fn rotate_about_axis(&mut self, axis: usize, angle: f64) {
-        // tumble's own sine and cosine: the same bits on every platform.
-        let (s, c) = crate::simd::sin_cos(0.5 * angle);
-        // cos θ and sin θ from the half angle: one sin_cos per rotation.
-        let (cos, sin) = (c * c - s * s, 2.0 * s * c);
-        let m = self.m;
-        match axis {
-            0 => {
-                self.q *= DQuat::from_xyzw(s, 0.0, 0.0, c);
-                self.m = DVec3::new(m.x, cos * m.y + sin * m.z, cos * m.z - sin * m.y);
-            }
-            1 => {
-                self.q *= DQuat::from_xyzw(0.0, s, 0.0, c);
-                self.m = DVec3::new(cos * m.x - sin * m.z, m.y, cos * m.z + sin * m.x);
-            }
-            _ => {
-                self.q *= DQuat::from_xyzw(0.0, 0.0, s, c);
-                self.m = DVec3::new(cos * m.x + sin * m.y, cos * m.y - sin * m.x, m.z);
-            }
-        }
-    }
-
-    /// Exact flow of `½ k mₐ²` for time `h`: rotation about axis `a` by `h k mₐ`.
-    #[inline]
-    pub(super) fn axis_flow(&mut self, axis: usize, k: f64, h: f64) {
-        if k != 0.0 {
-            self.rotate_about_axis(axis, h * k * self.m[axis]);
-        }
-    }
-}
-
-/// A free-flow approximation over `h`, given the reciprocal principal moments `r = 1/I_b`
-/// (0 on locked axes).
-pub(super) type FreeFlow = fn(&mut FreeBody, DVec3, f64);
-
-/// The rotational part of a drift over `h` at constant world `L`, after the kick `L += J` of the
-/// angular impulse `J` (world frame; zero in a phase without a kick): a method's free rotation.
-pub(super) type Rotation = fn(&mut BodyState, &MassProperties, Real, Vec3);
 
 /// The free rotation `flow` over `h` on the lane kernel of the module `symmetric_kernel` (the
 /// same code the batched step runs, so one body gets the same bits alone or in a batch), after
@@ -160,149 +109,6 @@ pub(super) fn rotate_symmetric_kicked(
     rotate_kicked_on_kernel(state, mass, h, impulse, LaneFlow::Symmetric { kicks: true });
 }
 
-/// The rotational part of a drift: the free flow over `h` at constant world `L`.
-#[inline]
-pub(super) fn rotate_freely(state: &mut BodyState, mass: &MassProperties, h: Real, flow: FreeFlow) {
-    if mass.is_spherical() {
-        state.rotation = rotate_exact(state.rotation, state.angular_velocity, h);
-        return;
-    }
-    let mut free = FreeState::new(state, mass);
-    flow(&mut free.body, free.r, h.widen());
-    free.write(state);
-}
-
-/// A non-spherical body's state as a free flow advances it: the [`FreeBody`], its reciprocal
-/// principal moments and its principal frame (see [`rotate_freely`]).
-pub(crate) struct FreeState {
-    pub(crate) body: FreeBody,
-    pub(crate) r: DVec3,
-    frame: DQuat,
-}
-
-impl FreeState {
-    /// The free body of `state`.
-    #[inline(always)]
-    pub(crate) fn new(state: &BodyState, mass: &MassProperties) -> Self {
-        let frame = mass.principal_frame().widen();
-        let q = state.rotation.widen() * frame;
-        let inertia = mass.principal_inertia().widen();
-        let r = DVec3::new(
-            reciprocal(inertia.x),
-            reciprocal(inertia.y),
-            reciprocal(inertia.z),
-        );
-        let body = FreeBody {
-            q,
-            m: inertia * rotate64(q.conjugate(), state.angular_velocity.widen()),
-        };
-        Self { body, r, frame }
-    }
-
-    /// Writes the flowed body back into `state`, rounded to the engine's precision.
-    #[inline(always)]
-    pub(crate) fn write(&self, state: &mut BodyState) {
-        let q = self.body.q.normalize();
-        state.angular_velocity = rotate64(q, self.r * self.body.m).narrow();
-        state.rotation = crate::math::quat_normalize((q * self.frame.conjugate()).narrow());
-    }
-}
-
-/// The angular kick `L += J` as `ω += I⁻¹ J` at the current pose (nothing for `J = 0`).
-#[inline(always)]
-pub(crate) fn kick_angular(state: &mut BodyState, mass: &MassProperties, impulse: Vec3) {
-    if impulse != Vec3::ZERO {
-        state.angular_velocity += mass.world_inv_inertia_mul(state.rotation, impulse);
-    }
-}
-
-/// The span of free rotation that completes `phase` of a drift–kick–drift step over `dt`: `½Δt`
-/// for either half, `Δt` for a whole torque-free step (see [`drift_kick_drift_translation`]).
-#[inline(always)]
-pub(crate) fn free_rotation_span(phase: StepPhase, dt: Real) -> Real {
-    match phase {
-        StepPhase::Whole => dt,
-        StepPhase::Begin | StepPhase::Finish => 0.5 * dt,
-    }
-}
-
-/// The translational part of `phase` of the drift–kick–drift step `D(Δt/2) ∘ K(Δt) ∘ D(Δt/2)`,
-/// the one sequence the scalar and the batched paths both run; a free rotation over
-/// [`free_rotation_span`] completes the phase:
-///
-/// - `Begin`, before forces are sampled: the first half drift's `x += ½Δt v`.
-/// - `Finish`: the kick `v += Δt F/m`, `L += Δt τ`, then the second half drift's `x += ½Δt v`.
-/// - `Whole` without torque: `x += ½Δt v; v += Δt F/m; x += ½Δt v` (exact for a constant force);
-///   with nothing to kick between them, the two half rotations are one, over `Δt`.
-///
-/// Returns false, leaving `state` untouched, for `Whole` under a torque: the torque must be
-/// kicked between the two half rotations, so that step is `Begin` then `Finish`.
-#[inline(always)]
-pub(crate) fn drift_kick_drift_translation(
-    phase: StepPhase,
-    state: &mut BodyState,
-    mass: &MassProperties,
-    wrench: &Wrench,
-    dt: Real,
-) -> bool {
-    let Some(impulse) = drift_kick_drift_linear(phase, state, mass, wrench, dt) else {
-        return false;
-    };
-    kick_angular(state, mass, impulse);
-    true
-}
-
-/// [`drift_kick_drift_translation`] without the angular kick: returns the angular impulse
-/// `J = Δt τ` that the phase's free rotation must take (zero outside `Finish`), or `None` for
-/// `Whole` under a torque.
-#[inline(always)]
-pub(crate) fn drift_kick_drift_linear(
-    phase: StepPhase,
-    state: &mut BodyState,
-    mass: &MassProperties,
-    wrench: &Wrench,
-    dt: Real,
-) -> Option<Vec3> {
-    let half = 0.5 * dt;
-    match phase {
-        StepPhase::Begin => state.position += half * state.linear_velocity,
-        StepPhase::Finish => {
-            state.linear_velocity += (dt * mass.inv_mass()) * wrench.force;
-            state.position += half * state.linear_velocity;
-            if wrench.torque != Vec3::ZERO {
-                return Some(dt * wrench.torque);
-            }
-        }
-        StepPhase::Whole if wrench.torque == Vec3::ZERO => {
-            state.position += half * state.linear_velocity;
-            state.linear_velocity += (dt * mass.inv_mass()) * wrench.force;
-            state.position += half * state.linear_velocity;
-        }
-        StepPhase::Whole => return None,
-    }
-    Some(Vec3::ZERO)
-}
-
-/// `phase` of the drift–kick–drift step with a method's free `rotation`.
-#[inline]
-pub(crate) fn drift_kick_drift(
-    phase: StepPhase,
-    state: &mut BodyState,
-    mass: &MassProperties,
-    wrench: &Wrench,
-    dt: Real,
-    rotation: Rotation,
-) {
-    if let Some(impulse) = drift_kick_drift_linear(phase, state, mass, wrench, dt) {
-        rotation(state, mass, free_rotation_span(phase, dt), impulse);
-        return;
-    }
-    for half in [StepPhase::Begin, StepPhase::Finish] {
-        let impulse = drift_kick_drift_linear(half, state, mass, wrench, dt).unwrap_or(Vec3::ZERO);
-        rotation(state, mass, free_rotation_span(half, dt), impulse);
-    }
-}
-
 impl FreeBody {
     /// Exact flow of the Casimir `½ k |m|²` for time `h`: rotation about the body momentum by
     /// `h k |m|` (`Q ← Q exp(θ m̂)`; `m` lies on the axis and is unchanged).
@@ -333,7 +139,8 @@ pub(super) fn symmetric_free_flow(body: &mut FreeBody, r: DVec3, odd: usize, h: 
 /// The `splitting` batch: each body's drift–kick–drift translation and linear kick, then its
 /// free rotation (which takes the angular kick, in `Finish`), queued for the SIMD kernel
 /// ([`PendingRotations`]), or stepped whole by `alone` when its translation cannot run first
-/// (a whole step under a torque).
+/// (a whole step under a torque). A body `switch` gives the exact flow takes `exact`'s stage:
+/// its rotation two bodies at a time ([`ExactPairs`]) where its translation runs first.
 #[inline(always)]
 pub(super) fn drift_kick_drift_batch(
     kernel: Kernel,
@@ -347,6 +154,8 @@ pub(super) fn drift_kick_drift_batch(
     let h = free_rotation_span(phase, dt);
     let flow = flow.with_kick(phase == StepPhase::Finish);
     let mut pending = PendingRotations::new(h, kernel, QueuedRotation::Free(flow));
+    // The bodies the switch gives `exact`, whose translation is the same drift–kick–drift.
+    let mut exact = ExactPairs::new(h);
     let mut next = BodyState::ZEROED;
     for i in 0..bodies.len() {
         bodies.prefetch(i + PREFETCH_AHEAD);
@@ -358,8 +167,15 @@ pub(super) fn drift_kick_drift_batch(
             && switch.applies_turned(&next, mass, bodies.spring_turn_rate(i))
         {
             let mut single = next;
-            switch.exact().stage(phase, &mut single, mass, &wrench, dt);
-            commit(bodies, i, &single);
+            if switch.exact() == Integrator::Exact
+                && !mass.is_spherical()
+                && drift_kick_drift_translation(phase, &mut single, mass, &wrench, dt)
+            {
+                exact.rotate(i, single, bodies);
+            } else {
+                switch.exact().stage(phase, &mut single, mass, &wrench, dt);
+                commit(bodies, i, &single);
+            }
             continue;
         }
         match drift_kick_drift_linear(phase, &mut next, mass, &wrench, dt) {
@@ -383,6 +199,7 @@ pub(super) fn drift_kick_drift_batch(
         }
     }
     pending.flush(bodies);
+    exact.finish(bodies);
 }
 
 /// The batch of whole composed steps (`yoshida4`): a body without torque takes the exact
@@ -400,8 +217,15 @@ pub(super) fn composed_step_batch(
 ) {
     let flow = LaneFlow::Composed(weights);
     let pending = PendingRotations::new(dt, kernel, QueuedRotation::Free(flow));
+    // A torque-free `exact4` step is the exact translation and one exact flow over `dt` (exact
+    // flows compose exactly; see `Integrator::step`): its rotation pairs with another's.
     let exact = |switch: ExactSwitch, s: &mut BodyState, m: &MassProperties, w: &Wrench| {
+        if switch.exact() == Integrator::Exact4 && w.torque == Vec3::ZERO && !m.is_spherical() {
+            drift_kick_drift_translation(StepPhase::Whole, s, m, w, dt);
+            return true;
+        }
         switch.exact().step(s, m, w, dt);
+        false
     };
     queued(pending, bodies, switch, exact, |next, mass, wrench| {
         if wrench.torque != Vec3::ZERO {

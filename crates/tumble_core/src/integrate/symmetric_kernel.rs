@@ -22,12 +22,12 @@
 //! (`r = 0`) and symmetric bodies need no branches.
 
 use super::frame::reciprocal;
-use super::lane_input::{LaneInput, LaneInputs, RotatedLanes, to_real};
+use super::lane_input::{LaneInput, LaneInputs, RotatedLanes};
 use super::lanes::{Quat4, Rotor, Vec3L, conjugate, mul, rotate};
 use super::rk4::rk4_flow;
 use crate::mass::MassProperties;
 use crate::math::{Quat, Real, Vec3, Widen};
-use crate::simd::{Counted, LANES, Lane, LaneKernel, OpCounts, counted, sin_cos};
+use crate::simd::{Counted, LANES, Lane, LaneKernel, OpCounts, Portable, counted, sin_cos};
 
 /// `(sin θ/2, cos θ/2)` of `angle` θ, and `(cos θ, sin θ)` from them by the double-angle
 /// formulas.
@@ -231,6 +231,15 @@ impl LaneFlow {
         )
     }
 
+    /// The composed flow's weights (none for the other flows).
+    #[inline(always)]
+    pub(super) fn weights(self) -> &'static [Real] {
+        match self {
+            LaneFlow::Composed(weights) => weights,
+            _ => &[],
+        }
+    }
+
     /// True when the flow runs in the relabelled frame whose odd axis is `x` (the symmetric-top
     /// flows); the others run in the principal frame as it is.
     #[inline(always)]
@@ -250,28 +259,6 @@ impl LaneFlow {
     }
 }
 
-/// The free rotation of `flow` over `h`, in lanes: the kick (when the flow has one), the flow,
-/// then the new world angular velocity `ω' = Q (r ⊙ m)` and orientation
-/// `q' = normalize(Q F'ᵀ)` (unit, f64). See the module documentation for the sequence.
-#[inline(always)]
-pub(super) fn symmetric_rotation<T: Lane>(
-    input: &LaneInput<T>,
-    h: T,
-    flow: LaneFlow,
-) -> (Quat4<T>, Vec3L<T>) {
-    let mut flowing = Flowing::start(input, flow.kicks());
-    flowing.flow(h, flow);
-    let Flowing {
-        free: Free { q, m },
-        r,
-        frame,
-    } = flowing;
-    let omega = rotate(q, [r[0] * m[0], r[1] * m[1], r[2] * m[2]]);
-    let [x, y, z, w] = mul(q, conjugate(frame));
-    let inv = T::splat(w.cpu(), 1.0) / (x * x + y * y + z * z + w * w).sqrt();
-    ([x * inv, y * inv, z * inv, w * inv], omega)
-}
-
 /// The floating-point operations of one body's free rotation through this kernel (after a kick
 /// when `kicks`), counted by running it on a lane that counts: a body with distinct moments at
 /// game rates (I = (1, 2, 3), |ω| ≈ 1 rad/s, Δt = 1/60), whose angles take the sine's
@@ -287,16 +274,12 @@ pub fn symmetric_rotation_flops(kicks: bool) -> OpCounts {
         &mass,
     )
     .with_impulse(Vec3::new(0.01, 0.0, -0.02));
-    let lanes = LaneInput::<Counted> {
-        rotation: input.rotation.map(Counted),
-        omega: input.omega.map(Counted),
-        frame: input.frame.map(Counted),
-        relabel: input.relabel.map(Counted),
-        inertia: input.inertia.map(Counted),
-        impulse: input.impulse.map(Counted),
-        spherical: Counted(input.spherical),
+    let one = OneInput {
+        input: &input,
+        h: 1.0 / 60.0,
     };
-    counted(|| symmetric_rotation(&lanes, Counted(1.0 / 60.0), LaneFlow::Symmetric { kicks })).1
+    let rotation = SymmetricLanes::<_, ANY>::new(one, LaneFlow::Symmetric { kicks });
+    counted(|| rotation.run::<Counted>(Portable)).1
 }
 
 /// The turn `C` of `flow` over `h` from the identity (`Q₁ = Q₀ C`, unnormalized) of a body with
@@ -321,74 +304,140 @@ pub(super) fn turn_from_momentum(flow: LaneFlow, m: [f64; 3], r: [f64; 3], h: f6
 /// engine precision once.
 #[inline]
 pub(super) fn rotate_symmetric_one(input: &LaneInput, h: Real, flow: LaneFlow) -> (Quat, Vec3) {
-    let (q, w) = symmetric_rotation::<f64>(input, h.widen(), flow);
-    to_real(q, w)
+    let one = OneInput {
+        input,
+        h: h.widen(),
+    };
+    SymmetricLanes::<_, ANY>::new(one, flow)
+        .run::<f64>(Portable)
+        .lane(0)
 }
 
 /// The kinds of [`LaneFlow`] as constants: one compilation of the kernel per kind of flow, its
 /// kind a constant (one compilation holding every kind's code runs the hot `splitting` flow
-/// measurably slower: the free-body rows of `tumble bench`).
+/// measurably slower: the free-body rows of `tumble bench`). [`ANY`] takes the flow's kind as
+/// it comes (the one-body step, which compiles the kernel once for every kind).
 pub(super) const SYMMETRIC: u8 = 0;
 pub(super) const COMPOSED: u8 = 1;
 pub(super) const XYZ: u8 = 2;
 pub(super) const RK4: u8 = 3;
+pub(super) const ANY: u8 = 4;
 
-/// The flow of kind `KIND`.
+/// `flow` with its kind made the constant `KIND` (its kick and weights kept), or as it is for
+/// [`ANY`].
 #[inline(always)]
-fn flow_of<const KIND: u8>(kicks: bool, weights: &'static [Real]) -> LaneFlow {
+fn of_kind<const KIND: u8>(flow: LaneFlow) -> LaneFlow {
+    let kicks = flow.kicks();
     match KIND {
         SYMMETRIC => LaneFlow::Symmetric { kicks },
-        COMPOSED => LaneFlow::Composed(weights),
+        COMPOSED => LaneFlow::Composed(flow.weights()),
         XYZ => LaneFlow::Xyz { kicks },
-        _ => LaneFlow::Rk4 { kicks },
+        RK4 => LaneFlow::Rk4 { kicks },
+        _ => flow,
     }
 }
 
-/// [`LANES`] bodies' free rotations of kind `KIND` (SIMD lanes), each over its own `h` (after
-/// the kick of its impulse for a kicking flow), run on a kernel path by
-/// [`run_on`](crate::simd::run_on): lane `i` of the result is bit-identical to
-/// [`rotate_symmetric_one`]`(&inputs.get(i), h[i], flow)` on every path.
-pub(super) struct SymmetricLanes<'a, const KIND: u8> {
-    inputs: &'a LaneInputs,
-    h: [Real; LANES],
-    kicks: bool,
-    weights: &'static [Real],
+/// Where a rotation kernel reads its bodies and their spans `h`: a queued batch of [`LANES`]
+/// ([`QueuedInputs`]) or one body ([`OneInput`]).
+pub(super) trait RotationInputs {
+    /// How many bodies.
+    const BODIES: usize;
+
+    /// Bodies `start..start + T::WIDTH` as lanes (their angular impulses when `kicks`), and
+    /// their spans.
+    fn load<T: Lane>(&self, cpu: T::Cpu, start: usize, kicks: bool) -> (LaneInput<T>, T);
 }
 
-impl<'a, const KIND: u8> SymmetricLanes<'a, KIND> {
-    /// The rotations of `inputs` over `h`, `kicks` (when the kind has a kick) and the composed
-    /// flow's `weights` (`&[]` for the other kinds).
+/// A queued batch's inputs, component by component, and each body's span.
+pub(super) struct QueuedInputs<'a> {
+    /// The bodies, [`LANES`] of them.
+    pub inputs: &'a LaneInputs,
+    /// Each body's span.
+    pub h: [Real; LANES],
+}
+
+impl RotationInputs for QueuedInputs<'_> {
+    const BODIES: usize = LANES;
+
+    /// One vector load per input component of the run.
     #[inline(always)]
-    pub(super) fn new(
-        inputs: &'a LaneInputs,
-        h: [Real; LANES],
-        kicks: bool,
-        weights: &'static [Real],
-    ) -> Self {
-        Self {
-            inputs,
-            h,
-            kicks,
-            weights,
-        }
+    fn load<T: Lane>(&self, cpu: T::Cpu, start: usize, kicks: bool) -> (LaneInput<T>, T) {
+        let input = self.inputs.load::<T>(cpu, start, true, kicks, false);
+        (input, T::load_real(cpu, &self.h[start..]))
     }
 }
 
-impl<const KIND: u8> LaneKernel for SymmetricLanes<'_, KIND> {
+/// One body's inputs and span, in `f64`.
+pub(super) struct OneInput<'a> {
+    /// The body.
+    pub input: &'a LaneInput,
+    /// Its span.
+    pub h: f64,
+}
+
+impl RotationInputs for OneInput<'_> {
+    const BODIES: usize = 1;
+
+    /// The body in every lane of `T` (`f64`, or a lane that counts).
+    #[inline(always)]
+    fn load<T: Lane>(&self, cpu: T::Cpu, _: usize, _: bool) -> (LaneInput<T>, T) {
+        let lane = |x: f64| T::splat(cpu, x);
+        let one = self.input;
+        let input = LaneInput {
+            rotation: one.rotation.map(lane),
+            omega: one.omega.map(lane),
+            frame: one.frame.map(lane),
+            relabel: one.relabel.map(lane),
+            inertia: one.inertia.map(lane),
+            impulse: one.impulse.map(lane),
+            spherical: lane(one.spherical),
+        };
+        (input, lane(self.h))
+    }
+}
+
+/// The free rotations of flow kind `KIND` (see [`of_kind`]) of the bodies of `S`, each over its
+/// own `h` (after the kick of its impulse for a kicking flow), run on a kernel path by
+/// [`run_on!`](crate::simd::run_on): lane `i` of a queued batch's result is bit-identical to
+/// [`rotate_symmetric_one`]`(&inputs.get(i), h[i], flow)` on every path.
+pub(super) struct SymmetricLanes<S, const KIND: u8> {
+    inputs: S,
+    flow: LaneFlow,
+}
+
+impl<S: RotationInputs, const KIND: u8> SymmetricLanes<S, KIND> {
+    /// The rotations of `inputs` under `flow` (of kind `KIND`, unless that is [`ANY`]).
+    #[inline(always)]
+    pub(super) fn new(inputs: S, flow: LaneFlow) -> Self {
+        Self { inputs, flow }
+    }
+}
+
+impl<S: RotationInputs, const KIND: u8> LaneKernel for SymmetricLanes<S, KIND> {
     type Output = RotatedLanes;
 
-    /// Rotates the bodies in runs of `T::WIDTH`: loads each input component of a run with one
-    /// vector load, rotates, rounds the results to the engine precision.
+    /// The free rotation, run by run of `T::WIDTH` bodies: the kick (when the flow has one)
+    /// and the flow of `Q` and `m` (see the module documentation), then the new world angular
+    /// velocity `ω' = Q (r ⊙ m)` and orientation `q' = normalize(Q F'ᵀ)` (unit, f64), rounded
+    /// to the engine precision.
     #[inline(always)]
     fn run<T: Lane>(self, cpu: T::Cpu) -> RotatedLanes {
-        let flow = flow_of::<KIND>(self.kicks, self.weights);
+        let flow = of_kind::<KIND>(self.flow);
         let mut out = RotatedLanes::new();
         let mut start = 0;
-        while start < LANES {
-            let input = self.inputs.load::<T>(cpu, start, true, flow.kicks(), false);
-            let h = T::load_real(cpu, &self.h[start..]);
-            let (q, omega) = symmetric_rotation::<T>(&input, h, flow);
-            out.store(start, q, omega);
+        while start < S::BODIES {
+            let (input, h) = self.inputs.load::<T>(cpu, start, flow.kicks());
+            let mut flowing = Flowing::start(&input, flow.kicks());
+            flowing.flow(h, flow);
+            let Flowing {
+                free: Free { q, m },
+                r,
+                frame,
+            } = flowing;
+            let omega = rotate(q, [r[0] * m[0], r[1] * m[1], r[2] * m[2]]);
+            let [x, y, z, w] = mul(q, conjugate(frame));
+            let inv = T::splat(cpu, 1.0) / (x * x + y * y + z * z + w * w).sqrt();
+            out.store(start, [x * inv, y * inv, z * inv, w * inv], omega);
             start += T::WIDTH;
         }
         out
@@ -411,22 +460,16 @@ mod tests {
         h: [Real; LANES],
         flow: LaneFlow,
     ) -> RotatedLanes {
-        let kicks = flow.kicks();
+        let queued = QueuedInputs { inputs, h };
         match flow {
-            LaneFlow::Symmetric { .. } => run_on(
-                kernel,
-                SymmetricLanes::<SYMMETRIC>::new(inputs, h, kicks, &[]),
-            ),
-            LaneFlow::Composed(weights) => run_on(
-                kernel,
-                SymmetricLanes::<COMPOSED>::new(inputs, h, kicks, weights),
-            ),
-            LaneFlow::Xyz { .. } => {
-                run_on(kernel, SymmetricLanes::<XYZ>::new(inputs, h, kicks, &[]))
+            LaneFlow::Symmetric { .. } => {
+                run_on!(kernel, SymmetricLanes::<_, SYMMETRIC>::new(queued, flow))
             }
-            LaneFlow::Rk4 { .. } => {
-                run_on(kernel, SymmetricLanes::<RK4>::new(inputs, h, kicks, &[]))
+            LaneFlow::Composed(_) => {
+                run_on!(kernel, SymmetricLanes::<_, COMPOSED>::new(queued, flow))
             }
+            LaneFlow::Xyz { .. } => run_on!(kernel, SymmetricLanes::<_, XYZ>::new(queued, flow)),
+            LaneFlow::Rk4 { .. } => run_on!(kernel, SymmetricLanes::<_, RK4>::new(queued, flow)),
         }
     }
 

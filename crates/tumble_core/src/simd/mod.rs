@@ -30,7 +30,7 @@ mod avx2;
 #[cfg(target_arch = "x86_64")]
 mod avx512;
 mod counting;
-mod dispatch;
+pub(crate) mod dispatch;
 mod pair;
 mod path;
 mod portable;

@@ -5,7 +5,7 @@
 use glam::{DQuat, DVec3};
 
 use super::exact_free_flow;
-use crate::integrate::splitting::FreeBody;
+use crate::integrate::drift_kick_drift::FreeBody;
 use tumble_reference::exact::TorqueFreeTop;
 
 /// Angle of `a* b`, in radians, from its sine and cosine halves (`acos` of a dot product near 1
