@@ -8,7 +8,7 @@ use serde::Serialize;
 use crate::energy::EnergyTrace;
 use crate::springs::SpringRun;
 use crate::stability::Cell;
-use crate::workprec::Point;
+use crate::workprec::{Point, headline_error, work_us};
 use tumble_core::math::REAL_NAME;
 
 /// Where and on what the report was measured.
@@ -116,15 +116,6 @@ impl Results {
             thin_plate,
             f32_storage: Vec::new(),
         }
-    }
-}
-
-/// The error that matters for a scene: orientation for rotating scenes, position otherwise.
-pub fn headline_error(p: &Point) -> f64 {
-    if p.scene.starts_with("top") || p.scene == "dzhanibekov" {
-        p.orientation_error_rad
-    } else {
-        p.position_error_m.max(p.orientation_error_rad)
     }
 }
 
@@ -423,9 +414,4 @@ pub fn thin_plate_section(rows: &[crate::thin::ThinRow]) -> String {
     }
     out.push('\n');
     out
-}
-
-/// Run time to simulate the scene's horizon for one body (µs): the work of a work–precision plot.
-pub(crate) fn work_us(p: &Point) -> f64 {
-    p.ns_per_body_step * p.steps as f64 / 1e3
 }

@@ -6,9 +6,8 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use crate::energy::EnergyTrace;
-use crate::output::{headline_error, work_us};
 use crate::stability::Cell;
-use crate::workprec::Point;
+use crate::workprec::{Point, headline_error, work_us};
 
 /// Draws the SVG file `file` in `dir`, `size` pixels on a white background, with `draw`, and
 /// returns `file`.

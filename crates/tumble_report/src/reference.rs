@@ -136,7 +136,7 @@ pub fn cases() -> Vec<Case> {
             "thin-plate",
             "torque-free thin asymmetric plate, I = (0.01, 1, 1.01), |ω₀| = 10 rad/s about a \
              tilted axis (0.3, 1, 0.5)",
-            crate::thin::PLATE,
+            PLATE,
             Vec3::new(0.3, 1.0, 0.5).normalize() * 10.0,
         ),
         Case {
@@ -189,6 +189,10 @@ pub fn cases() -> Vec<Case> {
         },
     ]
 }
+
+/// Principal moments of the thin asymmetric plate (kg·m²), the `thin-plate` case and the
+/// [`thin`](crate::thin) study.
+pub const PLATE: Vec3 = Vec3::new(0.01, 1.0, 1.01);
 
 /// f64 → f32 quaternion.
 pub fn to_quat(q: DQuat) -> Quat {

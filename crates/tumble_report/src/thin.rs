@@ -12,10 +12,8 @@ use tumble_core::rotation::angle_between;
 use tumble_core::{BodyState, Integrator, Mass, MassProperties, Wrench};
 use tumble_reference::exact::TorqueFreeTop;
 
+pub use crate::reference::PLATE;
 use crate::reference::to_quat;
-
-/// Principal moments of the plate (kg·m²).
-pub const PLATE: Vec3 = Vec3::new(0.01, 1.0, 1.01);
 
 /// The spin rates measured, as `|ω|Δt`.
 pub const OMEGA_DTS: [Real; 4] = [0.1, 0.3, 1.0, 3.0];

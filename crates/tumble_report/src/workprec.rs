@@ -194,3 +194,17 @@ pub fn measure(case: &Case, method: Method, dt: f64, effort: Effort) -> Point {
         finite,
     }
 }
+
+/// The error that matters for a scene: orientation for rotating scenes, position otherwise.
+pub fn headline_error(p: &Point) -> f64 {
+    if p.scene.starts_with("top") || p.scene == "dzhanibekov" {
+        p.orientation_error_rad
+    } else {
+        p.position_error_m.max(p.orientation_error_rad)
+    }
+}
+
+/// Run time to simulate the scene's horizon for one body (µs): the work of a work–precision plot.
+pub(crate) fn work_us(p: &Point) -> f64 {
+    p.ns_per_body_step * p.steps as f64 / 1e3
+}

@@ -18,9 +18,11 @@ use crate::text::terminal_safe;
 use crate::validate::{Checker, Locate, NoText, TomlText};
 
 use crate::checks::{
-    bad_name, bad_text, checked_body, checked_extras, compose_names, unknown_name, validate_body,
-    validate_forces, validate_world, wrong_length,
+    bad_name, bad_text, checked_body, checked_extras, compose_names, validate_body,
+    validate_forces, validate_world,
 };
+use crate::model::{SceneForce, ValidBody};
+use crate::validate::{unknown_name, wrong_length};
 
 /// A scene that passed every check: it builds a world without failing.
 ///
@@ -54,55 +56,6 @@ pub struct SceneBody {
     pub angular_damping: Real,
 }
 
-#[derive(Debug, Clone, PartialEq)]
-pub(crate) struct ValidBody {
-    pub(crate) mass: MassProperties,
-    pub(crate) transform: Pose,
-    pub(crate) velocity: Velocity,
-    pub(crate) gravity_scale: Real,
-    pub(crate) damping: Damping,
-}
-
-/// A force generator of a [`Scene`] as its checks accepted it: bodies by their index in file
-/// order ([`Scene::body_states`]), vectors and numbers in the engine precision.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum SceneForce {
-    /// A constant force on `body`, at its centre of mass or at `point` (body frame).
-    Constant {
-        /// The body's index.
-        body: usize,
-        /// The force (N), world frame.
-        force: Vec3,
-        /// Where it acts, body coordinates relative to the origin; `None`: the centre of mass.
-        point: Option<Vec3>,
-    },
-    /// A constant torque on `body`.
-    Torque {
-        /// The body's index.
-        body: usize,
-        /// The torque (N·m), world frame.
-        torque: Vec3,
-    },
-    /// A spring from `anchor_a` on body `a` to `anchor_b` on body `b` (body coordinates), or to
-    /// the world point `anchor_b` when `b` is `None`.
-    Spring {
-        /// The first body's index.
-        a: usize,
-        /// The anchor on `a`.
-        anchor_a: Vec3,
-        /// The other body's index, or `None` for a world point.
-        b: Option<usize>,
-        /// The anchor on `b`, or the world point.
-        anchor_b: Vec3,
-        /// Stiffness (N/m), `>= 0`.
-        k: Real,
-        /// Damping (N·s/m), `>= 0`.
-        c: Real,
-        /// Rest length (m), `>= 0`.
-        rest: Real,
-    },
-}
-
 /// A world built from a scene, with its planned schedule and the bodies in file order.
 pub struct BuiltScene {
     /// The world.
@@ -133,13 +86,6 @@ impl SceneSyntax {
         }
     }
 }
-
-/// Largest accepted step count.
-pub const MAX_STEPS: u64 = 1_000_000_000;
-
-/// Most substeps per step a scene may ask for: each costs a whole step, so beyond this a smaller
-/// `dt` is the honest setting.
-pub const MAX_SUBSTEPS: u32 = 1000;
 
 impl Scene {
     /// Parses and validates scene text; `file` names it in errors.
@@ -284,7 +230,7 @@ impl Scene {
         self.settings
     }
 
-    /// Number of steps, `1..=`[`MAX_STEPS`].
+    /// Number of steps, `1..=`[`MAX_STEPS`](crate::MAX_STEPS).
     pub fn steps(&self) -> u64 {
         self.steps
     }

@@ -19,7 +19,7 @@ use crate::text::{is_unsafe_char, terminal_safe};
 use crate::validate::{Checker, NoText};
 use tumble_core::error::compact;
 
-use crate::build::{MAX_STEPS, MAX_SUBSTEPS, SceneForce, ValidBody};
+use crate::model::{MAX_STEPS, MAX_SUBSTEPS, SceneForce, ValidBody};
 
 /// Body `i` of a scene in engine form: [`validate_body`] again, which cannot fail on a body
 /// that passed it when the scene was parsed (a `Scene`'s model is not changed in place).
@@ -447,20 +447,6 @@ pub(crate) fn mass_error(ck: &Checker<'_>, i: usize, e: tumble_core::InvalidInpu
              finite and > 0 in {REAL_NAME}"
         ),
     )
-}
-
-/// `k` from the messages "unknown field `k`, …" and "unknown variant `k`, …".
-pub(crate) fn unknown_name(message: &str) -> Option<&str> {
-    let rest = message
-        .strip_prefix("unknown field `")
-        .or_else(|| message.strip_prefix("unknown variant `"))?;
-    rest.split_once('`').map(|(name, _)| name)
-}
-
-/// `M` from the message "expected N numbers, got M" of a fixed-length array.
-pub(crate) fn wrong_length(message: &str) -> Option<usize> {
-    let rest = message.split_once("numbers, got ")?.1;
-    rest.trim().parse().ok()
 }
 
 /// Puts every name of the model (the scene's, the bodies', and those the forces refer to) in

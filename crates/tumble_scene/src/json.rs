@@ -120,11 +120,11 @@ fn located(file: &str, mut input: impl BufRead, source: JsonSource<'_>) -> Optio
     let mut line = inner.line();
     let mut field = field;
     let steps = path_steps(&field);
-    if let Some(name) = crate::checks::unknown_name(&message).filter(|_| !steps.is_empty()) {
+    if let Some(name) = crate::validate::unknown_name(&message).filter(|_| !steps.is_empty()) {
         let mut with_key = steps.clone();
         with_key.push(Step::Key(name));
         line = source.line(&with_key).max(source.line(&steps));
-    } else if let Some(len) = crate::checks::wrong_length(&message).filter(|_| !steps.is_empty())
+    } else if let Some(len) = crate::validate::wrong_length(&message).filter(|_| !steps.is_empty())
         && let Some((key, at)) = source
             .open()
             .and_then(|input| array_member_of_len(input, &steps, len))

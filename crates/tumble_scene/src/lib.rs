@@ -20,6 +20,7 @@ mod format;
 mod json;
 mod json_locate;
 pub mod many;
+mod model;
 pub mod output;
 mod spawn;
 pub mod text;
@@ -27,10 +28,11 @@ mod tool;
 mod trajectory;
 mod validate;
 
-pub use build::{BuiltScene, MAX_STEPS, MAX_SUBSTEPS, Scene, SceneBody, SceneForce, SceneSyntax};
+pub use build::{BuiltScene, Scene, SceneBody, SceneSyntax};
 pub use checks::MAX_NAME_BYTES;
 pub use error::{SaveError, SceneError};
 pub use format::{BodyDef, ForceDef, SceneFile, ShapeDef, WorldDef};
+pub use model::{MAX_STEPS, MAX_SUBSTEPS, SceneForce};
 pub use trajectory::{
     CSV_HEADER, Recording, TrajectoryError, TrajectoryStats, csv_text_cell, write_trajectory,
 };

@@ -16,7 +16,7 @@ use tumble_ecs::components::{ImplicitBody, SpringTurn};
 use tumble_ecs::prelude::*;
 use tumble_ecs::springs::Classification;
 
-use crate::build::ValidBody;
+use crate::model::ValidBody;
 
 /// A body to spawn and what it carries besides its state.
 pub(crate) struct BodySpawn {

@@ -377,3 +377,17 @@ impl Checker<'_> {
         Ok(Vec3::from_array(out))
     }
 }
+
+/// `k` from the messages "unknown field `k`, …" and "unknown variant `k`, …".
+pub(crate) fn unknown_name(message: &str) -> Option<&str> {
+    let rest = message
+        .strip_prefix("unknown field `")
+        .or_else(|| message.strip_prefix("unknown variant `"))?;
+    rest.split_once('`').map(|(name, _)| name)
+}
+
+/// `M` from the message "expected N numbers, got M" of a fixed-length array.
+pub(crate) fn wrong_length(message: &str) -> Option<usize> {
+    let rest = message.split_once("numbers, got ")?.1;
+    rest.trim().parse().ok()
+}
