@@ -57,57 +57,187 @@ pub fn apply_gravity(
     }
 }
 
-/// Applies every [`ConstantForce`]: its force, and the torque of a force at a body point about
-/// the centre of mass (for a body of an implicit spring group, the point goes to the implicit
-/// solve instead, which takes that torque at mid-step: see [`ImplicitBody`]).
-pub fn apply_constant_forces(
-    generators: IndexedQuery<ConstantForce, ()>,
-    local_generators: IndexedQuery<ConstantLocalForce, ()>,
-    mut bodies: ForceTargets,
-    mut rows: Local<TargetRows>,
-    mut implicit: Query<&mut ImplicitBody>,
-    mut orders: Local<[IndexOrder; 2]>,
-) {
-    let mut targets = Targets::of(&mut bodies, &mut rows);
-    // Looked up only where some body is in an implicit group: a lookup per force otherwise.
-    let any_implicit = !implicit.is_empty();
-    let mut apply = |body: Entity, force: Vec3, in_body_frame: bool, local_point: Option<Vec3>| {
+/// What one constant force adds to its body's accumulator: the force, and the torque of a
+/// force at a body point about the centre of mass. Computed from the body's pose alone, so many
+/// forces can be computed at once; added in generator order, so the sums are the same whatever
+/// computed them.
+#[derive(Debug, Clone, Copy, Default)]
+enum ForcePush {
+    /// The body is missing: nothing.
+    #[default]
+    Nothing,
+    /// A force through the centre of mass.
+    Force(Vec3),
+    /// A force at a point, and its torque `(p − x) × F`.
+    AtPoint { force: Vec3, torque: Vec3 },
+}
+
+impl ForcePush {
+    /// The push of a force on `body` (given in the body's frame when `in_body_frame`, turned
+    /// into the world by the body's rotation), at the body-local `local_point` or the centre of
+    /// mass, with the body as `targets` holds it.
+    #[inline]
+    fn of(
+        body: Entity,
+        force: Vec3,
+        in_body_frame: bool,
+        local_point: Option<Vec3>,
+        targets: &Targets,
+    ) -> Self {
         let Some((transform, mass)) = targets.body(body) else {
-            return;
+            return Self::Nothing;
         };
         let force = if in_body_frame {
             quat_rotate(transform.rotation, force)
         } else {
             force
         };
-        let Some(local) = local_point else {
-            targets.push(body, |acc| acc.add_force(force));
-            return;
-        };
-        if any_implicit && let Ok(mut implicit) = implicit.get_mut(body) {
-            // The implicit step takes the torque of a force at a point at mid-step (it turns
-            // with the body): the force goes to the accumulator, its point to the solve.
-            implicit.add_point_force(local - mass.local_center_of_mass(), force);
-            targets.push(body, |acc| acc.add_force(force));
-            return;
+        match local_point {
+            None => Self::Force(force),
+            Some(local) => {
+                let (point, center) = anchor_point(transform, mass, local);
+                Self::AtPoint {
+                    force,
+                    torque: (point - center).cross(force),
+                }
+            }
         }
-        let (point, center) = (
-            transform.transform_point(local),
-            transform.center_of_mass(mass),
-        );
-        targets.push(body, |acc| acc.add_force_at_point(force, point, center));
-    };
-    // World-frame forces first, then body-frame ones, each in entity order (see
-    // [`IndexOrder`]: a body's sum must not follow the order a query visits tables in).
+    }
+
+    /// Adds the push to `body`'s accumulator (the bits of
+    /// [`ForceAccumulator::add_force_at_point`] for a force at a point).
+    #[inline]
+    fn apply(self, body: Entity, targets: &mut Targets) {
+        match self {
+            Self::Nothing => {}
+            Self::Force(force) => targets.push(body, |acc| acc.add_force(force)),
+            Self::AtPoint { force, torque } => targets.push(body, |acc| {
+                acc.add_force(force);
+                acc.add_torque(torque);
+            }),
+        }
+    }
+}
+
+/// The pushes of one run of [`apply_constant_forces`] on the compute pool, kept between steps
+/// so that a step does not allocate.
+#[derive(Debug, Default)]
+pub struct ForcePushes(Vec<ForcePush>);
+
+/// Applies every [`ConstantForce`] and [`ConstantLocalForce`]: its force, and the torque of a
+/// force at a body point about the centre of mass (for a body of an implicit spring group, the
+/// point goes to the implicit solve instead, which takes that torque at mid-step: see
+/// [`ImplicitBody`]).
+///
+/// World-frame forces first, then body-frame ones, each in entity order ([`IndexOrder`]: a
+/// body's sum must not follow the order a query visits tables in). With [`Parallelism`] and
+/// enough forces, in a world without implicit groups, the pushes are computed on the compute
+/// pool's threads and added on this thread in that order, as [`apply_springs`] does: the same
+/// bits for any thread count.
+pub fn apply_constant_forces(
+    generators: IndexedQuery<ConstantForce, ()>,
+    local_generators: IndexedQuery<ConstantLocalForce, ()>,
+    mut bodies: ForceTargets,
+    mut rows: Local<TargetRows>,
+    mut implicit: Query<&mut ImplicitBody>,
+    (mut orders, mut pushes): (Local<[IndexOrder; 2]>, Local<ForcePushes>),
+    parallelism: Option<Res<Parallelism>>,
+) {
+    let mut targets = Targets::of(&mut bodies, &mut rows);
+    let parallelism = parallelism.map_or_else(Parallelism::default, |p| *p);
+    // Looked up only where some body is in an implicit group: a lookup per force otherwise.
+    let any_implicit = !implicit.is_empty();
     let [world_frame, body_frame] = &mut *orders;
     world_frame.refresh(&generators);
-    world_frame.for_each(&generators, |g| {
-        apply(g.body, g.force, false, g.local_point)
-    });
     body_frame.refresh(&local_generators);
-    body_frame.for_each(&local_generators, |g| {
-        apply(g.body, g.force, true, g.local_point);
-    });
+    let threads = |order: &IndexOrder, count: usize, targets: &Targets| match targets {
+        // Forces on implicit bodies hand their points to the solve, on this thread.
+        _ if any_implicit || !order.is_query_order() => 1,
+        Targets::Tables { .. } => parallelism.threads_for(count),
+        // The query's own lookups are not shared between threads.
+        Targets::Query(_) => 1,
+    };
+    let pushes = &mut pushes.0;
+    let world_threads = threads(world_frame, generators.iter().len(), &targets);
+    if world_threads > 1 {
+        for (_, table) in dense(generators.contiguous_iter()) {
+            push_in_blocks(
+                table,
+                world_threads,
+                pushes,
+                &mut targets,
+                |g: &ConstantForce, targets| {
+                    ForcePush::of(g.body, g.force, false, g.local_point, targets)
+                },
+                |g, push, targets| push.apply(g.body, targets),
+            );
+        }
+    } else {
+        world_frame.for_each(&generators, |g| {
+            apply_force(
+                &mut targets,
+                &mut implicit,
+                any_implicit,
+                g.body,
+                g.force,
+                false,
+                g.local_point,
+            );
+        });
+    }
+    let body_threads = threads(body_frame, local_generators.iter().len(), &targets);
+    if body_threads > 1 {
+        for (_, table) in dense(local_generators.contiguous_iter()) {
+            push_in_blocks(
+                table,
+                body_threads,
+                pushes,
+                &mut targets,
+                |g: &ConstantLocalForce, targets| {
+                    ForcePush::of(g.body, g.force, true, g.local_point, targets)
+                },
+                |g, push, targets| push.apply(g.body, targets),
+            );
+        }
+    } else {
+        body_frame.for_each(&local_generators, |g| {
+            apply_force(
+                &mut targets,
+                &mut implicit,
+                any_implicit,
+                g.body,
+                g.force,
+                true,
+                g.local_point,
+            );
+        });
+    }
+}
+
+/// One constant force on this thread: its push, or for a force at a point of a body in an
+/// implicit group, the force to the accumulator and its point to the solve (which takes the
+/// torque at mid-step, as the body turns).
+#[inline]
+fn apply_force(
+    targets: &mut Targets,
+    implicit: &mut Query<&mut ImplicitBody>,
+    any_implicit: bool,
+    body: Entity,
+    force: Vec3,
+    in_body_frame: bool,
+    local_point: Option<Vec3>,
+) {
+    let push = ForcePush::of(body, force, in_body_frame, local_point, targets);
+    if any_implicit
+        && let (ForcePush::AtPoint { force, .. }, Some(local)) = (push, local_point)
+        && let Ok(mut implicit) = implicit.get_mut(body)
+        && let Some((_, mass)) = targets.body(body)
+    {
+        implicit.add_point_force(local - mass.local_center_of_mass(), force);
+        targets.push(body, |acc| acc.add_force(force));
+        return;
+    }
+    push.apply(body, targets);
 }
 
 /// Applies every [`ConstantTorque`], in entity order.
@@ -237,9 +367,9 @@ impl SpringPush {
     }
 }
 
-/// Springs whose pushes [`apply_springs`] computes on the pool at once, then adds in order: the
-/// buffer stays a few megabytes however many springs there are, and a block is long enough
-/// that handing it out costs little beside its work.
+/// Springs (or forces) whose pushes [`apply_springs`] ([`apply_constant_forces`]) computes on
+/// the pool at once, then adds in order: the buffer stays a few megabytes however many there
+/// are, and a block is long enough that handing it out costs little beside its work.
 const PUSH_BLOCK: usize = 1 << 15;
 
 /// The springs' pushes of one run of [`apply_springs`] on the compute pool, kept between steps
@@ -280,25 +410,47 @@ pub fn apply_springs(
         });
         return;
     }
-    let pushes = &mut pushes.0;
     for (_, table) in dense(springs.contiguous_iter()) {
-        for block in table.chunks(PUSH_BLOCK) {
-            pushes.clear();
-            pushes.resize(block.len(), SpringPush::Nothing);
-            let per = block.len().div_ceil(threads).max(1);
-            let shared = &targets;
-            scope(|spawn| {
-                for (springs, out) in block.chunks(per).zip(pushes.chunks_mut(per)) {
-                    spawn(Box::new(move || {
-                        for (spring, push) in springs.iter().zip(out) {
-                            *push = SpringPush::of(spring, shared);
-                        }
-                    }));
-                }
-            });
-            for (spring, push) in block.iter().zip(pushes.iter()) {
-                push.apply(spring, &mut targets);
+        push_in_blocks(
+            table,
+            threads,
+            &mut pushes.0,
+            &mut targets,
+            SpringPush::of,
+            |spring, push, targets| push.apply(spring, targets),
+        );
+    }
+}
+
+/// Computes `of(item, targets)` for every item of `table` on `threads` threads of the compute
+/// pool, [`PUSH_BLOCK`] items at a time into `pushes`, then hands each item and its push to
+/// `apply` on this thread, in table order: the work that only reads the bodies runs at once,
+/// the additions to the accumulators in one fixed order, so the sums are the same bits on any
+/// number of threads.
+fn push_in_blocks<T: Sync, P: Copy + Default + Send + Sync>(
+    table: &[T],
+    threads: usize,
+    pushes: &mut Vec<P>,
+    targets: &mut Targets,
+    of: impl Fn(&T, &Targets) -> P + Sync,
+    mut apply: impl FnMut(&T, P, &mut Targets),
+) {
+    for block in table.chunks(PUSH_BLOCK) {
+        pushes.clear();
+        pushes.resize(block.len(), P::default());
+        let per = block.len().div_ceil(threads).max(1);
+        let (shared, of) = (&*targets, &of);
+        scope(|spawn| {
+            for (items, out) in block.chunks(per).zip(pushes.chunks_mut(per)) {
+                spawn(Box::new(move || {
+                    for (item, push) in items.iter().zip(out) {
+                        *push = of(item, shared);
+                    }
+                }));
             }
+        });
+        for (item, push) in block.iter().zip(pushes.iter()) {
+            apply(item, *push, targets);
         }
     }
 }

@@ -132,8 +132,8 @@ fn ecs_matches_the_raw_loop_bit_for_bit() {
     }
 }
 
-/// A large mixed world (free bodies under gravity, bodies with accumulators, springs, spheres,
-/// asymmetric and locked-axis bodies) stepped with the given threading policy.
+/// A large mixed world (free bodies under gravity, bodies with accumulators, constant forces,
+/// springs, spheres, asymmetric and locked-axis bodies) stepped with the given threading policy.
 fn big_world_bits(parallelism: Parallelism, integrator: Integrator) -> Vec<u64> {
     let mut world = world_with(1.0 / 60.0, integrator);
     world.insert_resource(Gravity(Vec3::new(0.0, -9.81, 0.0)));
@@ -163,6 +163,28 @@ fn big_world_bits(parallelism: Parallelism, integrator: Integrator) -> Vec<u64> 
             e.insert(ForceAccumulator::default());
         }
         bodies.push(e.id());
+    }
+    // Constant forces, world and body frame, at points and through the centre of mass, two on
+    // some bodies: enough of them that the threaded policy computes them on the pool.
+    for (i, &body) in bodies.iter().enumerate().filter(|(i, _)| i % 2 == 0) {
+        let f = i as Real / 6000.0;
+        world.spawn(ConstantForce {
+            body,
+            force: Vec3::new(0.5, -1.0 + f, 0.25),
+            local_point: (i % 4 == 0).then(|| Vec3::new(0.1, 0.05 * f, -0.02)),
+        });
+        world.spawn(ConstantLocalForce {
+            body,
+            force: Vec3::new(-0.3, 0.2, 1.0 - f),
+            local_point: (i % 6 != 0).then(|| Vec3::new(0.0, 0.1, 0.03)),
+        });
+        if i % 10 == 0 {
+            world.spawn(ConstantForce {
+                body,
+                force: Vec3::new(0.0, 0.0, 2.0),
+                local_point: Some(Vec3::new(-0.05, 0.0, 0.1)),
+            });
+        }
     }
     for pair in bodies.chunks(6) {
         let end = SpringEnd::on_body(pair[3], Vec3::ZERO);
