@@ -70,3 +70,40 @@ fn a_body_at_rest_far_away_loses_nothing_and_is_not_warned() {
     world.get_mut::<Velocity>(body).unwrap().linear = Vec3::ZERO;
     assert!(!warned(&mut world));
 }
+
+#[test]
+fn a_body_farther_than_the_precision_can_count_is_warned_with_its_distance() {
+    // Each coordinate finite, the distance beyond what `f32` can hold (|x|² overflows it).
+    let far = Real::MAX / 2.0;
+    let mut world = World::new();
+    world.insert_resource(PhysicsSettings::new(DT, Integrator::Splitting).unwrap());
+    world.spawn((
+        RigidBody,
+        Pose::from_translation(Vec3::new(far, far, far)),
+        Velocity::linear(Vec3::new(1.0, 0.0, 0.0)),
+    ));
+    let warnings = check_stability(&mut world);
+    let Some(StabilityWarning::CoarsePosition {
+        distance,
+        relative_error,
+        ..
+    }) = warnings
+        .iter()
+        .find(|w| matches!(w, StabilityWarning::CoarsePosition { .. }))
+    else {
+        panic!("no position warning: {warnings:?}");
+    };
+    let exact = far.widen() * 3f64.sqrt();
+    assert!(
+        (distance / exact - 1.0).abs() < 1e-12,
+        "distance {distance:e}, expected {exact:e}"
+    );
+    assert!(relative_error.is_finite() && *relative_error > 1.0);
+    let text = warnings
+        .iter()
+        .map(ToString::to_string)
+        .collect::<Vec<_>>()
+        .join("\n");
+    assert!(!text.contains("inf") && !text.contains("NaN"), "{text}");
+    assert!(text.contains("a whole step can be lost"), "{text}");
+}

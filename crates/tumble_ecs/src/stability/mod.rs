@@ -230,13 +230,13 @@ fn check_positions(world: &mut World, dt: Real, warnings: &mut Vec<StabilityWarn
                 warnings.push(StabilityWarning::LockedAxisRate { body, rate });
             }
         }
-        let distance = t.translation.length();
-        let swing = v.angular.length() * (t.rotation * m.local_center_of_mass()).length();
-        let fall = (gravity * scale.map_or(1.0, |s| s.0)).length() * dt;
-        let step_motion = (v.linear.length() + swing + fall) * dt;
+        let distance = length_f64(t.translation);
+        let swing = length_f64(v.angular) * length_f64(t.rotation * m.local_center_of_mass());
+        let fall = length_f64(gravity) * scale.map_or(1.0, |s| s.0).widen().abs() * dt.widen();
+        let step_motion = (length_f64(v.linear) + swing + fall) * dt.widen();
         if step_motion > 0.0 {
-            let relative_error = distance * Real::EPSILON / (2.0 * step_motion);
-            if relative_error > POSITION_RESOLUTION_LIMIT {
+            let relative_error = distance * Real::EPSILON.widen() / (2.0 * step_motion);
+            if relative_error > POSITION_RESOLUTION_LIMIT.widen() {
                 warnings.push(StabilityWarning::CoarsePosition {
                     body,
                     distance,
@@ -245,6 +245,19 @@ fn check_positions(world: &mut World, dt: Real, warnings: &mut Vec<StabilityWarn
                 });
             }
         }
+    }
+}
+
+/// `|v|` in `f64`, scaled by its largest component: a finite position may lie farther from the
+/// origin than its squared length can count (beyond 1.8e19 m in `f32`), and a warning must give
+/// the distance, not `inf`.
+fn length_f64(v: Vec3) -> f64 {
+    let v = v.widen();
+    let scale = v.abs().max_element();
+    if scale > 0.0 && scale.is_finite() {
+        scale * (v / scale).length()
+    } else {
+        scale
     }
 }
 

@@ -2,7 +2,7 @@
 
 use bevy_ecs::prelude::*;
 use tumble_core::Integrator;
-use tumble_core::math::{DOUBLE_PRECISION, REAL_NAME, Real};
+use tumble_core::math::{DOUBLE_PRECISION, REAL_NAME, Real, Widen};
 
 use super::{
     ACCURACY_HORIZON, COMPOSED_SPLIT_ERROR_LIMIT, RK4_STIFFNESS_LIMIT, SPLIT_DRIFT_TOLERANCE,
@@ -111,12 +111,13 @@ pub enum StabilityWarning {
     CoarsePosition {
         /// The body.
         body: Entity,
-        /// Its distance from the origin (m).
-        distance: Real,
+        /// Its distance from the origin (m), in `f64` (a finite `f32` position may lie farther
+        /// than `f32` can count).
+        distance: f64,
         /// Its motion in one step, `s Δt` (m).
-        step_motion: Real,
+        step_motion: f64,
         /// `r ε / (2 s Δt)`, compared with [`POSITION_RESOLUTION_LIMIT`](super::POSITION_RESOLUTION_LIMIT).
-        relative_error: Real,
+        relative_error: f64,
     },
     /// A body that turns about a locked principal axis (a zero moment of inertia): every
     /// integrator holds that rate at 0, so the first step drops it (not an instability, but the
@@ -245,10 +246,17 @@ impl std::fmt::Display for StabilityWarning {
             } => write!(
                 f,
                 "rigid body {body}: {distance:.3e} m from the origin, {REAL_NAME} positions are \
-                 spaced up to {:.1e} m there, and it moves {step_motion:.1e} m per step: up to \
-                 {:.2} % of every step is lost to rounding{}",
-                distance * Real::EPSILON,
-                100.0 * relative_error,
+                 spaced up to {:.1e} m there, and it moves {step_motion:.1e} m per step: {}{}",
+                distance * Real::EPSILON.widen(),
+                if relative_error < 1.0 {
+                    format!(
+                        "up to {:.2} % of every step is lost to rounding",
+                        100.0 * relative_error
+                    )
+                } else {
+                    // Beyond 100 % a percentage is only a long number: the step may be lost.
+                    "a whole step can be lost to rounding".to_owned()
+                },
                 if DOUBLE_PRECISION {
                     "; move the origin closer"
                 } else {
