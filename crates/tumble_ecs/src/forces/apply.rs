@@ -159,58 +159,85 @@ pub fn apply_constant_forces(
     };
     let pushes = &mut pushes.0;
     let world_threads = threads(world_frame, generators.iter().len(), &targets);
-    if world_threads > 1 {
-        for (_, table) in dense(generators.contiguous_iter()) {
-            push_in_blocks(
-                table,
-                world_threads,
-                pushes,
-                &mut targets,
-                |g: &ConstantForce, targets| {
-                    ForcePush::of(g.body, g.force, false, g.local_point, targets)
-                },
-                |g, push, targets| push.apply(g.body, targets),
-            );
-        }
-    } else {
-        world_frame.for_each(&generators, |g| {
-            apply_force(
-                &mut targets,
-                &mut implicit,
-                any_implicit,
-                g.body,
-                g.force,
-                false,
-                g.local_point,
-            );
-        });
-    }
     let body_threads = threads(body_frame, local_generators.iter().len(), &targets);
-    if body_threads > 1 {
-        for (_, table) in dense(local_generators.contiguous_iter()) {
-            push_in_blocks(
-                table,
-                body_threads,
-                pushes,
-                &mut targets,
-                |g: &ConstantLocalForce, targets| {
-                    ForcePush::of(g.body, g.force, true, g.local_point, targets)
-                },
-                |g, push, targets| push.apply(g.body, targets),
-            );
+    let mut kind = ForceKind {
+        pushes,
+        targets: &mut targets,
+        any_implicit,
+    };
+    kind.apply(&generators, world_frame, world_threads, &mut implicit);
+    kind.apply(&local_generators, body_frame, body_threads, &mut implicit);
+}
+
+/// A constant force generator's parts: its body, its force, the body point it acts at (`None`:
+/// the centre of mass), and whether the force is given in the body's frame.
+trait ForceGenerator: Component + Sync {
+    /// The force turns with the body.
+    const IN_BODY_FRAME: bool;
+    /// `(body, force, point)`.
+    fn parts(&self) -> (Entity, Vec3, Option<Vec3>);
+}
+
+impl ForceGenerator for ConstantForce {
+    const IN_BODY_FRAME: bool = false;
+    fn parts(&self) -> (Entity, Vec3, Option<Vec3>) {
+        (self.body, self.force, self.local_point)
+    }
+}
+
+impl ForceGenerator for ConstantLocalForce {
+    const IN_BODY_FRAME: bool = true;
+    fn parts(&self) -> (Entity, Vec3, Option<Vec3>) {
+        (self.body, self.force, self.local_point)
+    }
+}
+
+/// What [`apply_constant_forces`] applies each kind of generator with.
+struct ForceKind<'p, 'a, 'w, 's> {
+    pushes: &'p mut Vec<ForcePush>,
+    targets: &'p mut Targets<'a, 'w, 's>,
+    any_implicit: bool,
+}
+
+impl ForceKind<'_, '_, '_, '_> {
+    /// Applies every generator of one kind in entity order (`order`), computing the pushes on
+    /// `threads` threads of the pool where that is more than one (the points of forces on
+    /// bodies of implicit groups go to their `implicit` solve, on this thread).
+    fn apply<G: ForceGenerator>(
+        &mut self,
+        generators: &IndexedQuery<G, ()>,
+        order: &IndexOrder,
+        threads: usize,
+        implicit: &mut Query<&mut ImplicitBody>,
+    ) {
+        if threads > 1 {
+            for (_, table) in dense(generators.contiguous_iter()) {
+                push_in_blocks(
+                    table,
+                    threads,
+                    self.pushes,
+                    self.targets,
+                    |g: &G, targets| {
+                        let (body, force, point) = g.parts();
+                        ForcePush::of(body, force, G::IN_BODY_FRAME, point, targets)
+                    },
+                    |g, push, targets| push.apply(g.parts().0, targets),
+                );
+            }
+        } else {
+            order.for_each(generators, |g| {
+                let (body, force, point) = g.parts();
+                apply_force(
+                    self.targets,
+                    implicit,
+                    self.any_implicit,
+                    body,
+                    force,
+                    G::IN_BODY_FRAME,
+                    point,
+                );
+            });
         }
-    } else {
-        body_frame.for_each(&local_generators, |g| {
-            apply_force(
-                &mut targets,
-                &mut implicit,
-                any_implicit,
-                g.body,
-                g.force,
-                true,
-                g.local_point,
-            );
-        });
     }
 }
 
