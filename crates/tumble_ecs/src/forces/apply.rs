@@ -150,12 +150,13 @@ pub fn apply_constant_forces(
     let [world_frame, body_frame] = &mut *orders;
     world_frame.refresh(&generators);
     body_frame.refresh(&local_generators);
-    let threads = |order: &IndexOrder, count: usize, targets: &Targets| match targets {
-        // Forces on implicit bodies hand their points to the solve, on this thread.
-        _ if any_implicit || !order.is_query_order() => 1,
-        Targets::Tables { .. } => parallelism.threads_for(count),
-        // The query's own lookups are not shared between threads.
-        Targets::Query(_) => 1,
+    // Forces on implicit bodies hand their points to the solve, on this thread.
+    let threads = |order: &IndexOrder, count: usize, targets: &Targets| {
+        if any_implicit {
+            1
+        } else {
+            push_threads(targets, order, count, &parallelism)
+        }
     };
     let pushes = &mut pushes.0;
     let world_threads = threads(world_frame, generators.iter().len(), &targets);
@@ -424,13 +425,7 @@ pub fn apply_springs(
     let parallelism = parallelism.map_or_else(Parallelism::default, |p| *p);
     let count = springs.iter().len();
     order.refresh(&springs);
-    let threads = match targets {
-        // Springs in several tables, out of entity order: added one by one in that order.
-        _ if !order.is_query_order() => 1,
-        Targets::Tables { .. } => parallelism.threads_for(count),
-        // The query's own lookups are not shared between threads.
-        Targets::Query(_) => 1,
-    };
+    let threads = push_threads(&targets, &order, count, &parallelism);
     if threads <= 1 {
         order.for_each(&springs, |spring| {
             SpringPush::of(spring, &targets).apply(spring, &mut targets);
@@ -446,6 +441,24 @@ pub fn apply_springs(
             SpringPush::of,
             |spring, push, targets| push.apply(spring, targets),
         );
+    }
+}
+
+/// Threads that compute a force system's pushes ([`push_in_blocks`]) for `count` items: the
+/// pool's share where the items are visited in entity order (`order`) and the targets are
+/// tables the threads can share, else one.
+fn push_threads(
+    targets: &Targets,
+    order: &IndexOrder,
+    count: usize,
+    parallelism: &Parallelism,
+) -> usize {
+    match targets {
+        // Items in several tables, out of entity order: added one by one in that order.
+        _ if !order.is_query_order() => 1,
+        Targets::Tables { .. } => parallelism.threads_for(count),
+        // The query's own lookups are not shared between threads.
+        Targets::Query(_) => 1,
     }
 }
 
