@@ -292,7 +292,12 @@ impl Scene {
             let def = &self.file.bodies[i];
             (def.name.clone(), checked_body(file, i, def))
         });
-        self.finish_build(world, bodies, &classified.implicit_springs)
+        let kinds = self.force_runs(&classified.implicit_springs);
+        let mut forces = self.forces.iter().copied();
+        spawn_forces(&mut world, &bodies, &kinds, || {
+            forces.next().expect("one kind per force")
+        });
+        planned(world, bodies)
     }
 
     /// [`build`](Self::build), consuming the scene as the world fills: each body's file model
@@ -322,7 +327,26 @@ impl Scene {
             (def.name, body)
         });
         drop(defs);
-        self.finish_build(world, bodies, &classified.implicit_springs)
+        // The forces the same way: released as their generators are spawned, so that a file of
+        // springs is not held twice, once checked and once spawned.
+        let kinds = self.force_runs(&classified.implicit_springs);
+        drop(classified);
+        let mut forces = std::mem::take(&mut self.forces);
+        drop(self);
+        forces.reverse();
+        let release_every = (forces.len() / 8).max(1 << 16);
+        let mut spawned = 0;
+        spawn_forces(&mut world, &bodies, &kinds, || {
+            spawned += 1;
+            if spawned % release_every == 0 {
+                forces.shrink_to_fit();
+            }
+            forces.pop().expect("one kind per force")
+        });
+        drop(kinds);
+        // Planning builds tables of its own (the springs' classification, the audit's) with
+        // only the world and the names held.
+        planned(world, bodies)
     }
 
     /// Per body, whether a force generator names it. Such a body is spawned with its
@@ -400,91 +424,115 @@ impl Scene {
         world
     }
 
-    /// Spawns the force generators between the spawned `bodies` and plans the schedule.
-    fn finish_build(
-        &self,
-        mut world: World,
-        bodies: Vec<(String, Entity)>,
-        implicit_springs: &[bool],
-    ) -> BuiltScene {
-        let entity = |i: usize| bodies[i].1;
-        let constant = |f: &SceneForce| match *f {
-            SceneForce::Constant { body, force, point } => Some(ConstantForce {
-                body: entity(body),
-                force,
-                local_point: point,
-            }),
-            _ => None,
-        };
-        let torque = |f: &SceneForce| match *f {
-            SceneForce::Torque { body, torque } => Some(ConstantTorque {
-                body: entity(body),
-                torque,
-            }),
-            _ => None,
-        };
-        let spring_of = |f: &SceneForce| match *f {
-            SceneForce::Spring {
-                a,
-                anchor_a,
-                b,
-                anchor_b,
-                k,
-                c,
-                rest,
-            } => Some(Spring {
-                a: entity(a),
-                anchor_a,
-                b: match b {
-                    Some(b) => SpringEnd::Body {
-                        body: entity(b),
-                        anchor: anchor_b,
-                    },
-                    None => SpringEnd::World(anchor_b),
-                },
-                stiffness: k,
-                damping: c,
-                rest_length: rest,
-            }),
-            _ => None,
-        };
-        // Runs of one kind: of one generator type, springs also of one solve (the
-        // classification's, so that no spring moves to another table when it is planned).
+    /// The runs of one kind the scene's forces are spawned in (see [`spawn_forces`]).
+    fn force_runs(&self, implicit_springs: &[bool]) -> Vec<ForceRun> {
         let mut spring = 0;
-        let kinds: Vec<_> = (self.forces.iter())
-            .map(|f| {
-                let implicit = matches!(f, SceneForce::Spring { .. }) && {
-                    spring += 1;
-                    implicit_springs.get(spring - 1).copied().unwrap_or(false)
-                };
-                (std::mem::discriminant(f), implicit)
-            })
-            .collect();
-        const ONE_KIND: &str = "a run holds one kind of force";
-        for (start, len) in runs(&kinds) {
-            let run = self.forces[start..start + len].iter();
-            match self.forces[start] {
-                SceneForce::Constant { .. } => {
-                    batch(&mut world, run.map(|f| constant(f).expect(ONE_KIND)), drop);
-                }
-                SceneForce::Torque { .. } => {
-                    batch(&mut world, run.map(|f| torque(f).expect(ONE_KIND)), drop);
-                }
-                SceneForce::Spring { .. } if kinds[start].1 => {
-                    let run = run.map(|f| (spring_of(f).expect(ONE_KIND), ImplicitSpring));
-                    batch(&mut world, run, drop);
-                }
+        (self.forces.iter())
+            .map(|f| match f {
+                SceneForce::Constant { .. } => ForceRun::Constant,
+                SceneForce::Torque { .. } => ForceRun::Torque,
                 SceneForce::Spring { .. } => {
-                    batch(&mut world, run.map(|f| spring_of(f).expect(ONE_KIND)), drop);
+                    spring += 1;
+                    ForceRun::Spring {
+                        implicit: implicit_springs.get(spring - 1).copied().unwrap_or(false),
+                    }
                 }
+            })
+            .collect()
+    }
+}
+
+/// The kind of a run of forces spawned by one batch: one generator type, and for springs one
+/// solve (the classification's, so that no spring moves to another table when it is planned).
+/// A byte a force, beside the forces themselves.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum ForceRun {
+    Constant,
+    Torque,
+    Spring { implicit: bool },
+}
+
+/// Spawns the force generators between the spawned `bodies`, in runs of one kind (`kinds`, per
+/// force); `next()` gives the forces in scene order, once each.
+fn spawn_forces(
+    world: &mut World,
+    bodies: &[(String, Entity)],
+    kinds: &[ForceRun],
+    mut next: impl FnMut() -> SceneForce,
+) {
+    let entity = |i: usize| bodies[i].1;
+    const ONE_KIND: &str = "a run holds one kind of force";
+    for (start, len) in runs(kinds) {
+        let run = (0..len).map(|_| next());
+        match kinds[start] {
+            ForceRun::Constant => {
+                let run = run.map(|f| match f {
+                    SceneForce::Constant { body, force, point } => ConstantForce {
+                        body: entity(body),
+                        force,
+                        local_point: point,
+                    },
+                    _ => unreachable!("{ONE_KIND}"),
+                });
+                batch(world, run, drop);
+            }
+            ForceRun::Torque => {
+                let run = run.map(|f| match f {
+                    SceneForce::Torque { body, torque } => ConstantTorque {
+                        body: entity(body),
+                        torque,
+                    },
+                    _ => unreachable!("{ONE_KIND}"),
+                });
+                batch(world, run, drop);
+            }
+            ForceRun::Spring { implicit: true } => {
+                let run = run.map(|f| (spring_of(f, &entity), ImplicitSpring));
+                batch(world, run, drop);
+            }
+            ForceRun::Spring { implicit: false } => {
+                batch(world, run.map(|f| spring_of(f, &entity)), drop);
             }
         }
-        let physics = PhysicsRunner::new(&mut world);
-        BuiltScene {
-            world,
-            physics,
-            bodies,
-        }
+    }
+}
+
+/// The spring generator of the scene's spring `f`, its bodies' entities given by `entity`.
+fn spring_of(f: SceneForce, entity: &impl Fn(usize) -> Entity) -> Spring {
+    match f {
+        SceneForce::Spring {
+            a,
+            anchor_a,
+            b,
+            anchor_b,
+            k,
+            c,
+            rest,
+        } => Spring {
+            a: entity(a),
+            anchor_a,
+            b: match b {
+                Some(b) => SpringEnd::Body {
+                    body: entity(b),
+                    anchor: anchor_b,
+                },
+                None => SpringEnd::World(anchor_b),
+            },
+            stiffness: k,
+            damping: c,
+            rest_length: rest,
+        },
+        _ => unreachable!("a run holds one kind of force"),
+    }
+}
+
+/// The built scene of a world whose bodies and forces are spawned: its schedule planned.
+fn planned(mut world: World, bodies: Vec<(String, Entity)>) -> BuiltScene {
+    let physics = PhysicsRunner::new(&mut world);
+    BuiltScene {
+        world,
+        physics,
+        bodies,
     }
 }
 

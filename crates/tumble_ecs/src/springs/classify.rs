@@ -213,13 +213,14 @@ pub fn classify_springs(world: &mut World) {
         .unwrap_or_default();
     let dt = classification_span(&settings);
     // In entity order: a body's sums over its springs must not follow the order a query
-    // visits the spring tables in (see `ImplicitScratch::sort_by_entity`).
-    let mut springs: Vec<(Entity, Spring)> = world
-        .query::<(Entity, &Spring)>()
+    // visits the spring tables in (see `ImplicitScratch::sort_by_entity`). The entities only,
+    // each spring read where it is when the walks need it: a copy of a million springs would
+    // be the largest table of the plan.
+    let mut springs: Vec<Entity> = world
+        .query_filtered::<Entity, With<Spring>>()
         .iter(world)
-        .map(|(e, s)| (e, *s))
         .collect();
-    springs.sort_unstable_by_key(|(e, _)| e.index_u32());
+    springs.sort_unstable_by_key(|e| e.index_u32());
     let mut dynamic = world.query_filtered::<(Entity, &MassProps), Dynamic>();
     let mut index = EntityHashMap::default();
     let mut masses = Vec::new();
@@ -227,7 +228,9 @@ pub fn classify_springs(world: &mut World) {
         index.insert(entity, masses.len());
         masses.push(*mass);
     }
-    let classified = springs.iter().map(|(_, spring)| {
+    let spring = |entity: &Entity| *world.get::<Spring>(*entity).expect("queried with a Spring");
+    let classified = springs.iter().map(|entity| {
+        let spring = &spring(entity);
         let (a, b) = ends_in(&index, spring);
         ClassifiedSpring {
             a,
@@ -279,12 +282,12 @@ fn turn_rates(
 /// takes them off the others.
 fn mark_stiff(
     world: &mut World,
-    springs: &[(Entity, Spring)],
+    springs: &[Entity],
     implicit_spring: Vec<bool>,
     index: &EntityHashMap<usize>,
     implicit_body: &[bool],
 ) {
-    for ((entity, _), stiff) in springs.iter().zip(implicit_spring) {
+    for (entity, stiff) in springs.iter().zip(implicit_spring) {
         let has = world.get::<ImplicitSpring>(*entity).is_some();
         if stiff && !has {
             world.entity_mut(*entity).insert(ImplicitSpring);
