@@ -65,15 +65,17 @@ fn multiply_right(a: &mut Block, b: &Block) {
 /// rows hold two entries, and a vector of whole blocks would reserve four (1.2 kB) for them.
 type Entry = (u32, u32);
 
-/// One eliminated body: its pivot inverse, the multipliers `A_ip P` of the bodies below it and
-/// the blocks `A_pj` of the bodies after it (both over the bodies still present when it went),
-/// their blocks in the pool.
-#[derive(Debug, Clone, Default)]
+/// One eliminated body: the multipliers `A_ip P` of the bodies below it and the blocks `A_pj`
+/// of the bodies after it (both over the bodies still present when it went), as ranges of
+/// [`BlockLu`]'s pivot entries, their blocks in the pool. Its pivot inverse `P` is kept in
+/// its diagonal block's place, which elimination no longer reads once the body is gone.
+#[derive(Debug, Clone, Copy, Default)]
 struct Pivot {
-    body: usize,
-    inverse: Block,
-    lower: Vec<Entry>,
-    upper: Vec<Entry>,
+    body: u32,
+    /// `entries[upper..lower]` are the upper blocks, `entries[lower..end]` the multipliers.
+    upper: u32,
+    lower: u32,
+    end: u32,
 }
 
 /// The factorization, with its working storage kept between factorizations (no allocation once
@@ -83,6 +85,7 @@ pub(crate) struct BlockLu {
     /// Off-diagonal entries by row: `rows[i]` holds `(j, block of A_ij)`; the pattern is
     /// symmetric.
     rows: Vec<Vec<Entry>>,
+    /// The diagonal blocks; once factored, each eliminated body's pivot inverse.
     diagonal: Vec<Block>,
     /// Every off-diagonal block: the matrix's, the multipliers that replace the lower ones as
     /// their bodies go, and the fill.
@@ -90,8 +93,8 @@ pub(crate) struct BlockLu {
     /// Scratch of `analyze`: the bodies already ordered.
     eliminated: Vec<bool>,
     pivots: Vec<Pivot>,
-    pivot_count: usize,
-    scratch: Vec<f64>,
+    /// The pivots' entries, in elimination order (see [`Pivot`]).
+    pivot_entries: Vec<Entry>,
     /// The elimination order, from [`BlockLu::analyze`].
     order: Vec<usize>,
     /// Per body, where column `j` sits in the row being updated (`usize::MAX`: absent).
@@ -121,11 +124,11 @@ fn narrow(i: usize) -> u32 {
 }
 
 impl BlockLu {
-    /// Starts a matrix of `n` bodies: the diagonal blocks `diagonal`, no off-diagonal blocks.
-    pub(crate) fn reset(&mut self, diagonal: &[Block]) {
+    /// Starts a matrix of `diagonal.len()` bodies: the diagonal blocks `diagonal`, taken over
+    /// (not copied: a group's blocks are held once), no off-diagonal blocks.
+    pub(crate) fn reset(&mut self, diagonal: Vec<Block>) {
         let n = diagonal.len();
-        self.diagonal.clear();
-        self.diagonal.extend_from_slice(diagonal);
+        self.diagonal = diagonal;
         self.rows.resize_with(n.max(self.rows.len()), Vec::new);
         for row in &mut self.rows {
             row.clear();
@@ -133,7 +136,17 @@ impl BlockLu {
         self.pool.clear();
         self.slot.clear();
         self.slot.resize(n, usize::MAX);
-        self.pivot_count = 0;
+        self.pivots.clear();
+        self.pivot_entries.clear();
+    }
+
+    /// Hands the diagonal blocks' storage back (emptied) for the next matrix: the
+    /// factorization it held is gone.
+    pub(crate) fn take_diagonal(&mut self) -> Vec<Block> {
+        self.pivots.clear();
+        let mut diagonal = std::mem::take(&mut self.diagonal);
+        diagonal.clear();
+        diagonal
     }
 
     /// Adds `block` to the off-diagonal entry `(i, j)`, `i ≠ j`, and makes `(j, i)` present.
@@ -240,6 +253,11 @@ impl BlockLu {
             self.graph[p].clear();
         }
         self.slot.fill(usize::MAX);
+        // The symbolic graph and the queue are needed again only when the pattern changes:
+        // released, not kept beside the factorization (a body's list costs more than its
+        // entry in the factorization).
+        self.graph = Vec::new();
+        self.queue = BinaryHeap::new();
         // Every block a factorization of this pattern holds: the matrix's and the fill. Sized
         // exactly (a pool grown by doubling holds up to twice its blocks).
         let blocks = self.pool.len() + fill;
@@ -255,53 +273,61 @@ impl BlockLu {
             diagonal,
             pool,
             pivots,
-            pivot_count,
+            pivot_entries: entries,
             order,
             slot,
             targets,
             ..
         } = self;
-        *pivot_count = 0;
-        pivots.reserve_exact(order.len().saturating_sub(pivots.len()));
+        pivots.clear();
+        entries.clear();
+        // Sized once: a pivot per body, and each block of the pool (the matrix's and the
+        // fill, counted by `analyze`) is one pivot's upper block or multiplier.
+        pivots.reserve_exact(order.len());
+        entries.reserve_exact(pool.capacity());
         for &p in order.iter() {
-            if pivots.len() <= *pivot_count {
-                pivots.push(Pivot::default());
-            }
-            let pivot = &mut pivots[*pivot_count];
-            *pivot_count += 1;
-            pivot.body = p;
-            if !invert_into(&diagonal[p], &mut pivot.inverse) {
+            let mut inverse = [[0.0; 6]; 6];
+            if !invert_into(&diagonal[p], &mut inverse) {
                 return Err(SingularPivot);
             }
-            // Row p becomes the pivot's upper blocks A_pj (the lists trade places, no block
-            // is copied); each A_jp leaves row j (p is gone from the remaining matrix), its
-            // block overwritten by the multiplier A_jp P.
-            pivot.upper.clear();
-            std::mem::swap(&mut pivot.upper, &mut rows[p]);
-            pivot.lower.clear();
+            diagonal[p] = inverse;
+            // Row p becomes the pivot's upper blocks A_pj; each A_jp leaves row j (p is gone
+            // from the remaining matrix), its block overwritten by the multiplier A_jp P.
+            let upper = entries.len();
+            entries.extend_from_slice(&rows[p]);
+            rows[p].clear();
+            let lower = entries.len();
             let column = narrow(p);
-            for &(j, _) in &pivot.upper {
+            for k in upper..lower {
+                let j = entries[k].0;
                 let row = &mut rows[j as usize];
                 let at = row
                     .iter()
                     .position(|(c, _)| *c == column)
                     .expect("the pattern is symmetric");
                 let block = row[at].1;
-                multiply_right(&mut pool[block as usize], &pivot.inverse);
-                pivot.lower.push((j, block));
+                multiply_right(&mut pool[block as usize], &diagonal[p]);
+                entries.push((j, block));
                 row.swap_remove(at);
             }
+            let end = entries.len();
+            pivots.push(Pivot {
+                body: narrow(p),
+                upper: narrow(upper),
+                lower: narrow(lower),
+                end: narrow(end),
+            });
             // Schur complement: A_ij −= (A_ip P) A_pj over all remaining neighbours i, j of p.
             // The fill blocks first, so that the updates read the pool's blocks in place (a
             // target `(i, j)` is never `(i, p)` or `(p, j)`); in the same order as the updates,
             // so every block keeps its place in the pool.
             targets.clear();
-            for &(i, l_ip) in &pivot.lower {
+            for &(i, l_ip) in &entries[lower..end] {
                 let row = &mut rows[i as usize];
                 for (at, (j, _)) in row.iter().enumerate() {
                     slot[*j as usize] = at;
                 }
-                for &(j, a_pj) in &pivot.upper {
+                for &(j, a_pj) in &entries[upper..lower] {
                     let target = if i == j {
                         DIAGONAL
                     } else if slot[j as usize] != usize::MAX {
@@ -331,15 +357,14 @@ impl BlockLu {
         Ok(())
     }
 
-    /// `out = A⁻¹ u` with the factorization (forward elimination, then back substitution).
-    pub(crate) fn solve(&mut self, u: &[f64], out: &mut [f64]) {
-        let y = &mut self.scratch;
-        y.clear();
-        y.extend_from_slice(u);
-        for pivot in &self.pivots[..self.pivot_count] {
-            let p = pivot.body;
+    /// `y ← A⁻¹ y` with the factorization, in place (forward elimination, then back
+    /// substitution: a body's entry is read for the last time just before its solution
+    /// replaces it).
+    pub(crate) fn solve_in_place(&self, y: &mut [f64]) {
+        for pivot in &self.pivots {
+            let p = pivot.body as usize;
             let yp: [f64; 6] = y[6 * p..6 * p + 6].try_into().expect("six entries");
-            for &(i, l) in &pivot.lower {
+            for &(i, l) in &self.pivot_entries[pivot.lower as usize..pivot.end as usize] {
                 let i = i as usize;
                 let d = block_mul(&self.pool[l as usize], &yp);
                 for (a, b) in y[6 * i..6 * i + 6].iter_mut().zip(d) {
@@ -347,18 +372,25 @@ impl BlockLu {
                 }
             }
         }
-        for pivot in self.pivots[..self.pivot_count].iter().rev() {
-            let p = pivot.body;
+        for pivot in self.pivots.iter().rev() {
+            let p = pivot.body as usize;
             let mut r: [f64; 6] = y[6 * p..6 * p + 6].try_into().expect("six entries");
-            for &(j, a) in &pivot.upper {
+            for &(j, a) in &self.pivot_entries[pivot.upper as usize..pivot.lower as usize] {
                 let j = j as usize;
-                let d = block_mul(&self.pool[a as usize], &out[6 * j..6 * j + 6]);
+                let d = block_mul(&self.pool[a as usize], &y[6 * j..6 * j + 6]);
                 for (x, b) in r.iter_mut().zip(d) {
                     *x -= b;
                 }
             }
-            out[6 * p..6 * p + 6].copy_from_slice(&block_mul(&pivot.inverse, &r));
+            y[6 * p..6 * p + 6].copy_from_slice(&block_mul(&self.diagonal[p], &r));
         }
+    }
+
+    /// `out = A⁻¹ u` with the factorization ([`Self::solve_in_place`] on a copy).
+    #[cfg(test)]
+    pub(crate) fn solve(&self, u: &[f64], out: &mut [f64]) {
+        out.copy_from_slice(u);
+        self.solve_in_place(out);
     }
 }
 
@@ -405,7 +437,7 @@ mod tests {
                 }
             }
             let mut lu = BlockLu::default();
-            lu.reset(&diagonal);
+            lu.reset(diagonal.clone());
             let mut off = Vec::new();
             for (k, &(i, j)) in edges.iter().enumerate() {
                 let (a, b) = (
@@ -453,7 +485,7 @@ mod tests {
         let diagonal: Vec<Block> = (0..n).map(|i| block(i as u64, true)).collect();
         let mut lu = BlockLu::default();
         for round in 0..2 {
-            lu.reset(&diagonal);
+            lu.reset(diagonal.clone());
             for i in 1..n {
                 lu.add(i - 1, i, &block(1000 + i as u64, false));
                 lu.add(i, i - 1, &block(2000 + i as u64, false));
@@ -469,10 +501,7 @@ mod tests {
                 capacity,
                 "round {round}: the factorization grew"
             );
-            let entries: usize = lu.pivots[..lu.pivot_count]
-                .iter()
-                .map(|p| p.lower.len() + p.upper.len())
-                .sum();
+            let entries = lu.pivot_entries.len();
             assert_eq!(entries, 2 * (n - 1), "round {round}");
         }
     }
@@ -480,7 +509,7 @@ mod tests {
     #[test]
     fn a_singular_pivot_is_reported() {
         let mut lu = BlockLu::default();
-        lu.reset(&[[[0.0; 6]; 6]]);
+        lu.reset(vec![[[0.0; 6]; 6]]);
         lu.analyze();
         assert_eq!(lu.factor(), Err(SingularPivot));
     }

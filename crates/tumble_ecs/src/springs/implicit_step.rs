@@ -192,11 +192,21 @@ impl ImplicitScratch {
         refusals: &mut Refusals,
     ) {
         let members = self.member_start[g]..self.member_start[g + 1];
-        self.bodies.clear();
-        self.bodies
-            .extend(self.members[members.clone()].iter().map(|&i| self.all[i]));
+        let group = &self.members[members.clone()];
+        // A group whose bodies lie side by side in `all` (a world of one group, or groups
+        // spawned one after the other) is solved where it lies; any other is gathered. The
+        // solver sees the same bodies in the same order either way.
+        let first = group.first().copied().unwrap_or(0);
+        let side_by_side = group.iter().copied().eq(first..first + group.len());
+        let bodies_of_group = if side_by_side {
+            &mut self.all[first..first + group.len()]
+        } else {
+            self.bodies.clear();
+            self.bodies.extend(group.iter().map(|&i| self.all[i]));
+            &mut self.bodies[..]
+        };
         let springs = &self.springs[self.spring_start[g]..self.spring_start[g + 1]];
-        let stats = match self.solver.step(&mut self.bodies, springs, span.h) {
+        let stats = match self.solver.step(bodies_of_group, springs, span.h) {
             Ok(stats) => stats,
             Err(error) => {
                 for &i in &self.members[members] {
@@ -210,7 +220,7 @@ impl ImplicitScratch {
             }
         };
         tracing::trace!(
-            bodies = self.bodies.len(),
+            bodies = bodies_of_group.len(),
             springs = springs.len(),
             newton = stats.newton_iterations,
             linear = stats.linear_iterations,
@@ -224,7 +234,7 @@ impl ImplicitScratch {
             if let Ok(((_, mut t, mut v, m, _, damping, _), _, _)) =
                 bodies.get_mut(self.entities[i])
             {
-                write_body_state(&self.bodies[k].state, m, &mut t, &mut v);
+                write_body_state(&bodies_of_group[k].state, m, &mut t, &mut v);
                 if let Some(d) = damping
                     && span.closes_substep
                 {

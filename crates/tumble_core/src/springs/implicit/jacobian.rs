@@ -113,7 +113,12 @@ impl ImplicitSpringSolver {
     /// gyroscopic terms, and the turning of the torques' frame and arms with `Ω̄`.
     pub(super) fn build_blocks(&mut self, h: f64) {
         self.linearize(h);
+        // The storage of the last factorization's diagonal, which this matrix replaces: a
+        // group's blocks are held once, here or in the factorization.
         let mut blocks = std::mem::take(&mut self.blocks);
+        if blocks.capacity() == 0 {
+            blocks = self.lu.take_diagonal();
+        }
         blocks.clear();
         blocks.extend((0..self.starts.len()).map(|i| self.body_block(h, i)));
         // The torques turn with Ω̄ too (forces held): the factor 1 − [hΩ̄/2]× and the mean arms
@@ -140,7 +145,7 @@ impl ImplicitSpringSolver {
     /// inertia where that block is singular too).
     pub(super) fn factor(&mut self, h: f64) {
         let mut lu = std::mem::take(&mut self.lu);
-        lu.reset(&self.blocks);
+        lu.reset(std::mem::take(&mut self.blocks));
         self.assemble_springs(h, &mut lu);
         if !self.analyzed {
             // The pattern is the group's graph, the same for every Newton iteration of a solve
@@ -155,6 +160,9 @@ impl ImplicitSpringSolver {
         }
         // Block Jacobi where the direct factorization failed (a singular pivot): each body's
         // diagonal block inverted, or its mass and inertia where that block is singular too.
+        // The body blocks went into the factorization: built again (the same function of the
+        // iterate), for the preconditioner and the matrix-free products.
+        self.build_blocks(h);
         let mut diagonal = DiagonalBlocks {
             blocks: std::mem::take(&mut self.preconditioner),
             off_diagonal: [[0.0; 6]; 6],
@@ -409,7 +417,6 @@ mod jacobian_tests {
             solver.residual = vec![0.0; n];
             solver.evaluate(h);
             solver.build_blocks(h);
-            solver.factor(h);
             let base = solver.z.clone();
             for j in 0..n {
                 let mut unit = vec![0.0; n];
@@ -430,7 +437,6 @@ mod jacobian_tests {
                 solver.z = base.clone();
                 solver.evaluate(h);
                 solver.build_blocks(h);
-                solver.factor(h);
                 for i in 0..n {
                     let numeric = (r_plus[i] - r_minus[i]) / (2.0 * eps);
                     let scale = numeric.abs().max(analytic[i].abs()).max(1e-3);
@@ -501,13 +507,21 @@ mod jacobian_tests {
         solver.build_blocks(h);
         solver.factor(h);
         assert!(solver.factored, "the test matrix is regular");
-        for j in 0..n {
+        let columns: Vec<Vec<f64>> = (0..n)
+            .map(|j| {
+                let mut x = vec![0.0; n];
+                x[j] = 1.0;
+                solver.lu.solve_in_place(&mut x);
+                x
+            })
+            .collect();
+        // The body blocks went into the factorization; built again for the product.
+        solver.build_blocks(h);
+        for (j, x) in columns.iter().enumerate() {
             let mut unit = vec![0.0; n];
             unit[j] = 1.0;
-            let mut x = vec![0.0; n];
-            solver.lu.solve(&unit, &mut x);
             let mut back = vec![0.0; n];
-            solver.apply_jacobian(h, &x, &mut back);
+            solver.apply_jacobian(h, x, &mut back);
             for (i, (b, u)) in back.iter().zip(&unit).enumerate() {
                 assert!((b - u).abs() < 1e-9, "(J LU⁻¹)[{i}][{j}] = {b:e}");
             }

@@ -166,7 +166,6 @@ impl ImplicitSpringSolver {
             &mut self.trial_residual,
             &mut self.delta,
             &mut self.trial,
-            &mut self.rhs,
         ] {
             buffer.clear();
             buffer.resize(n, 0.0);
@@ -176,17 +175,20 @@ impl ImplicitSpringSolver {
     /// The Newton update `δ` solving `J δ = −r` at the iterate (`J` the last factorized matrix
     /// in a chord step). Takes `self.delta`'s buffer; the caller puts it back.
     fn newton_update(&mut self, h: f64, refactor: bool, stats: &mut SolveStats) -> Vec<f64> {
-        for (b, r) in self.rhs.iter_mut().zip(&self.residual) {
-            *b = -r;
-        }
-        let rhs = std::mem::take(&mut self.rhs);
         let mut delta = std::mem::take(&mut self.delta);
         if self.factored {
-            // A direct solve with the factorization: of the exact Newton matrix after a
-            // refactor, of a recent one in a chord step.
-            self.lu.solve(&rhs, &mut delta);
+            // A direct solve with the factorization, in place: of the exact Newton matrix after
+            // a refactor, of a recent one in a chord step.
+            for (d, r) in delta.iter_mut().zip(&self.residual) {
+                *d = -r;
+            }
+            self.lu.solve_in_place(&mut delta);
             stats.linear_iterations += 1;
         } else {
+            // The right-hand side apart, sized here: only this (rare) path needs it.
+            let mut rhs = std::mem::take(&mut self.rhs);
+            rhs.clear();
+            rhs.extend(self.residual.iter().map(|r| -r));
             // A singular pivot: BiCGSTAB on the exact Newton matrix (the body blocks
             // follow the iterate) with block Jacobi.
             if !refactor {
@@ -202,8 +204,8 @@ impl ImplicitSpringSolver {
                 |u, out| self.apply_preconditioner(u, out),
             );
             self.krylov = krylov;
+            self.rhs = rhs;
         }
-        self.rhs = rhs;
         delta
     }
 
