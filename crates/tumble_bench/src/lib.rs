@@ -41,8 +41,8 @@ pub struct BenchOptions {
     /// Smaller worlds (up to 10⁴ bodies) and shorter timings: a smoke run of a few seconds.
     #[arg(long)]
     pub quick: bool,
-    /// Largest world for tumble (default 10⁶, 10⁴ with --quick).
-    #[arg(long)]
+    /// Largest world for tumble (default 10⁶, 10⁴ with --quick; at least 1).
+    #[arg(long, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..))]
     pub max_bodies: Option<usize>,
     /// Largest world for rapier (default 10⁵: a million rapier bodies take gigabytes and
     /// minutes).

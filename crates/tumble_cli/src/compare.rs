@@ -295,6 +295,11 @@ fn print_energy(out: &mut String, result: &Comparison) {
             Some(step) => {
                 format!("{e0:.6e} J → not valid from step {step} (quarantined or non-finite)")
             }
+            None if e0 == 0.0 => {
+                // No ratio to a zero start (it would print NaN): the largest change itself.
+                let worst = series.iter().map(|e| e.abs()).fold(0.0, f64::max);
+                format!("0 → {end:.6e} J (from 0: max |E − E₀| = {worst:.2e} J)")
+            }
             None => {
                 let worst = series
                     .iter()

@@ -166,7 +166,7 @@ pub(crate) fn run(
         SceneSyntax::Json => {
             let result = match file.as_mut() {
                 Some(file) => write_many_json(n, steps, &guard, file),
-                None => write_many_json(n, steps, &guard, std::io::stdout().lock()),
+                None => write_many_json(n, steps, &guard, crate::stdout::open()?),
             };
             match result {
                 Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {
@@ -192,7 +192,7 @@ pub(crate) fn run(
             match file.as_mut() {
                 Some(file) => file.write_all(text.as_bytes()),
                 None => {
-                    let mut stdout = std::io::stdout().lock();
+                    let mut stdout = crate::stdout::open()?;
                     stdout
                         .write_all(text.as_bytes())
                         .and_then(|()| stdout.flush())

@@ -32,6 +32,12 @@ fn on_signal() {
     if again || !POLLED.load(Ordering::SeqCst) {
         // No destructor runs from here: remove what an unwinding exit would have removed.
         tumble_scene::output::remove_live_temporary_files();
+        // The one `error:` line every failure ends with (this runs on a thread of its own,
+        // not in the signal's context, so it may write; a closed stderr is no reason to stay).
+        let _ = std::io::Write::write_all(
+            &mut std::io::stderr(),
+            b"error: interrupted; no output file was written or changed\n",
+        );
         std::process::exit(i32::from(exit::INTERRUPTED));
     }
 }

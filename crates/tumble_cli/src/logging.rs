@@ -4,6 +4,9 @@ use std::io::IsTerminal;
 
 use tracing_subscriber::EnvFilter;
 use tracing_subscriber::filter::LevelFilter;
+use tumble_scene::text::terminal_safe;
+
+use crate::exit::{self, Failure};
 
 /// The level `-v`/`-q` ask for: warnings by default, `-v` info, `-vv` debug, `-vvv` trace,
 /// `-q` errors only.
@@ -17,14 +20,26 @@ pub(crate) fn level(verbose: u8, quiet: bool) -> LevelFilter {
     }
 }
 
-/// Installs a `fmt` subscriber on stderr: `RUST_LOG` directives (ignored where malformed) over
-/// the default level from the flags; colour only on a terminal.
-pub(crate) fn init(verbose: u8, quiet: bool) {
+/// Installs a `fmt` subscriber on stderr: `RUST_LOG` directives over the default level from
+/// the flags; colour only on a terminal. A malformed `RUST_LOG` is an error naming it (escaped
+/// for the terminal): the parser's own "ignoring …" message would echo its bytes raw, and a
+/// setting that silently does nothing is no setting.
+pub(crate) fn init(verbose: u8, quiet: bool) -> Result<(), Failure> {
     let level = level(verbose, quiet);
     let filter = match std::env::var("RUST_LOG") {
         Ok(directives) if !directives.trim().is_empty() => EnvFilter::builder()
             .with_default_directive(level.into())
-            .parse_lossy(directives),
+            .parse(&directives)
+            .map_err(|e| {
+                Failure::new(
+                    exit::ERROR,
+                    format!(
+                        "RUST_LOG `{}` is not a log filter: {}",
+                        terminal_safe(&directives),
+                        terminal_safe(&e.to_string())
+                    ),
+                )
+            })?,
         // The CLI names bodies and springs as the scene does when it reports predictions and
         // quarantines (target `tumble`); the engine's own events say the same with entity ids,
         // so by default they are kept to errors. `RUST_LOG` shows them.
@@ -39,4 +54,5 @@ pub(crate) fn init(verbose: u8, quiet: bool) {
         .with_ansi(std::io::stderr().is_terminal())
         .without_time()
         .try_init();
+    Ok(())
 }

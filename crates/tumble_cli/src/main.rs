@@ -76,7 +76,9 @@ fn main() -> ExitCode {
         Ok(cli) => cli,
         Err(e) => return usage_error(&e),
     };
-    logging::init(cli.verbose, cli.quiet);
+    if let Err(failure) = logging::init(cli.verbose, cli.quiet) {
+        return failure.report();
+    }
     // A bad TUMBLE_KERNEL is a clear error here, not a panic in the middle of a step.
     if let Err(e) = tumble_core::KernelPath::selected() {
         return Failure::new(exit::ERROR, e.to_string()).report();
@@ -93,12 +95,9 @@ fn main() -> ExitCode {
 fn usage_error(e: &clap::Error) -> ExitCode {
     match e.kind() {
         ErrorKind::DisplayHelp | ErrorKind::DisplayVersion => {
-            match e
-                .print()
-                .and_then(|()| std::io::Write::flush(&mut std::io::stdout()))
-            {
+            match stdout::print(&e.render().to_string()) {
                 Ok(()) => ExitCode::from(exit::SUCCESS),
-                Err(err) => stdout::failed(&err).report(),
+                Err(failure) => failure.report(),
             }
         }
         ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {

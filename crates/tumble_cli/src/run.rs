@@ -172,7 +172,7 @@ fn write_summary(lines: &[String], to_stdout: bool) -> Result<(), Failure> {
     let mut summary: Box<dyn Write> = if to_stdout {
         Box::new(std::io::stderr().lock())
     } else {
-        Box::new(std::io::stdout().lock())
+        crate::stdout::open()?
     };
     // A closed or full stdout is an error, not a success with the summary (and the checksums
     // a script reads) lost.
@@ -223,7 +223,7 @@ fn step_and_write(
     };
     match destination {
         Destination::Stdout => {
-            let stdout = std::io::stdout().lock();
+            let stdout = crate::stdout::open()?;
             let written = tumble_scene::write_trajectory(built, steps, record, stdout, on_step)
                 .map_err(|e| match e {
                     TrajectoryError::Stopped { step } => interrupted(step, None),

@@ -55,6 +55,9 @@ fn usage_errors_are_one_line_with_exit_code_2() {
     // A negative size for the benchmark is a bad value of its flag, not an unknown argument.
     let output = tumble_run(&["bench", "--max-bodies", "-1"]);
     assert!(failure(&output, 2).starts_with("error: invalid value '-1' for '--max-bodies"));
+    // So is an empty benchmark: no world to time (it panicked on an empty size list).
+    let output = tumble_run(&["bench", "--quick", "--max-bodies", "0"]);
+    assert!(failure(&output, 2).starts_with("error: invalid value '0' for '--max-bodies"));
     // Help is not an error.
     assert!(tumble().arg("--help").output().unwrap().status.success());
 }
@@ -129,6 +132,21 @@ fn warnings_reach_stderr_and_follow_rust_log_and_the_flags() {
         .output()
         .unwrap();
     assert!(!stderr(&off).contains("WARN"), "{}", stderr(&off));
+    // A malformed RUST_LOG is an error naming it, its control and bidi characters escaped
+    // (the filter parser's own message echoed them raw, and the run went on without it).
+    let hostile = "\u{1b}[2J\u{1b}]0;pwned\u{7}\u{202e}=x";
+    let bad = tumble()
+        .args(&args)
+        .env("RUST_LOG", hostile)
+        .output()
+        .unwrap();
+    let line = failure(&bad, 1);
+    assert!(line.starts_with("error: RUST_LOG `"), "{line}");
+    assert!(
+        line.contains("\\u{1b}") && line.contains("\\u{202e}"),
+        "{line}"
+    );
+    assert!(!stderr(&bad).contains('\u{1b}') && !stderr(&bad).contains('\u{202e}'));
     // -vv lowers the level: the warnings stay; -q and -v together are a usage error.
     let verbose = tumble().arg("-vv").args(&args).output().unwrap();
     assert!(stderr(&verbose).contains("WARN"));
@@ -256,6 +274,24 @@ fn the_summary_gives_total_energy_and_never_an_unexplained_nan() {
     assert!(energy.contains("kinetic + spring + gravity"), "{energy}");
     assert!(energy.contains("not conserved: damping"), "{energy}");
     assert!(text.lines().any(|l| l.starts_with("|L|")), "{text}");
+    assert!(!text.contains("NaN") && !text.contains("inf"), "{text}");
+}
+
+/// A world that starts with no energy (one body at rest, no gravity): `compare` gives the change
+/// from zero, not a ratio to it (which printed `E/E₀ = NaN`).
+#[test]
+fn compare_from_zero_energy_prints_no_nan() {
+    let scene = "name = \"still\"\n[world]\ndt = 0.01\nsteps = 5\n[[bodies]]\nname = \"a\"\n\
+                 mass = 1.0\ninertia = [1.0, 1.0, 1.0]\n";
+    let (_dir, path) = scratch_file("still.toml", scene);
+    let output = tumble_run(&["compare", path.to_str().unwrap()]);
+    assert!(output.status.success(), "{}", stderr(&output));
+    let text = String::from_utf8_lossy(&output.stdout);
+    let energy = text
+        .lines()
+        .find(|l| l.starts_with("total energy"))
+        .unwrap();
+    assert!(energy.contains("from 0"), "{energy}");
     assert!(!text.contains("NaN") && !text.contains("inf"), "{text}");
 }
 

@@ -270,6 +270,46 @@ fn ending_signals_remove_the_temporary_file_and_exit_130() {
     }
 }
 
+/// A signal where no loop polls (the quick report, which writes all its files at the end) ends
+/// the process at once with exit code 130, and with the `error:` line every failure ends with
+/// (it ended silently), having written nothing.
+#[cfg(unix)]
+#[test]
+fn a_signal_outside_a_polling_loop_ends_with_an_error_line() {
+    let dir = scratch_dir();
+    let out = dir.path().join("report");
+    let mut child = tumble()
+        .args(["report", "--quick", "--out"])
+        .arg(&out)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(500));
+    assert!(
+        Command::new("kill")
+            .arg("-TERM")
+            .arg(child.id().to_string())
+            .status()
+            .unwrap()
+            .success()
+    );
+    let status = wait_at_most(&mut child, Duration::from_secs(20));
+    assert_eq!(status.code(), Some(130));
+    let mut message = String::new();
+    std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut message).unwrap();
+    assert_eq!(
+        message.lines().last(),
+        Some("error: interrupted; no output file was written or changed"),
+        "{message}"
+    );
+    assert!(
+        !out.exists() || listing(&out).is_empty(),
+        "{:?}",
+        listing(dir.path())
+    );
+}
+
 /// A run that crosses the file-size limit (`ulimit -f`, SIGXFSZ) fails with an `error:` line and
 /// leaves no temporary file (the signal's default action killed it and left the file).
 #[cfg(unix)]
@@ -525,6 +565,14 @@ fn report_and_bench_refuse_an_unwritable_destination_before_working() {
     let dir = scratch_dir();
     let readme = dir.path().join("README.md");
     std::fs::write(&readme, "no markers here\n").unwrap();
+    // Two pairs of one section's markers: which is the section is not clear, and replacing
+    // the first left the second stale.
+    let twice = dir.path().join("TWICE.md");
+    std::fs::write(
+        &twice,
+        "<!-- report:begin -->\na\n<!-- report:end -->\n<!-- report:begin -->\nb\n<!-- report:end -->\n",
+    )
+    .unwrap();
     let read_only = dir.path().join("kept");
     std::fs::create_dir(&read_only).unwrap();
     let report_md = read_only.join("report.md");
@@ -564,6 +612,19 @@ fn report_and_bench_refuse_an_unwritable_destination_before_working() {
                 readme.clone().into(),
             ],
             format!("error: {}: no <!-- report:begin -->", readme.display()),
+        ),
+        (
+            "report",
+            vec![
+                "--out".into(),
+                fresh.clone().into(),
+                "--readme".into(),
+                twice.clone().into(),
+            ],
+            format!(
+                "error: {}: more than one <!-- report:begin -->",
+                twice.display()
+            ),
         ),
         (
             "bench",

@@ -1,6 +1,7 @@
 //! A failed write to standard output is an `error:` line and exit code 1, never a panic (exit
-//! 101) and never a success with the output lost: a pipe whose reader is gone, and a full
-//! device.
+//! 101) and never a success with the output lost: a pipe whose reader is gone, a full device, a
+//! standard output opened read-only, and one closed (which Rust's runtime turns into
+//! `/dev/null` before `main`, where writes would succeed unread).
 
 mod common;
 
@@ -27,7 +28,8 @@ fn check_failed(args: &[&str], output: &Output, what: &str) {
     );
     let last = stderr.lines().last().unwrap_or_default();
     assert!(
-        last.starts_with("error: writing") && last.contains("standard output"),
+        (last.starts_with("error: writing") || last.starts_with("error: standard output"))
+            && last.contains("standard output"),
         "{args:?} into {what}: {stderr}"
     );
     assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
@@ -63,5 +65,46 @@ fn a_full_device_is_an_error() {
             .output()
             .unwrap();
         check_failed(args, &output, "/dev/full");
+    }
+}
+
+#[cfg(unix)]
+#[test]
+fn a_read_only_standard_output_is_an_error() {
+    for args in PRINTING {
+        let read_only = std::fs::File::open("/dev/null").unwrap();
+        let output = tumble()
+            .args(*args)
+            .stdout(Stdio::from(read_only))
+            .stderr(Stdio::piped())
+            .output()
+            .unwrap();
+        check_failed(args, &output, "a read-only descriptor");
+    }
+}
+
+/// A closed standard output (`>&-`) is an error; `> /dev/null`, output the caller discards on
+/// purpose, is a success.
+#[cfg(target_os = "linux")]
+#[test]
+fn a_closed_standard_output_is_an_error_and_dev_null_is_not() {
+    let shell = |redirect: &str, args: &[&str]| {
+        std::process::Command::new("sh")
+            .arg("-c")
+            .arg(format!("exec \"$0\" \"$@\" {redirect}"))
+            .arg(env!("CARGO_BIN_EXE_tumble"))
+            .args(args)
+            .stderr(Stdio::piped())
+            .output()
+            .unwrap()
+    };
+    for args in PRINTING {
+        check_failed(args, &shell(">&-", args), "a closed descriptor");
+        let discarded = shell("> /dev/null", args);
+        assert!(
+            discarded.status.success(),
+            "{args:?} into /dev/null: {}",
+            String::from_utf8_lossy(&discarded.stderr)
+        );
     }
 }

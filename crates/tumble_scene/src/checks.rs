@@ -4,7 +4,7 @@
 use std::borrow::Cow;
 use std::collections::HashMap;
 use std::num::NonZeroU32;
-use tumble_core::math::{Quat, REAL_NAME, Real, Vec3, quat_normalize};
+use tumble_core::math::{Quat, REAL_NAME, Real, Vec3, Widen, quat_normalize};
 
 use bevy_ecs::prelude::*;
 
@@ -433,7 +433,54 @@ pub(crate) fn shape_mass(
             });
         }
     };
-    result.map_err(|e| mass_error(ck, i, e))
+    result.map_err(|e| match analytic_volume(shape) {
+        // Dimensions and density are > 0: only the range of the precision can make a solid
+        // shape's mass properties fail (parry's `mass()` reads an overflowed mass as 0).
+        Some(volume) => range_error(ck, i, volume, density.get().widen()),
+        None => mass_error(ck, i, e),
+    })
+}
+
+/// The volume of a shape given by its dimensions, in `f64` (m³): parry computes it in the
+/// engine's precision, whose range it can leave while the dimensions do not. `None` for a hull.
+fn analytic_volume(shape: &ShapeDef) -> Option<f64> {
+    use std::f64::consts::PI;
+    let ball = |r: f64| 4.0 / 3.0 * PI * r * r * r;
+    match *shape {
+        ShapeDef::Ball(r) => Some(ball(r)),
+        ShapeDef::Cuboid([x, y, z]) => Some(8.0 * x * y * z),
+        ShapeDef::Capsule([hh, r]) => Some(PI * r * r * 2.0 * hh + ball(r)),
+        ShapeDef::Cylinder([hh, r]) => Some(PI * r * r * 2.0 * hh),
+        ShapeDef::Cone([hh, r]) => Some(PI * r * r * 2.0 * hh / 3.0),
+        ShapeDef::ConvexHull(_) => None,
+    }
+}
+
+/// The mass properties of a solid shape of `volume` (m³, `f64`) and `density` left the range
+/// of the precision: says where, with the mass `ρV` in `f64` (the engine's own number reads an
+/// overflowed mass as 0).
+fn range_error(ck: &Checker<'_>, i: usize, volume: f64, density: f64) -> SceneError {
+    let mass = volume * density;
+    let (largest, smallest) = (Real::MAX.widen(), Real::MIN_POSITIVE.widen());
+    let why = if mass > largest || mass.is_nan() {
+        format!("the mass ρV = {mass:.3e} kg is past {REAL_NAME}'s largest number ({largest:.3e})")
+    } else if mass < smallest {
+        format!("the mass ρV = {mass:.3e} kg is below {REAL_NAME}'s smallest normal number")
+    } else {
+        format!(
+            "the volume ({volume:.3e} m³) or the moments of inertia leave {REAL_NAME}'s range \
+             (mass ρV = {mass:.3e} kg)"
+        )
+    };
+    ck.error(
+        "bodies",
+        Some(i),
+        "shape",
+        format!(
+            "{why}: expected dimensions and a density whose mass and moments of inertia are \
+             finite and > 0 in {REAL_NAME}"
+        ),
+    )
 }
 
 /// A shape whose mass properties are not valid.

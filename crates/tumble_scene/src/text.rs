@@ -90,18 +90,44 @@ pub fn path_for_terminal(path: &std::path::Path) -> String {
 }
 
 /// `text` with what stands between `<!-- {name}:begin -->` and `<!-- {name}:end -->` replaced
-/// by a line break and `section`; `None` when the markers are missing.
+/// by a line break and `section`; `None` unless the text holds exactly one pair of them, in
+/// that order (a second pair would be left stale, or the text between two begins lost).
 pub fn replace_between_markers(text: &str, name: &str, section: &str) -> Option<String> {
     let begin = format!("<!-- {name}:begin -->");
     let end = format!("<!-- {name}:end -->");
+    if markers_repeated(text, name) {
+        return None;
+    }
     let start = text.find(&begin)? + begin.len();
     let end = start + text[start..].find(&end)?;
     Some(format!("{}\n{}{}", &text[..start], section, &text[end..]))
 }
 
+/// True when `text` holds either marker of section `name` more than once.
+pub fn markers_repeated(text: &str, name: &str) -> bool {
+    ["begin", "end"]
+        .iter()
+        .any(|which| text.matches(&format!("<!-- {name}:{which} -->")).count() > 1)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn markers_are_replaced_once_and_repeated_ones_refused() {
+        let one = "a\n<!-- s:begin -->\nold\n<!-- s:end -->\nb";
+        assert_eq!(
+            replace_between_markers(one, "s", "new\n").unwrap(),
+            "a\n<!-- s:begin -->\nnew\n<!-- s:end -->\nb"
+        );
+        let two = "<!-- s:begin -->x<!-- s:end --> <!-- s:begin -->y<!-- s:end -->";
+        assert!(markers_repeated(two, "s"));
+        assert_eq!(replace_between_markers(two, "s", "new"), None);
+        let two_begins = "<!-- s:begin -->x<!-- s:begin -->y<!-- s:end -->";
+        assert_eq!(replace_between_markers(two_begins, "s", "new"), None);
+        assert!(!markers_repeated(one, "s"));
+    }
 
     #[test]
     fn plain_text_is_borrowed_unchanged() {

@@ -341,7 +341,8 @@ impl Checker<'_> {
                 index,
                 key,
                 format!(
-                    "{} rounds to 0 in {REAL_NAME}; expected 0 or a magnitude ≥ {:.1e}",
+                    // Not "expected 0 or …": whether 0 itself is allowed is the field's rule.
+                    "{} rounds to 0 in {REAL_NAME}, whose smallest magnitude is {:.1e}",
                     compact(x),
                     Real::from_bits(1)
                 ),

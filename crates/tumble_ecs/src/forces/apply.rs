@@ -326,16 +326,38 @@ enum SpringPush {
 }
 
 impl SpringPush {
-    /// The push of `spring` on the bodies as `targets` holds them: nothing where the force is
-    /// not finite (bad data game code wrote into an end between steps — that body is refused by
-    /// the integrate systems, or by [`check_fixed_bodies`](crate::integrate::check_fixed_bodies)
-    /// where tumble never steps it — and the spring must not carry it to the other end first).
+    /// The push of `spring` on the bodies as `targets` holds them. Where the force is not
+    /// finite: nothing if an end's anchor or centre is not finite either (bad data game code
+    /// wrote into that body between steps — it is refused by the integrate systems, or by
+    /// [`check_fixed_bodies`](crate::integrate::check_fixed_bodies) where tumble never steps it
+    /// — and the spring must not carry it to the other end first); the force as it is where
+    /// both ends are finite and the force overflowed the precision (`k (ℓ − L₀)` past its
+    /// largest number): both bodies then carry a force that is not finite and are refused for
+    /// it, loudly, rather than stepped as if the spring were not there.
     #[inline]
     fn of(spring: &Spring, targets: &Targets) -> Self {
         let push = Self::unchecked(spring, targets);
-        match push {
-            Self::OnA { f, .. } | Self::OnBoth { f, .. } if !f.is_finite() => Self::Nothing,
-            push => push,
+        let (force, ends) = push.finite();
+        if force || ends { push } else { Self::Nothing }
+    }
+
+    /// Whether the force is finite, and whether every anchor and centre it acts at is.
+    #[inline(always)]
+    fn finite(&self) -> (bool, bool) {
+        match *self {
+            Self::Nothing => (true, true),
+            Self::OnA { f, pa, com_a } => (f.is_finite(), pa.is_finite() && com_a.is_finite()),
+            Self::OnBoth {
+                f,
+                pa,
+                com_a,
+                pb,
+                com_b,
+                ..
+            } => (
+                f.is_finite(),
+                pa.is_finite() && com_a.is_finite() && pb.is_finite() && com_b.is_finite(),
+            ),
         }
     }
 

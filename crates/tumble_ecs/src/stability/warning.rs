@@ -321,20 +321,61 @@ fn exact_free_flow(
         } else {
             format!(" and {} more bodies", bodies - 1)
         },
+        // An estimate past the precision's range (a step of 1e38 s) says so, not `inf`.
         if integrator.composition().len() > 1 {
             format!(
-                "err by {:.1} % a stage (Δt²|ω_b ω_c||I_b − I_c|/I_a > {:.0} %)",
-                100.0 * measure,
+                "err by {} a stage (Δt²|ω_b ω_c||I_b − I_c|/I_a > {:.0} %)",
+                if measure.is_finite() {
+                    format!("{:.1} %", 100.0 * measure)
+                } else {
+                    format!("more than {REAL_NAME} can count")
+                },
                 100.0 * COMPOSED_SPLIT_ERROR_LIMIT
             )
         } else {
             format!(
-                "drift by about {measure:.1e} rad in {ACCURACY_HORIZON} s (> \
-                         {SPLIT_DRIFT_TOLERANCE:.0e} rad, the {REAL_NAME} state's own rounding)"
+                "drift by {} in {ACCURACY_HORIZON} s (> {SPLIT_DRIFT_TOLERANCE:.0e} rad, the \
+                 {REAL_NAME} state's own rounding)",
+                if measure.is_finite() {
+                    format!("about {measure:.1e} rad")
+                } else {
+                    format!("more radians than {REAL_NAME} can count")
+                }
             )
         },
         integrator
             .exact_counterpart()
             .map_or("exact", |exact| exact.name()),
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A split's error estimate past the precision's range (a step of 1e38 s) is said in words,
+    /// never printed as `inf`; a finite one keeps its number.
+    #[test]
+    fn an_estimate_past_the_range_is_not_printed_as_inf() {
+        let body = Entity::from_raw_u32(7).expect("a valid index");
+        for integrator in [Integrator::Splitting, Integrator::Yoshida4] {
+            let text = |measure: Real| {
+                StabilityWarning::ExactFreeFlow {
+                    body,
+                    bodies: 1,
+                    integrator,
+                    measure,
+                }
+                .to_string()
+            };
+            let past = text(Real::INFINITY);
+            assert!(!past.contains("inf") && !past.contains("NaN"), "{past}");
+            assert!(past.contains("can count"), "{past}");
+            let finite = text(0.25);
+            assert!(
+                finite.contains("2.5e-1 rad") || finite.contains("25.0 %"),
+                "{finite}"
+            );
+        }
+    }
 }

@@ -662,6 +662,78 @@ fn bad_data_in_a_fixed_body_harms_none_of_its_springs_bodies() {
     }
 }
 
+/// A spring whose force overflows the precision (`k (ℓ − L₀)` past its largest number, both
+/// ends finite) refuses the bodies it pulls, loudly, with a force that is not finite: it is not
+/// left out of the step as if it were not there (the bodies then stood still, and the run
+/// reported success). To a world point and between two bodies; a healthy body beside them
+/// steps on untouched.
+#[test]
+fn a_spring_force_past_the_precision_refuses_its_bodies() {
+    for between_bodies in [false, true] {
+        let case = if between_bodies {
+            "two bodies"
+        } else {
+            "a world point"
+        };
+        let mut world = world_with(1.0 / 60.0, Integrator::Splitting);
+        world.resource_mut::<PhysicsSettings>().springs = SpringSolver::Explicit;
+        let body = |world: &mut World, x: Real| {
+            world
+                .spawn((
+                    RigidBody,
+                    mass_props(1.0, [1.0, 1.0, 1.0]),
+                    Pose::from_translation(Vec3::new(x, 0.0, 0.0)),
+                    Velocity::ZERO,
+                    ForceAccumulator::default(),
+                ))
+                .id()
+        };
+        let a = body(&mut world, 0.0);
+        let healthy = body(&mut world, 5.0);
+        // `k ℓ` is ten times the precision's largest number, `ℓ` itself is finite.
+        let far = Real::MAX / 2.0;
+        let (b, spring_end) = if between_bodies {
+            let b = body(&mut world, far);
+            (Some(b), SpringEnd::on_body(b, Vec3::ZERO))
+        } else {
+            (None, SpringEnd::World(Vec3::new(far, 0.0, 0.0)))
+        };
+        world.spawn(Spring::new(a, Vec3::ZERO, spring_end, 20.0, 0.0));
+        let mut physics = PhysicsRunner::new(&mut world);
+        run_steps(&mut world, &mut physics, 2);
+        for pulled in std::iter::once(a).chain(b) {
+            let rejected = world
+                .get::<Rejected>(pulled)
+                .unwrap_or_else(|| panic!("{case}: a pulled body was not refused"));
+            assert!(
+                matches!(
+                    &rejected.0.kind,
+                    BodyErrorKind::Invalid {
+                        component: "ForceAccumulator",
+                        ..
+                    }
+                ),
+                "{case}: {}",
+                rejected.0
+            );
+            assert!(
+                world
+                    .resource::<PhysicsErrors>()
+                    .bodies
+                    .iter()
+                    .any(|e| e.entity == pulled),
+                "{case}: not recorded"
+            );
+        }
+        assert!(world.get::<Rejected>(healthy).is_none(), "{case}");
+        assert_eq!(
+            world.get::<Pose>(healthy).unwrap().translation,
+            Vec3::new(5.0, 0.0, 0.0),
+            "{case}"
+        );
+    }
+}
+
 /// A negative or NaN damping rate written by game code is refused for its body, naming the
 /// field, on the explicit and the implicit path: the damping flow treats such a rate as no
 /// damping (never growth), so without the check it would be ignored silently.

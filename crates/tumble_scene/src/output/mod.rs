@@ -124,6 +124,18 @@ pub enum OutputError {
         /// The section's name.
         name: String,
     },
+    /// A Markdown file to update holds a section's marker more than once: which pair is the
+    /// section is not clear, and replacing one would leave the other stale.
+    #[error(
+        "{}: more than one <!-- {name}:begin --> or <!-- {name}:end --> marker; expected one pair",
+        path_for_terminal(.path)
+    )]
+    RepeatedMarkers {
+        /// The file.
+        path: std::path::PathBuf,
+        /// The section's name.
+        name: String,
+    },
     /// An I/O error while checking, writing or renaming.
     #[error("{}: {source}", path_for_terminal(.path))]
     Io {
@@ -154,6 +166,7 @@ impl OutputError {
             | Self::SymlinkLoop { path }
             | Self::UntrustedLink { path, .. }
             | Self::MissingMarkers { path, .. }
+            | Self::RepeatedMarkers { path, .. }
             | Self::Io { path, .. } => path,
             Self::EmptyPath => Path::new(""),
         }

@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use super::OutputError;
-use crate::text::replace_between_markers;
+use crate::text::{markers_repeated, replace_between_markers};
 
 /// The text of the Markdown file at `path` with, for each `(name, section)`, what stands between
 /// `<!-- {name}:begin -->` and `<!-- {name}:end -->` replaced by `section`. Reads the file; writes
@@ -13,6 +13,12 @@ use crate::text::replace_between_markers;
 pub fn with_sections(path: &Path, sections: &[(&str, &str)]) -> Result<String, OutputError> {
     let mut text = std::fs::read_to_string(path).map_err(|e| OutputError::io(path, e))?;
     for &(name, section) in sections {
+        if markers_repeated(&text, name) {
+            return Err(OutputError::RepeatedMarkers {
+                path: path.to_owned(),
+                name: name.to_owned(),
+            });
+        }
         text = replace_between_markers(&text, name, section).ok_or_else(|| {
             OutputError::MissingMarkers {
                 path: path.to_owned(),
