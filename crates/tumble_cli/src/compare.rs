@@ -244,7 +244,7 @@ fn comparison_scene(scene: &Scene) -> ComparisonScene {
         .collect();
     let mut spring_defs = Vec::new();
     for force in scene.forces() {
-        match *force {
+        match force {
             SceneForce::Constant { body, force, point } => {
                 bodies[body].loads.push(Load::Force {
                     force,

@@ -6,6 +6,7 @@ use bevy_app::App;
 use bevy_ecs::prelude::*;
 use bevy_ecs::schedule::ScheduleLabel;
 use tumble_core::math::{Real, Vec3, to_f64};
+use tumble_ecs::components::{ImplicitBody, ImplicitSpring};
 use tumble_ecs::prelude::*;
 use tumble_ecs::schedule::TumblePlugin;
 
@@ -194,5 +195,98 @@ fn a_body_without_mass_is_marked_once() {
             !tumble_ecs::components::bodies_without_mass(world),
             "{name}"
         );
+    }
+}
+
+/// The total linear momentum of `bodies` (kg·m/s, `f64`).
+fn momentum(world: &World, bodies: &[Entity]) -> [f64; 3] {
+    let mut p = [0.0; 3];
+    for &e in bodies {
+        let m = to_f64(world.get::<MassProps>(e).unwrap().mass());
+        let v = world.get::<Velocity>(e).unwrap().linear;
+        for (p, v) in p.iter_mut().zip(v.to_array()) {
+            *p += m * to_f64(v);
+        }
+    }
+    p
+}
+
+/// A spring changed in place — its end moved to another body, its stiffness raised past the
+/// explicit step's reach — or a body's mass lowered is classified again before the next step,
+/// though the number of springs and every body's components stay the same: a stiff spring
+/// rewired onto a free body pulls both its new ends (it pulled one, creating momentum), and a
+/// spring made stiff either way is stepped implicitly (it stayed explicit and blew up). Each
+/// change alone, the world's tables unchanged by it.
+#[test]
+fn springs_and_masses_changed_in_place_are_classified_again() {
+    let body = |world: &mut World, y: Real| {
+        let mass = MassProperties::new(Mass::new(1.0).unwrap(), Vec3::splat(0.1)).unwrap();
+        let pose = Pose::from_translation(Vec3::new(0.0, y, 0.0));
+        (world.spawn((
+            RigidBody,
+            MassProps(mass),
+            pose,
+            ForceAccumulator::default(),
+        )))
+        .id()
+    };
+    let pair = |world: &mut World, y: Real, k: Real, rest: Real| {
+        let (a, b) = (body(world, y), body(world, y + 1.0));
+        let spring = Spring::new(a, Vec3::ZERO, SpringEnd::on_body(b, Vec3::ZERO), k, rest);
+        (a, b, world.spawn(spring).id())
+    };
+    for mut entry in Entry::all() {
+        let name = entry.name();
+        entry.world().resource_mut::<PhysicsSettings>().integrator = Integrator::Splitting;
+        let world = entry.world();
+        let (a, b, stiff) = pair(world, 0.0, 1.0e6, 1.0);
+        let c = body(world, 1.1);
+        let (_, _, soft) = pair(world, 5.0, 1.0, 0.9);
+        let (f, g, light) = pair(world, 10.0, 1.0, 0.9);
+        entry.step(5);
+        let implicit =
+            |entry: &mut Entry, spring| entry.world().get::<ImplicitSpring>(spring).is_some();
+        assert!(implicit(&mut entry, stiff), "{name}");
+        assert!(
+            !implicit(&mut entry, soft) && !implicit(&mut entry, light),
+            "{name}"
+        );
+        // The stiff spring moved from `b` to `c`, 0.1 m past its rest length.
+        entry.world().get_mut::<Spring>(stiff).unwrap().b = SpringEnd::on_body(c, Vec3::ZERO);
+        entry.step(30);
+        let world = entry.world();
+        assert!(world.get::<ImplicitBody>(c).is_some(), "{name}");
+        let vc = world.get::<Velocity>(c).unwrap().linear;
+        assert!(vc.length() > 1.0, "{name}: `c` not pulled ({vc})");
+        // The pair a–c keeps its momentum (zero) to the solve's tolerance: it is pulled at
+        // both ends.
+        let p = momentum(world, &[a, b, c]);
+        let scale = to_f64(vc.length());
+        assert!(
+            p.iter().all(|p| p.abs() <= 1e-4 * scale),
+            "{name}: momentum {p:?} of a pair moving at {scale} m/s"
+        );
+        // The soft spring a million times stiffer: √(k/μ)Δt = 14.
+        entry.world().get_mut::<Spring>(soft).unwrap().stiffness = 1.0e6;
+        entry.step(1);
+        assert!(
+            implicit(&mut entry, soft),
+            "{name}: the stiffened spring left explicit"
+        );
+        // The light pair's masses a million times smaller (the same inertia shape).
+        for body in [f, g] {
+            let mass = MassProperties::new(Mass::new(1.0e-6).unwrap(), Vec3::splat(1.0e-7));
+            entry
+                .world()
+                .entity_mut(body)
+                .insert(MassProps(mass.unwrap()));
+        }
+        entry.step(1);
+        assert!(
+            implicit(&mut entry, light),
+            "{name}: the lightened pair left explicit"
+        );
+        let errors = entry.world().resource::<PhysicsErrors>();
+        assert!(errors.bodies.is_empty(), "{name}: {:?}", errors.bodies);
     }
 }

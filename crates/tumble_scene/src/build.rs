@@ -18,7 +18,7 @@ use crate::text::terminal_safe;
 use crate::validate::{Checker, Locate, NoText, TomlText};
 
 use crate::checks::{
-    bad_name, bad_text, checked_body, checked_extras, compose_names, validate_body,
+    bad_name, bad_text, checked_body, checked_extras, checked_force, compose_names, validate_body,
     validate_forces, validate_world,
 };
 use crate::model::{SceneForce, ValidBody};
@@ -36,7 +36,6 @@ pub struct Scene {
     settings: PhysicsSettings,
     steps: u64,
     gravity: Option<Vec3>,
-    forces: Vec<SceneForce>,
 }
 
 /// One body of a [`Scene`], as the engine will start it.
@@ -200,13 +199,14 @@ impl Scene {
             // model once, not a second, engine-ready copy of every body.
             validate_body(&ck, i, b)?;
         }
-        let forces = validate_forces(&ck, &parsed.forces, &names)?;
+        // Checked here and converted again where the world is built, like the bodies: a file
+        // of springs is held once, as read.
+        validate_forces(&ck, &parsed.forces, &names)?;
         Ok(Self {
             file: parsed,
             settings: world.settings,
             steps: world.steps,
             gravity: world.gravity,
-            forces,
         })
     }
 
@@ -245,9 +245,33 @@ impl Scene {
         self.gravity
     }
 
-    /// The force generators, in file order, as checked.
-    pub fn forces(&self) -> &[SceneForce] {
-        &self.forces
+    /// The force generators, in file order, as checked (converted from the file model, which
+    /// the scene holds alone).
+    pub fn forces(&self) -> Vec<SceneForce> {
+        let names = self.names();
+        self.scene_forces(&names).collect()
+    }
+
+    /// Each body's index by name, borrowed from the file model (the names the checks found
+    /// the forces' bodies by).
+    fn names(&self) -> HashMap<&str, usize> {
+        (self.file.bodies.iter().enumerate())
+            .map(|(i, b)| (b.name.as_str(), i))
+            .collect()
+    }
+
+    /// The force generators in engine form, in file order, converted from the file model as
+    /// they were checked, their bodies found in `names`.
+    fn scene_forces<'s>(
+        &'s self,
+        names: &'s HashMap<&'s str, usize>,
+    ) -> impl Iterator<Item = SceneForce> + Clone + 's {
+        let ck = Checker {
+            file: &self.file.name,
+            locate: &NoText,
+        };
+        (self.file.forces.iter().enumerate())
+            .map(move |(i, f)| checked_force(&ck, i, f, names).expect(CHECKED))
     }
 
     /// Each body with its mass properties, initial state and per-body parameters, in file
@@ -284,16 +308,17 @@ impl Scene {
     /// scene was parsed.
     pub fn build(&self) -> BuiltScene {
         let mut world = self.world_for_bodies();
-        let loaded = self.loaded_bodies();
-        let classified = self.classification();
+        let names = self.names();
+        let loaded = self.loaded_bodies(self.scene_forces(&names));
+        let classified = self.classification(self.scene_forces(&names));
         let kinds = self.body_kinds(&loaded, &classified);
         let file = &self.file.name;
         let bodies = spawn_in_runs(&mut world, &kinds, &loaded, &classified, |i| {
             let def = &self.file.bodies[i];
             (def.name.clone(), checked_body(file, i, def))
         });
-        let kinds = self.force_runs(&classified.implicit_springs);
-        let mut forces = self.forces.iter().copied();
+        let kinds = force_runs(self.scene_forces(&names), &classified.implicit_springs);
+        let mut forces = self.scene_forces(&names);
         spawn_forces(&mut world, &bodies, &kinds, || {
             forces.next().expect("one kind per force")
         });
@@ -305,11 +330,12 @@ impl Scene {
     /// their sum (a million bodies: ≈ 250 MB of file model, ≈ 200 MB of world).
     pub fn into_built(mut self) -> BuiltScene {
         let mut world = self.world_for_bodies();
-        // The forces' file model (names as strings) is not needed once checked: `self.forces`
-        // holds them by index. Dropped before anything else is built.
-        drop(std::mem::take(&mut self.file.forces));
-        let loaded = self.loaded_bodies();
-        let classified = self.classification();
+        // What the spawns need of the forces, from one pass each over the file model.
+        let names = self.names();
+        let loaded = self.loaded_bodies(self.scene_forces(&names));
+        let classified = self.classification(self.scene_forces(&names));
+        let force_kinds = force_runs(self.scene_forces(&names), &classified.implicit_springs);
+        drop(names);
         let kinds = self.body_kinds(&loaded, &classified);
         let mut defs = std::mem::take(&mut self.file.bodies);
         let n = defs.len();
@@ -326,24 +352,32 @@ impl Scene {
             }
             (def.name, body)
         });
-        drop(defs);
-        // The forces the same way: released as their generators are spawned, so that a file of
-        // springs is not held twice, once checked and once spawned.
-        let kinds = self.force_runs(&classified.implicit_springs);
-        drop(classified);
-        let mut forces = std::mem::take(&mut self.forces);
+        drop((defs, classified));
+        // The forces the same way: converted from the file model as their generators spawn,
+        // and released, so that a file of springs is never held twice. Their bodies are found
+        // by the names the spawned bodies took along (the same indices: file order).
+        let mut forces = std::mem::take(&mut self.file.forces);
+        let file = std::mem::take(&mut self.file.name);
         drop(self);
+        let names: HashMap<&str, usize> = (bodies.iter().enumerate())
+            .map(|(i, (name, _))| (name.as_str(), i))
+            .collect();
+        let ck = Checker {
+            file: &file,
+            locate: &NoText,
+        };
         forces.reverse();
         let release_every = (forces.len() / 8).max(1 << 16);
         let mut spawned = 0;
-        spawn_forces(&mut world, &bodies, &kinds, || {
+        spawn_forces(&mut world, &bodies, &force_kinds, || {
+            let def = forces.pop().expect("one kind per force");
             spawned += 1;
             if spawned % release_every == 0 {
                 forces.shrink_to_fit();
             }
-            forces.pop().expect("one kind per force")
+            checked_force(&ck, spawned - 1, &def, &names).expect(CHECKED)
         });
-        drop(kinds);
+        drop((forces, names, force_kinds));
         // Planning builds tables of its own (the springs' classification, the audit's) with
         // only the world and the names held.
         planned(world, bodies)
@@ -353,10 +387,10 @@ impl Scene {
     /// [`ForceAccumulator`] (which the generator's hook would otherwise add): adding a component
     /// moves the body to another table, and the table it leaves keeps its memory, so a world
     /// whose bodies all get one would hold them twice.
-    fn loaded_bodies(&self) -> Vec<bool> {
+    fn loaded_bodies(&self, forces: impl Iterator<Item = SceneForce>) -> Vec<bool> {
         let mut loaded = vec![false; self.file.bodies.len()];
-        for f in &self.forces {
-            match *f {
+        for f in forces {
+            match f {
                 SceneForce::Constant { body, .. } | SceneForce::Torque { body, .. } => {
                     loaded[body] = true;
                 }
@@ -389,8 +423,8 @@ impl Scene {
     /// The spring classification of the scene's world (see
     /// [`tumble_ecs::springs::classify`]), so that its bodies and springs are spawned with the
     /// markers it gives them; empty when the scene has no springs.
-    fn classification(&self) -> Classification {
-        let springs = self.forces.iter().filter_map(|f| match *f {
+    fn classification(&self, forces: impl Iterator<Item = SceneForce> + Clone) -> Classification {
+        let springs = forces.filter_map(|f| match f {
             SceneForce::Spring {
                 a,
                 anchor_a,
@@ -423,24 +457,31 @@ impl Scene {
         }
         world
     }
-
-    /// The runs of one kind the scene's forces are spawned in (see [`spawn_forces`]).
-    fn force_runs(&self, implicit_springs: &[bool]) -> Vec<ForceRun> {
-        let mut spring = 0;
-        (self.forces.iter())
-            .map(|f| match f {
-                SceneForce::Constant { .. } => ForceRun::Constant,
-                SceneForce::Torque { .. } => ForceRun::Torque,
-                SceneForce::Spring { .. } => {
-                    spring += 1;
-                    ForceRun::Spring {
-                        implicit: implicit_springs.get(spring - 1).copied().unwrap_or(false),
-                    }
-                }
-            })
-            .collect()
-    }
 }
+
+/// The runs of one kind `forces` are spawned in (see [`spawn_forces`]), springs of one solve
+/// by `implicit_springs` (per spring).
+fn force_runs(
+    forces: impl Iterator<Item = SceneForce>,
+    implicit_springs: &[bool],
+) -> Vec<ForceRun> {
+    let mut spring = 0;
+    forces
+        .map(|f| match f {
+            SceneForce::Constant { .. } => ForceRun::Constant,
+            SceneForce::Torque { .. } => ForceRun::Torque,
+            SceneForce::Spring { .. } => {
+                spring += 1;
+                ForceRun::Spring {
+                    implicit: implicit_springs.get(spring - 1).copied().unwrap_or(false),
+                }
+            }
+        })
+        .collect()
+}
+
+/// Conversions of what the scene's checks accepted cannot fail.
+const CHECKED: &str = "checked when the scene was parsed";
 
 /// The kind of a run of forces spawned by one batch: one generator type, and for springs one
 /// solve (the classification's, so that no spring moves to another table when it is planned).

@@ -109,12 +109,26 @@ pub(crate) fn validate_world(ck: &Checker<'_>, w: &WorldDef) -> Result<CheckedWo
     })
 }
 
-/// The force generators, their bodies looked up by name.
+/// Checks every force generator of the file, keeping none: a scene holds its file model once,
+/// and [`checked_force`] converts each again where the world is built.
 pub(crate) fn validate_forces(
     ck: &Checker<'_>,
     defs: &[ForceDef],
     names: &HashMap<&str, usize>,
-) -> Result<Vec<SceneForce>, SceneError> {
+) -> Result<(), SceneError> {
+    for (i, f) in defs.iter().enumerate() {
+        checked_force(ck, i, f, names)?;
+    }
+    Ok(())
+}
+
+/// Force generator `i` of the file in engine form, its bodies looked up by name in `names`.
+pub(crate) fn checked_force(
+    ck: &Checker<'_>,
+    i: usize,
+    f: &ForceDef,
+    names: &HashMap<&str, usize>,
+) -> Result<SceneForce, SceneError> {
     let body = |i: usize, key: &str, name: &str| {
         names.get(name).copied().ok_or_else(|| {
             ck.error(
@@ -128,71 +142,67 @@ pub(crate) fn validate_forces(
             )
         })
     };
-    let mut forces = Vec::with_capacity(defs.len());
-    for (i, f) in defs.iter().enumerate() {
-        let v = |key: &str, x: [f64; 3]| ck.vec3("forces", Some(i), key, x);
-        forces.push(match f {
-            ForceDef::Constant {
-                body: b,
-                force,
-                point,
-            } => SceneForce::Constant {
-                body: body(i, "body", b)?,
-                force: v("force", *force)?,
-                point: point.map(|p| v("point", p)).transpose()?,
-            },
-            ForceDef::Torque { body: b, torque } => SceneForce::Torque {
-                body: body(i, "body", b)?,
-                torque: v("torque", *torque)?,
-            },
-            ForceDef::Spring {
-                a,
-                anchor_a,
-                b,
-                anchor_b,
-                stiffness,
-                damping,
-                rest_length,
-            } => {
-                let non_negative = |key: &str, x: f64| -> Result<Real, SceneError> {
-                    let y = ck.scalar("forces", Some(i), key, x)?;
-                    if y < 0.0 {
-                        return Err(ck.error(
-                            "forces",
-                            Some(i),
-                            key,
-                            format!("expected a value >= 0, got {}", compact(x)),
-                        ));
-                    }
-                    Ok(y)
-                };
-                let a_index = body(i, "a", a)?;
-                let b_index = b.as_ref().map(|b| body(i, "b", b)).transpose()?;
-                if b_index == Some(a_index) {
+    let v = |key: &str, x: [f64; 3]| ck.vec3("forces", Some(i), key, x);
+    Ok(match f {
+        ForceDef::Constant {
+            body: b,
+            force,
+            point,
+        } => SceneForce::Constant {
+            body: body(i, "body", b)?,
+            force: v("force", *force)?,
+            point: point.map(|p| v("point", p)).transpose()?,
+        },
+        ForceDef::Torque { body: b, torque } => SceneForce::Torque {
+            body: body(i, "body", b)?,
+            torque: v("torque", *torque)?,
+        },
+        ForceDef::Spring {
+            a,
+            anchor_a,
+            b,
+            anchor_b,
+            stiffness,
+            damping,
+            rest_length,
+        } => {
+            let non_negative = |key: &str, x: f64| -> Result<Real, SceneError> {
+                let y = ck.scalar("forces", Some(i), key, x)?;
+                if y < 0.0 {
                     return Err(ck.error(
                         "forces",
                         Some(i),
-                        "b",
-                        format!(
-                            "spring joins `{}` to itself; expected a different body, \
-                             or no `b` to anchor `a` to the world point `anchor_b`",
-                            terminal_safe(a)
-                        ),
+                        key,
+                        format!("expected a value >= 0, got {}", compact(x)),
                     ));
                 }
-                SceneForce::Spring {
-                    a: a_index,
-                    anchor_a: v("anchor_a", *anchor_a)?,
-                    b: b_index,
-                    anchor_b: v("anchor_b", *anchor_b)?,
-                    k: non_negative("stiffness", *stiffness)?,
-                    c: non_negative("damping", *damping)?,
-                    rest: non_negative("rest_length", *rest_length)?,
-                }
+                Ok(y)
+            };
+            let a_index = body(i, "a", a)?;
+            let b_index = b.as_ref().map(|b| body(i, "b", b)).transpose()?;
+            if b_index == Some(a_index) {
+                return Err(ck.error(
+                    "forces",
+                    Some(i),
+                    "b",
+                    format!(
+                        "spring joins `{}` to itself; expected a different body, \
+                             or no `b` to anchor `a` to the world point `anchor_b`",
+                        terminal_safe(a)
+                    ),
+                ));
             }
-        });
-    }
-    Ok(forces)
+            SceneForce::Spring {
+                a: a_index,
+                anchor_a: v("anchor_a", *anchor_a)?,
+                b: b_index,
+                anchor_b: v("anchor_b", *anchor_b)?,
+                k: non_negative("stiffness", *stiffness)?,
+                c: non_negative("damping", *damping)?,
+                rest: non_negative("rest_length", *rest_length)?,
+            }
+        }
+    })
 }
 
 pub(crate) fn validate_body(

@@ -267,6 +267,7 @@ impl Locate for NoText {
 }
 
 /// Context for the checks of one scene: the file name and where its fields stand.
+#[derive(Clone, Copy)]
 pub(crate) struct Checker<'a> {
     /// File name for messages.
     pub file: &'a str,

@@ -258,7 +258,7 @@ impl Generator for Spring {
 
 /// The generator `g` of `entity` checked as on insert: values, then that its bodies exist
 /// (`exists`).
-fn check_inserted<G: Generator>(
+pub(crate) fn check_inserted<G: Generator>(
     g: &G,
     exists: impl Fn(Entity) -> bool,
 ) -> Result<(), GeneratorErrorKind> {

@@ -57,7 +57,7 @@ pub use markers::{Dynamic, ImplicitBody, ImplicitSpring, SpringTurn};
 pub use settings::{Gravity, PhysicsSettings, SpringSolver};
 
 pub(crate) use body::{RemovedBodies, reject};
-pub(crate) use generators::{Generator, ensure_accumulators, reject_generator};
+pub(crate) use generators::{Generator, check_inserted, ensure_accumulators, reject_generator};
 pub(crate) use markers::{Stepped, dense};
 pub(crate) use order::IndexedQuery;
 // Scratch memory of the systems that visit generators in entity order, in their signatures;

@@ -2,8 +2,8 @@ use bevy_ecs::prelude::*;
 use bevy_ecs::world::WorldId;
 
 use crate::components::{
-    ConstantForce, ConstantLocalForce, ConstantTorque, Generator, GeneratorError,
-    GeneratorErrorKind, RemovedBodies, Spring, reject_generator,
+    ConstantForce, ConstantLocalForce, ConstantTorque, ForceAccumulator, Generator, GeneratorError,
+    GeneratorErrorKind, RemovedBodies, Spring, check_inserted, reject_generator,
 };
 
 /// A query of the generators of type `G` changed since the world's last change-tracker clear,
@@ -42,12 +42,22 @@ impl GeneratorWatch {
             Some(removed)
         };
         let mut errors = Vec::new();
-        check_changed(&mut self.forces, world, orphans.as_ref(), &mut errors);
-        check_changed(&mut self.local_forces, world, orphans.as_ref(), &mut errors);
-        check_changed(&mut self.torques, world, orphans.as_ref(), &mut errors);
-        check_changed(&mut self.springs, world, orphans.as_ref(), &mut errors);
+        let mut lacking = Vec::new();
+        let found = &mut (&mut errors, &mut lacking);
+        check_changed(&mut self.forces, world, orphans.as_ref(), found);
+        check_changed(&mut self.local_forces, world, orphans.as_ref(), found);
+        check_changed(&mut self.torques, world, orphans.as_ref(), found);
+        check_changed(&mut self.springs, world, orphans.as_ref(), found);
         for (reject, error) in errors {
             reject(world, error);
+        }
+        // A generator changed in place (a spring's end moved to another body) gives its new
+        // bodies accumulators, as its insertion would have: without one a body is no target,
+        // and the force on it was dropped while its partner took the other half.
+        for body in lacking {
+            if let Ok(mut e) = world.get_entity_mut(body) {
+                e.insert_if_new(ForceAccumulator::default());
+            }
         }
     }
 }
@@ -55,14 +65,16 @@ impl GeneratorWatch {
 /// A generator to leave out, with the function that does it for its type.
 type Rejection = (fn(&mut World, GeneratorError), GeneratorError);
 
-/// Checks the generators of type `G`: the changed ones' values, and, when bodies went away
-/// (`orphans`), every one's bodies.
+/// Checks the generators of type `G`: the changed ones' values and bodies (as their insertion
+/// would: the bodies exist; those without an accumulator are listed in `found.1`), and, when
+/// bodies went away (`orphans`), every one's bodies. Rejections go to `found.0`.
 fn check_changed<G: Generator>(
     query: &mut Option<ChangedQuery<G>>,
     world: &World,
     orphans: Option<&bevy_ecs::entity::EntityHashSet>,
-    errors: &mut Vec<Rejection>,
+    found: &mut (&mut Vec<Rejection>, &mut Vec<Entity>),
 ) {
+    let (errors, lacking) = found;
     if query.as_ref().is_none_or(|(id, _)| *id != world.id()) {
         *query = world
             .try_query_filtered::<(Entity, &G), Changed<G>>()
@@ -83,8 +95,13 @@ fn check_changed<G: Generator>(
         ));
     };
     for (entity, g) in query.iter(world) {
-        if let Err(kind) = g.check_values() {
-            push(entity, kind);
+        match check_inserted(g, |body| world.get_entity(body).is_ok()) {
+            Err(kind) => push(entity, kind),
+            Ok(()) => lacking.extend(g.bodies().map(|(_, body)| body).filter(|&body| {
+                world
+                    .get_entity(body)
+                    .is_ok_and(|e| !e.contains::<ForceAccumulator>())
+            })),
         }
     }
     let Some(orphans) = orphans else {

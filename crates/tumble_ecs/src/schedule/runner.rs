@@ -135,6 +135,8 @@ pub struct PhysicsRunner {
     force_systems: Option<bevy_ecs::change_detection::Tick>,
     /// The checks of the force generators before each step.
     generators: GeneratorWatch,
+    /// The queries that tell whether the springs' classification saw every spring and mass.
+    classified: crate::springs::ClassifiedInputs,
     /// The bad [`Gravity`](crate::components::Gravity) last recorded, so that one bad value
     /// (bit for bit: a NaN is not equal to itself) is one record.
     bad_gravity: Option<tumble_core::math::Vec3>,
@@ -153,6 +155,7 @@ impl PhysicsRunner {
             springs: None,
             force_systems: force_systems_changed(world),
             generators: GeneratorWatch::default(),
+            classified: Default::default(),
             bad_gravity: None,
         }
     }
@@ -209,7 +212,7 @@ impl PhysicsRunner {
     fn is_stale(&mut self, world: &World) -> bool {
         world.get_resource::<PhysicsSettings>() != Some(&self.settings)
             || PhysicsPlan::of_with(world, &mut self.springs) != self.plan
-            || crate::springs::classification_is_stale(world)
+            || crate::springs::classification_is_stale_with(world, &mut self.classified)
             || force_systems_changed(world) != self.force_systems
     }
 

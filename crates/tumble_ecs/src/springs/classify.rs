@@ -1,8 +1,10 @@
 //! Classification of spring groups into implicit and explicit: which groups the implicit
 //! step solves, and how fast each body's springs can turn it.
 
+use bevy_ecs::change_detection::Tick;
 use bevy_ecs::entity::EntityHashMap;
 use bevy_ecs::prelude::*;
+use bevy_ecs::world::WorldId;
 
 use tumble_core::math::{Real, Vec3};
 use tumble_core::springs::{
@@ -21,6 +23,9 @@ pub struct SpringClassification {
     dt: Real,
     solver: SpringSolver,
     springs: usize,
+    /// The world's change tick when it was made: a spring or a body's mass changed (or added)
+    /// since then was not seen by it.
+    at: Tick,
 }
 
 /// The span the explicit spring step's accuracy is judged on, as if it were one plain step
@@ -48,8 +53,16 @@ fn spring_count(world: &World) -> usize {
 }
 
 /// True when [`classify_springs`] must run again: the time step, the setting or the number of
-/// springs changed since it last ran.
+/// springs changed since it last ran, or a spring (its ends, anchors, stiffness: the same count
+/// of springs rewired, or one despawned and another spawned) or a body's mass properties were
+/// changed or added since. Builds its queries: [`ClassifiedInputs`] keeps them for a caller
+/// that checks every step.
 pub fn classification_is_stale(world: &World) -> bool {
+    classification_is_stale_with(world, &mut ClassifiedInputs::default())
+}
+
+/// [`classification_is_stale`] with the queries `inputs` keeps.
+pub(crate) fn classification_is_stale_with(world: &World, inputs: &mut ClassifiedInputs) -> bool {
     let settings = world
         .get_resource::<PhysicsSettings>()
         .copied()
@@ -61,7 +74,45 @@ pub fn classification_is_stale(world: &World) -> bool {
             c.dt != classification_span(&settings)
                 || c.solver != settings.springs
                 || c.springs != springs
+                || (springs > 0 && inputs.changed_since(world, c.at))
         }
+    }
+}
+
+/// The queries of what a classification reads that can change in place (springs, bodies'
+/// mass properties), kept between steps by a caller that checks every step.
+#[derive(Default)]
+pub(crate) struct ClassifiedInputs {
+    springs: Option<(WorldId, QueryState<Ref<'static, Spring>>)>,
+    masses: Option<(
+        WorldId,
+        QueryState<Ref<'static, MassProps>, With<RigidBody>>,
+    )>,
+}
+
+impl ClassifiedInputs {
+    /// True when a spring or a rigid body's mass properties changed (or were added) after the
+    /// change tick `at`: one comparison of change ticks a component, nothing the engine's own
+    /// step writes.
+    fn changed_since(&mut self, world: &World, at: Tick) -> bool {
+        let now = world.read_change_tick();
+        let id = world.id();
+        if self.springs.as_ref().is_none_or(|(w, _)| *w != id) {
+            self.springs = world.try_query::<Ref<Spring>>().map(|q| (id, q));
+        }
+        if self.masses.as_ref().is_none_or(|(w, _)| *w != id) {
+            self.masses = world
+                .try_query_filtered::<Ref<MassProps>, With<RigidBody>>()
+                .map(|q| (id, q));
+        }
+        let newer = |tick: Tick| tick.is_newer_than(at, now);
+        self.springs
+            .as_mut()
+            .is_some_and(|(_, q)| q.iter(world).any(|s| newer(s.last_changed())))
+            || self
+                .masses
+                .as_mut()
+                .is_some_and(|(_, q)| q.iter(world).any(|m| newer(m.last_changed())))
     }
 }
 
@@ -253,10 +304,12 @@ pub fn classify_springs(world: &mut World) {
     // decides which bodies share a table.
     mark_turn_rates(world, &index, &turns);
     let springs = spring_count(world);
+    let at = world.change_tick();
     world.insert_resource(SpringClassification {
         dt,
         solver: settings.springs,
         springs,
+        at,
     });
 }
 

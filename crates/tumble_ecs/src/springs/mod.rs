@@ -120,6 +120,7 @@ pub use classify::{
     Classification, ClassifiedSpring, SpringClassification, classification_is_stale, classify,
     classify_springs,
 };
+pub(crate) use classify::{ClassifiedInputs, classification_is_stale_with};
 pub use damping::{damp_springs_end, damp_springs_start};
 pub use implicit_step::solve_implicit_springs;
 
