@@ -7,7 +7,7 @@
 //! physics states with `interpolate`. Run: `cargo run --release --example thruster_ship`.
 
 use tumble::bevy_ecs::prelude::{Entity, World};
-use tumble::math::{Real, Vec3};
+use tumble::math::{Real, Vec3, to_f64};
 use tumble::prelude::*;
 
 /// What the renderer needs of a body: its last two physics poses.
@@ -43,7 +43,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     );
 
     let mut physics = PhysicsRunner::new(&mut world);
-    let mut stepper = FixedStepper::new(dt, 8)?;
+    let mut stepper = FixedStepper::new(8)?;
     let mut rendered = Rendered {
         body: ship,
         previous: *world.get::<Pose>(ship).ok_or("no ship")?,
@@ -59,7 +59,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         };
         elapsed += frame_time;
         frame += 1;
-        let steps = stepper.advance(frame_time)?;
+        // Whole steps of the world's time step (its `PhysicsSettings`), however long the frame.
+        let steps = stepper.advance(frame_time, world.resource::<PhysicsSettings>())?;
         for _ in 0..steps.steps {
             // Game code, once per physics step: the thruster pushes along the ship's own −x
             // axis from its tail for the first 6 s; one sideways kick at 3 s.
@@ -75,7 +76,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             rendered.previous = *world.get::<Pose>(ship).ok_or("no ship")?;
             physics.step(&mut world);
             world.clear_trackers();
-            sim_time += stepper.dt() as f64;
+            sim_time += to_f64(world.resource::<PhysicsSettings>().dt());
         }
         // The renderer: between the last two physics states.
         let current = *world.get::<Pose>(rendered.body).ok_or("no ship")?;

@@ -241,3 +241,80 @@ fn a_constant_local_force_turns_with_the_body() {
     assert_eq!(errors.len(), 1);
     assert_eq!(errors[0].generator, "ConstantLocalForce");
 }
+
+/// A `Static` body never moves and a `Kinematic` one moves as game code sets it: an impulse
+/// (an explosion reaching everything in range) leaves their velocity as it was, through an
+/// entity and through `BodyForces`. And a damped spring to a static anchor whose `Velocity`
+/// holds a speed anyway (the one it had when game code made it static) does not drag the body
+/// it holds: the damper takes a static end's velocity as zero (it dragged the body away).
+#[test]
+fn fixed_bodies_take_no_impulse_and_lend_no_velocity_to_dampers() {
+    let mass = MassProperties::new(Mass::new(1.0).unwrap(), Vec3::ONE).unwrap();
+    let mut world = world(Integrator::Splitting);
+    let anchor = world
+        .spawn((
+            RigidBody,
+            Static,
+            MassProps(mass),
+            Pose::from_translation(Vec3::X * 2.0),
+        ))
+        .id();
+    let moved = world
+        .spawn((
+            RigidBody,
+            Kinematic,
+            MassProps(mass),
+            Pose::IDENTITY,
+            ForceAccumulator::default(),
+        ))
+        .id();
+    world
+        .entity_mut(anchor)
+        .apply_linear_impulse(Vec3::X * 10.0);
+    world
+        .entity_mut(moved)
+        .apply_angular_impulse(Vec3::Z * 10.0);
+    let mut state = bevy_ecs::system::SystemState::<Query<BodyForces>>::new(&mut world);
+    let mut bodies = state.get_mut(&mut world).expect("no resources needed");
+    for mut body in bodies.iter_mut() {
+        body.apply_linear_impulse(Vec3::Y * 10.0);
+    }
+    state.apply(&mut world);
+    for e in [anchor, moved] {
+        assert_eq!(
+            world.get::<Velocity>(e).copied().unwrap_or(Velocity::ZERO),
+            Velocity::ZERO
+        );
+    }
+    // The anchor made static while moving: its velocity stays in the component.
+    world
+        .entity_mut(anchor)
+        .insert(Velocity::linear(Vec3::X * 10.0));
+    let held = world
+        .spawn((
+            RigidBody,
+            MassProps(mass),
+            Pose::IDENTITY,
+            ForceAccumulator::default(),
+        ))
+        .id();
+    world.spawn(
+        Spring::new(
+            held,
+            Vec3::ZERO,
+            SpringEnd::on_body(anchor, Vec3::ZERO),
+            10.0,
+            2.0,
+        )
+        .with_damping(5.0),
+    );
+    let mut physics = PhysicsRunner::new(&mut world);
+    for _ in 0..100 {
+        physics.step(&mut world);
+    }
+    let pose = world.get::<Pose>(held).unwrap();
+    let velocity = world.get::<Velocity>(held).unwrap();
+    assert_eq!(pose.translation, Vec3::ZERO, "the held body was dragged");
+    assert_eq!(velocity.linear, Vec3::ZERO);
+    assert!(world.resource::<PhysicsErrors>().is_empty());
+}

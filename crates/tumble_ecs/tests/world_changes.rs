@@ -290,3 +290,53 @@ fn springs_and_masses_changed_in_place_are_classified_again() {
         assert!(errors.bodies.is_empty(), "{name}: {:?}", errors.bodies);
     }
 }
+
+/// A world without `PhysicsSettings` steps with the default ones and says so in
+/// `PhysicsErrors`; settings removed mid-run are put back as they were planned (not the
+/// default, which would change the step silently), recorded too.
+#[test]
+fn missing_settings_are_recorded_and_the_planned_ones_kept() {
+    let falling = |world: &mut World| {
+        world.insert_resource(Gravity(Vec3::new(0.0, G, 0.0)));
+        world.spawn((RigidBody, Pose::IDENTITY)).id()
+    };
+    let mut bare = World::new();
+    falling(&mut bare);
+    let mut runner = PhysicsRunner::new(&mut bare);
+    runner.step(&mut bare);
+    let recorded = &bare.resource::<PhysicsErrors>().world;
+    assert_eq!(recorded.len(), 1, "{recorded:?}");
+    let message = recorded[0].to_string();
+    assert!(
+        message.starts_with("PhysicsSettings: missing") && message.contains("default"),
+        "{message}"
+    );
+
+    let dt: Real = 1.0 / 120.0;
+    let mut world = World::new();
+    world.insert_resource(PhysicsSettings::new(dt, Integrator::Rk4).unwrap());
+    let body = falling(&mut world);
+    let mut runner = PhysicsRunner::new(&mut world);
+    for _ in 0..10 {
+        runner.step(&mut world);
+    }
+    world.remove_resource::<PhysicsSettings>();
+    for _ in 0..10 {
+        runner.step(&mut world);
+    }
+    let settings = world.resource::<PhysicsSettings>();
+    assert_eq!((settings.dt(), settings.integrator), (dt, Integrator::Rk4));
+    // Twenty steps of 1/120 s under gravity: v = g t, exact for every method.
+    let v = world.get::<Velocity>(body).unwrap().linear.y;
+    let exact = to_f64(G) * 20.0 * to_f64(dt);
+    assert!(rel(v, exact) < 1e-5, "v = {v}, exact {exact}");
+    let recorded = &world.resource::<PhysicsErrors>().world;
+    assert_eq!(recorded.len(), 1, "{recorded:?}");
+    assert!(
+        recorded[0]
+            .to_string()
+            .contains("the settings it was planned with"),
+        "{}",
+        recorded[0]
+    );
+}

@@ -96,16 +96,32 @@ pub struct PhysicsErrors {
     pub world: Vec<WorldError>,
 }
 
-/// A world resource game code made bad (a non-finite [`Gravity`](crate::components::Gravity)):
-/// it is left out of the step until it is valid again, rather than carried into every body it
-/// reaches. Recorded once per bad value.
+/// A world resource game code made bad (a non-finite [`Gravity`](crate::components::Gravity)),
+/// left out of the step until it is valid again rather than carried into every body it
+/// reaches; or one the step needs that is missing ([`PhysicsSettings`](crate::components::PhysicsSettings)),
+/// put back with what the step then uses. Recorded once per incident.
 #[derive(Debug, Clone, PartialEq, Error)]
-#[error("{resource}: {source}; left out of the step until it is valid")]
+#[error("{resource}: {kind}")]
 pub struct WorldError {
     /// The resource, e.g. `"Gravity"`.
     pub resource: &'static str,
     /// What is wrong with it.
-    pub source: InvalidInput,
+    pub kind: WorldErrorKind,
+}
+
+/// What is wrong with a world resource (see [`WorldError`]).
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum WorldErrorKind {
+    /// Not valid: left out of the step until it is.
+    #[error("{0}; left out of the step until it is valid")]
+    Invalid(InvalidInput),
+    /// Missing when a step needed it (removed after planning, or never inserted): put back
+    /// with what the step uses instead, said here so that it is never a silent default.
+    #[error("missing; inserted {used} (insert the resource to choose)")]
+    Missing {
+        /// What the step uses in its place.
+        used: String,
+    },
 }
 
 impl PhysicsErrors {

@@ -50,7 +50,7 @@ pub use body::{
 };
 pub use errors::{
     BodyError, BodyErrorKind, GeneratorError, GeneratorErrorKind, PhysicsErrors, Rejected,
-    RejectedGenerator, WorldError,
+    RejectedGenerator, WorldError, WorldErrorKind,
 };
 pub use generators::{ConstantForce, ConstantLocalForce, ConstantTorque, Spring, SpringEnd};
 pub use markers::{Dynamic, ImplicitBody, ImplicitSpring, SpringTurn};

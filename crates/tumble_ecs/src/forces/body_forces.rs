@@ -4,7 +4,9 @@ use bevy_ecs::prelude::*;
 use bevy_ecs::query::QueryData;
 use tumble_core::math::{Vec3, quat_rotate};
 
-use crate::components::{ForceAccumulator, MassProps, Pose, RigidBody, Velocity};
+use crate::components::{
+    ForceAccumulator, Kinematic, MassProps, Pose, RigidBody, Static, Velocity,
+};
 
 /// The loads and impulses of one body, for a game system's query: `Query<BodyForces>`, with the
 /// methods of [`ApplyForces`].
@@ -33,12 +35,17 @@ pub struct BodyForces {
     velocity: &'static mut Velocity,
     pose: &'static Pose,
     mass: &'static MassProps,
+    /// A [`Static`] or [`Kinematic`] body: its loads are discarded by the step, its impulses here.
+    fixed: Has<Static>,
+    kinematic: Has<Kinematic>,
 }
 
 /// Loads on a rigid body, in world or body coordinates, through the centre of mass or a point.
 /// Implemented by [`BodyForces`]' items (in a system) and by `EntityWorldMut` (on a bare
 /// `World`, where it inserts the body's [`ForceAccumulator`] when missing, and warns and drops
-/// the load when the entity is not a rigid body).
+/// the load when the entity is not a rigid body). An impulse on a [`Static`] or [`Kinematic`]
+/// body is discarded, as the step discards their loads: the one never moves, the other moves
+/// as game code sets it.
 pub trait ApplyForces {
     /// The body's accumulator, pose and mass properties (`None`: not a rigid body). Plumbing
     /// for implementors; game code calls the `apply_*` methods.
@@ -136,6 +143,9 @@ impl ApplyForces for BodyForcesItem<'_, '_> {
     }
 
     fn velocity_and_body(&mut self) -> Option<(&mut Velocity, Pose, MassProps)> {
+        if self.fixed || self.kinematic {
+            return None;
+        }
         Some((self.velocity.as_mut(), *self.pose, *self.mass))
     }
 }
@@ -171,6 +181,11 @@ impl ApplyForces for EntityWorldMut<'_> {
 
     fn velocity_and_body(&mut self) -> Option<(&mut Velocity, Pose, MassProps)> {
         let (pose, mass) = body_of(self)?;
+        // Static bodies never move and kinematic ones move as game code sets them: an
+        // impulse is discarded, as their loads are by the step.
+        if self.contains::<Static>() || self.contains::<Kinematic>() {
+            return None;
+        }
         let velocity = self.get_mut::<Velocity>()?.into_inner();
         Some((velocity, pose, mass))
     }

@@ -143,9 +143,16 @@ pub struct PhysicsRunner {
 }
 
 impl PhysicsRunner {
-    /// Plans the step for `world` (see [`PhysicsPlan::for_world`]).
+    /// Plans the step for `world` (see [`PhysicsPlan::for_world`]). A world without
+    /// [`PhysicsSettings`] gets the default ones, recorded as a
+    /// [`WorldError`](crate::components::WorldError) in [`PhysicsErrors`](crate::components::PhysicsErrors).
     pub fn new(world: &mut World) -> Self {
+        let missing = !world.contains_resource::<PhysicsSettings>();
         let plan = PhysicsPlan::for_world(world);
+        if missing {
+            let settings = *world.resource::<PhysicsSettings>();
+            record_missing_settings(world, &settings, "the default settings");
+        }
         let schedule = build(&plan, world);
         Self {
             plan,
@@ -172,6 +179,12 @@ impl PhysicsRunner {
     /// the plan against the world and plans again if it no longer matches. Public so that its
     /// cost can be measured on its own (`tumble bench` reports it against a whole step).
     pub fn prepare(&mut self, world: &mut World) {
+        if !world.contains_resource::<PhysicsSettings>() {
+            // Removed after planning: the step keeps the settings it was planned with, and
+            // says so (a default in their place would change the step silently).
+            world.insert_resource(self.settings);
+            record_missing_settings(world, &self.settings, "the settings it was planned with");
+        }
         crate::components::assume_missing_masses(world);
         self.generators.check(world);
         self.check_gravity(world);
@@ -199,7 +212,7 @@ impl PhysicsRunner {
         self.bad_gravity = Some(g);
         let error = crate::components::WorldError {
             resource: "Gravity",
-            source,
+            kind: crate::components::WorldErrorKind::Invalid(source),
         };
         tracing::error!("{error}");
         world
@@ -256,4 +269,24 @@ impl fmt::Display for PhysicsRunner {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         self.plan.fmt(f)
     }
+}
+
+/// Records (and logs) that the world had no [`PhysicsSettings`] when a step needed them, and
+/// which (`which`, `settings`) it got instead.
+fn record_missing_settings(world: &mut World, settings: &PhysicsSettings, which: &str) {
+    let error = crate::components::WorldError {
+        resource: "PhysicsSettings",
+        kind: crate::components::WorldErrorKind::Missing {
+            used: format!(
+                "{which} (Δt = {} s, `{}`)",
+                settings.dt(),
+                settings.integrator
+            ),
+        },
+    };
+    tracing::error!("{error}");
+    world
+        .get_resource_or_init::<crate::components::PhysicsErrors>()
+        .world
+        .push(error);
 }

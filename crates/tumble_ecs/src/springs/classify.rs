@@ -55,8 +55,8 @@ fn spring_count(world: &World) -> usize {
 /// True when [`classify_springs`] must run again: the time step, the setting or the number of
 /// springs changed since it last ran, or a spring (its ends, anchors, stiffness: the same count
 /// of springs rewired, or one despawned and another spawned) or a body's mass properties were
-/// changed or added since. Builds its queries: [`ClassifiedInputs`] keeps them for a caller
-/// that checks every step.
+/// changed or added since. Builds its queries (the runner keeps its own, as it checks every
+/// step).
 pub fn classification_is_stale(world: &World) -> bool {
     classification_is_stale_with(world, &mut ClassifiedInputs::default())
 }

@@ -73,7 +73,7 @@ pub(crate) fn is_damped(spring: &Spring) -> bool {
 struct Anchor {
     /// Lever arm `r = p − x` from the centre of mass.
     arm: Vec3,
-    /// Anchor velocity `v + ω × r`.
+    /// Anchor velocity `v + ω × r` (zero on a [`Static`] body, see [`Anchor::held`]).
     velocity: Vec3,
 }
 
@@ -83,6 +83,18 @@ impl Anchor {
         let arm = point - transform.center_of_mass(mass);
         let velocity = velocity.linear + velocity.angular.cross(arm);
         (point, Self { arm, velocity })
+    }
+
+    /// The anchor as the damper sees it: a [`Static`] body (`is_static`) never moves, so its
+    /// anchor's velocity is zero whatever its `Velocity` holds (an impulse game code gave it, or
+    /// the velocity it had when it was made static).
+    fn held((point, anchor): (Vec3, Self), is_static: bool) -> (Vec3, Self) {
+        let velocity = if is_static {
+            Vec3::ZERO
+        } else {
+            anchor.velocity
+        };
+        (point, Self { velocity, ..anchor })
     }
 
     /// This end's share of `1/m_eff` along `n`: `1/m + (r × n)·I⁻¹(r × n)`.
@@ -145,8 +157,8 @@ fn damp_spring(spring: &Spring, tau: Real, bodies: &mut DamperEnds) {
                 return;
             };
             let (dynamic_a, dynamic_b) = (!(sa || ka), !(sb || kb));
-            let (pa, a) = Anchor::of(ta, &va, ma, spring.anchor_a);
-            let (pb, b) = Anchor::of(tb, &vb, mb, anchor);
+            let (pa, a) = Anchor::held(Anchor::of(ta, &va, ma, spring.anchor_a), sa);
+            let (pb, b) = Anchor::held(Anchor::of(tb, &vb, mb, anchor), sb);
             let Some(n) = (pa - pb).try_normalize() else {
                 return;
             };
