@@ -482,19 +482,11 @@ fn range_error(ck: &Checker<'_>, i: usize, volume: f64, density: f64) -> SceneEr
              (mass ρV = {mass:.3e} kg)"
         )
     };
-    ck.error(
-        "bodies",
-        Some(i),
-        "shape",
-        format!(
-            "{why}: expected dimensions and a density whose mass and moments of inertia are \
-             finite and > 0 in {REAL_NAME}"
-        ),
-    )
+    mass_error(ck, i, why)
 }
 
-/// A shape whose mass properties are not valid.
-pub(crate) fn mass_error(ck: &Checker<'_>, i: usize, e: tumble_core::InvalidInput) -> SceneError {
+/// A shape whose mass properties are not valid, and why.
+pub(crate) fn mass_error(ck: &Checker<'_>, i: usize, e: impl std::fmt::Display) -> SceneError {
     ck.error(
         "bodies",
         Some(i),
