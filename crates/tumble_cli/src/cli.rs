@@ -34,10 +34,10 @@ pub(crate) enum GenKind {
         /// Number of bodies: 1 to 200000 in TOML, 1 to 10000000 in JSON (the generated file
         /// must stay loadable).
         #[arg(long, default_value_t = 100_000, allow_hyphen_values = true)]
-        n: i64,
+        n: i128,
         /// Steps (1 to 1000000000, as `run` accepts).
         #[arg(long, default_value_t = 600, allow_hyphen_values = true)]
-        steps: i64,
+        steps: i128,
         /// Output file, `-` for stdout (default: stdout). A name ending in `.json` gets JSON,
         /// the format for large scenes (read as a stream); any other, TOML.
         #[arg(long)]
@@ -108,7 +108,7 @@ pub(crate) struct RunArgs {
     /// Override the number of steps.
     // Numbers are read wide and signed so that `--steps -5` gets tumble's own message.
     #[arg(long, allow_hyphen_values = true)]
-    pub steps: Option<i64>,
+    pub steps: Option<i128>,
     /// Override the time step (s).
     #[arg(long, allow_hyphen_values = true)]
     pub dt: Option<f64>,
@@ -126,13 +126,13 @@ pub(crate) struct RunArgs {
     pub free_flow: Option<OsString>,
     /// Override the substeps per step (1 to 1000): the forces are sampled in each.
     #[arg(long, allow_hyphen_values = true)]
-    pub substeps: Option<i64>,
+    pub substeps: Option<i128>,
     /// Write the trajectory to this CSV file, `-` for stdout (the summary then goes to stderr).
     #[arg(long)]
     pub out: Option<PathBuf>,
     /// Record every K-th step (step 0 is always recorded).
     #[arg(long, default_value_t = 1, allow_hyphen_values = true)]
-    pub every: i64,
+    pub every: i128,
     /// Record only these bodies: a comma-separated list of names or shell glob patterns (`*`
     /// any run of characters, `?` one character, `[abc]` one of a class, `[!abc]` or `[^abc]`
     /// none of it, `\` escapes the next character), e.g. `--bodies 'b1,b2?,b9*'`.

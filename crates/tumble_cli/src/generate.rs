@@ -14,11 +14,11 @@ use crate::interrupt;
 
 /// Most bodies `gen many` writes in TOML: [`RECORD_BYTES_BOUND`] × this, plus the header,
 /// stays under [`MAX_SCENE_BYTES`], so the file loads.
-pub(crate) const MAX_BODIES: i64 = 200_000;
+pub(crate) const MAX_BODIES: i128 = 200_000;
 
 /// Most bodies `gen many` writes in JSON: [`JSON_RECORD_BYTES_BOUND`] × this, plus the
 /// header, stays under [`MAX_JSON_SCENE_BYTES`].
-pub(crate) const MAX_JSON_BODIES: i64 = 10_000_000;
+pub(crate) const MAX_JSON_BODIES: i128 = 10_000_000;
 
 /// A bound on the bytes of one body's record in TOML: 128 bytes of fixed text, the name (`b`
 /// and up to 8 digits), three grid coordinates of at most 4 digits (the grid side is ≤ 216 at
@@ -39,7 +39,7 @@ const _: () =
     assert!(MAX_JSON_BODIES as u64 * JSON_RECORD_BYTES_BOUND + 256 <= MAX_JSON_SCENE_BYTES);
 
 /// `n` and `steps` as `gen many` accepts them for a file in `syntax`.
-pub(crate) fn check_many(n: i64, steps: i64, syntax: SceneSyntax) -> Result<(u64, u64), Failure> {
+pub(crate) fn check_many(n: i128, steps: i128, syntax: SceneSyntax) -> Result<(u64, u64), Failure> {
     let (most, limit) = match syntax {
         SceneSyntax::Toml => (MAX_BODIES, MAX_SCENE_BYTES),
         SceneSyntax::Json => (MAX_JSON_BODIES, MAX_JSON_SCENE_BYTES),
@@ -62,7 +62,7 @@ pub(crate) fn check_many(n: i64, steps: i64, syntax: SceneSyntax) -> Result<(u64
             format!("--n: expected 1 to {most} bodies, got {n}{why}"),
         ));
     }
-    if !(1..=MAX_STEPS as i64).contains(&steps) {
+    if !(1..=i128::from(MAX_STEPS)).contains(&steps) {
         return Err(Failure::new(
             exit::ERROR,
             format!("--steps: expected 1 to {MAX_STEPS} steps, got {steps}"),
@@ -125,8 +125,8 @@ pub(crate) fn write_many_json(
 /// `tumble gen many`: the scene to `out` (a file, or stdout for `None` and `-`), in `format`
 /// (default: JSON for a file name ending in `.json`, else TOML).
 pub(crate) fn run(
-    n: i64,
-    steps: i64,
+    n: i128,
+    steps: i128,
     out: Option<&Path>,
     format: Option<SceneSyntax>,
 ) -> Result<(), Failure> {

@@ -94,12 +94,12 @@ fn override_error(
 /// to {max} {unit}, got {n}` otherwise.
 pub(crate) fn count_up_to(
     flag: &str,
-    given: Option<i64>,
+    given: Option<i128>,
     max: u64,
     unit: &str,
 ) -> Result<Option<u64>, Failure> {
     match given {
-        Some(n) if !(1..=max as i64).contains(&n) => Err(Failure::new(
+        Some(n) if !(1..=i128::from(max)).contains(&n) => Err(Failure::new(
             exit::ERROR,
             format!("{flag}: expected 1 to {max} {unit}, got {n}"),
         )),

@@ -154,7 +154,7 @@ fn open_output(
 }
 
 /// `--every`: a step count of at least 1.
-fn every(given: i64) -> Result<NonZeroU64, Failure> {
+fn every(given: i128) -> Result<NonZeroU64, Failure> {
     u64::try_from(given)
         .ok()
         .and_then(NonZeroU64::new)

@@ -28,7 +28,13 @@ const EXPLICIT_CHAIN: [&str; 6] = [
 fn negative_numbers_reach_tumbles_own_checks() {
     let cases: [BadValues; 4] = [
         ("--dt", "expected a time step > 0", &["-1"]),
-        ("--steps", "expected 1 to 1000000000 steps", &["-5"]),
+        // Past `u64` too: tumble's own message and exit code 1, as for any other value out of
+        // range (it was clap's "too large", exit 2).
+        (
+            "--steps",
+            "expected 1 to 1000000000 steps",
+            &["-5", "18446744073709551616"],
+        ),
         ("--every", "expected a value >= 1", &["-2", "0"]),
         (
             "--substeps",
@@ -40,6 +46,9 @@ fn negative_numbers_reach_tumbles_own_checks() {
         assert_eq!(output.status.code(), Some(1), "{args:?}");
         assert_eq!(error_line(&output), expected);
     }
+    // Any count of at least 1 is a valid `--every`, the largest `u64` included.
+    let output = tumble_run(&["run", "projectile", "--every", "18446744073709551615"]);
+    assert!(output.status.success(), "{}", stderr(&output));
 }
 
 #[test]
