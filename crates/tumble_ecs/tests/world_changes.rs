@@ -340,3 +340,30 @@ fn missing_settings_are_recorded_and_the_planned_ones_kept() {
         recorded[0]
     );
 }
+
+/// A spring changed right after the runner is made, before any step (a game tuning its world
+/// from a config), is seen too: the classification's tick is past, not at, the world's.
+#[test]
+fn a_spring_changed_before_the_first_step_is_classified_again() {
+    let mut world = World::new();
+    world.insert_resource(PhysicsSettings::new(DT, Integrator::Splitting).unwrap());
+    let mass = MassProperties::new(Mass::new(1.0).unwrap(), Vec3::splat(0.1)).unwrap();
+    let body = |world: &mut World, x: Real| {
+        let pose = Pose::from_translation(Vec3::new(x, 0.0, 0.0));
+        (world.spawn((
+            RigidBody,
+            MassProps(mass),
+            pose,
+            ForceAccumulator::default(),
+        )))
+        .id()
+    };
+    let (a, b) = (body(&mut world, 0.0), body(&mut world, 1.0));
+    let spring = Spring::new(a, Vec3::ZERO, SpringEnd::on_body(b, Vec3::ZERO), 1.0, 0.9);
+    let spring = world.spawn(spring).id();
+    let mut runner = PhysicsRunner::new(&mut world);
+    assert!(world.get::<ImplicitSpring>(spring).is_none());
+    world.get_mut::<Spring>(spring).unwrap().stiffness = 1.0e6;
+    runner.step(&mut world);
+    assert!(world.get::<ImplicitSpring>(spring).is_some());
+}

@@ -304,7 +304,9 @@ pub fn classify_springs(world: &mut World) {
     // decides which bodies share a table.
     mark_turn_rates(world, &index, &turns);
     let springs = spring_count(world);
-    let at = world.change_tick();
+    // Past this tick: a change game code makes before any system runs again (right after a
+    // runner is made, say) gets a newer tick than the classification's, and is seen.
+    let at = world.increment_change_tick();
     world.insert_resource(SpringClassification {
         dt,
         solver: settings.springs,
