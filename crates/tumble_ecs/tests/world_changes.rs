@@ -198,6 +198,19 @@ fn a_body_without_mass_is_marked_once() {
     }
 }
 
+/// A 1 kg body with moments 0.1 at `at`, at rest, with its accumulator.
+fn unit_body(world: &mut World, at: Vec3) -> Entity {
+    let mass = MassProperties::new(Mass::new(1.0).unwrap(), Vec3::splat(0.1)).unwrap();
+    let pose = Pose::from_translation(at);
+    (world.spawn((
+        RigidBody,
+        MassProps(mass),
+        pose,
+        ForceAccumulator::default(),
+    )))
+    .id()
+}
+
 /// The total linear momentum of `bodies` (kg·m/s, `f64`).
 fn momentum(world: &World, bodies: &[Entity]) -> [f64; 3] {
     let mut p = [0.0; 3];
@@ -219,17 +232,7 @@ fn momentum(world: &World, bodies: &[Entity]) -> [f64; 3] {
 /// change alone, the world's tables unchanged by it.
 #[test]
 fn springs_and_masses_changed_in_place_are_classified_again() {
-    let body = |world: &mut World, y: Real| {
-        let mass = MassProperties::new(Mass::new(1.0).unwrap(), Vec3::splat(0.1)).unwrap();
-        let pose = Pose::from_translation(Vec3::new(0.0, y, 0.0));
-        (world.spawn((
-            RigidBody,
-            MassProps(mass),
-            pose,
-            ForceAccumulator::default(),
-        )))
-        .id()
-    };
+    let body = |world: &mut World, y: Real| unit_body(world, Vec3::new(0.0, y, 0.0));
     let pair = |world: &mut World, y: Real, k: Real, rest: Real| {
         let (a, b) = (body(world, y), body(world, y + 1.0));
         let spring = Spring::new(a, Vec3::ZERO, SpringEnd::on_body(b, Vec3::ZERO), k, rest);
@@ -347,17 +350,7 @@ fn missing_settings_are_recorded_and_the_planned_ones_kept() {
 fn a_spring_changed_before_the_first_step_is_classified_again() {
     let mut world = World::new();
     world.insert_resource(PhysicsSettings::new(DT, Integrator::Splitting).unwrap());
-    let mass = MassProperties::new(Mass::new(1.0).unwrap(), Vec3::splat(0.1)).unwrap();
-    let body = |world: &mut World, x: Real| {
-        let pose = Pose::from_translation(Vec3::new(x, 0.0, 0.0));
-        (world.spawn((
-            RigidBody,
-            MassProps(mass),
-            pose,
-            ForceAccumulator::default(),
-        )))
-        .id()
-    };
+    let body = |world: &mut World, x: Real| unit_body(world, Vec3::new(x, 0.0, 0.0));
     let (a, b) = (body(&mut world, 0.0), body(&mut world, 1.0));
     let spring = Spring::new(a, Vec3::ZERO, SpringEnd::on_body(b, Vec3::ZERO), 1.0, 0.9);
     let spring = world.spawn(spring).id();
