@@ -288,11 +288,19 @@ pub fn springs_markdown(results: &BenchResults) -> String {
             )
         },
     );
+    let window = format!(
+        "every size timed over the same steps of the same motion: {} timings of {} steps after \
+         one warm-up step, from the scene's start",
+        springs.repetitions, springs.window_steps
+    );
     table(
         &mut s,
-        "**Spring throughput** (chains of ten, relaxed, with gravity, a force at a body point and \
-         damping on every body; one spring per body, so ns per spring-step = ns per body-step) — \
-         median, and relative to a free body's ECS step on one thread at the same N",
+        &format!(
+            "**Spring throughput** (chains of ten, relaxed, with gravity, a force at a body point \
+             and damping on every body; one spring per body, so ns per spring-step = ns per \
+             body-step; {window}) — median, and relative to a free body's ECS step on one thread \
+             at the same N"
+        ),
         "| springs | spring step | ωΔt | threads | ns/spring-step | × free body |",
         "|---:|---|---:|---:|---:|---:|",
         &springs.throughput,
@@ -314,9 +322,11 @@ pub fn springs_markdown(results: &BenchResults) -> String {
     );
     table(
         &mut s,
-        "**Stages** (the same loaded chains, explicit springs at ωΔt = 0.5, through the ECS): \
-         substeps and `yoshida4`'s fourth-order composition, ns per body-step (median) and \
-         relative to `splitting` in one stage",
+        &format!(
+            "**Stages** (the same loaded chains, explicit springs at ωΔt = 0.5, through the ECS; \
+             {window}): substeps and `yoshida4`'s fourth-order composition, ns per body-step \
+             (median) and relative to `splitting` in one stage"
+        ),
         "| bodies | integrator | substeps | stages | ns/body-step | × one stage |",
         "|---:|---|---:|---:|---:|---:|",
         &springs.stages,

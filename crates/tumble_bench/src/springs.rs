@@ -182,6 +182,10 @@ pub struct StagesRow {
 pub struct SpringResults {
     /// One chain at each stiffness.
     pub stiffness: Vec<StiffnessRow>,
+    /// Steps per timing of the loaded chains, the same at every size (after one warm-up step).
+    pub window_steps: usize,
+    /// Timings of each loaded-chain row (the median is kept).
+    pub repetitions: usize,
     /// Many chains with loads.
     pub throughput: Vec<ThroughputRow>,
     /// Steps of several stages on the loaded chains.
@@ -222,17 +226,36 @@ pub const OMEGA_DTS: [Real; 5] = [0.5, 2.0, 10.0, 30.0, 100.0];
 pub fn run(quick: bool, mut progress: impl FnMut(&str)) -> SpringResults {
     let stiffness = stiffness_rows(quick, &mut progress);
     let sizes: &[usize] = if quick { &[1_000] } else { &[1_000, 100_000] };
-    let effort = Effort {
-        body_steps: if quick { 10_000 } else { 300_000 },
-        min_steps: 2,
-        max_steps: 200,
-        // See the free-body rows' effort: the median of five survives two spoiled timings.
-        repetitions: if quick { 3 } else { 5 },
-    };
+    let effort = same_window(
+        sizes,
+        Effort {
+            body_steps: if quick { 10_000 } else { 300_000 },
+            min_steps: 2,
+            max_steps: 200,
+            // See the free-body rows' effort: the median of five survives two spoiled timings.
+            repetitions: if quick { 3 } else { 5 },
+        },
+    );
     SpringResults {
         stiffness,
+        window_steps: effort.min_steps,
+        repetitions: effort.repetitions,
         throughput: throughput_rows(sizes, &effort, &mut progress),
         stages: stage_rows(sizes, &effort, &mut progress),
+    }
+}
+
+/// `effort` with the steps per timing of the largest of `sizes` for every size: a loaded
+/// chain's cost follows its motion (bodies its loads spin up take the exact free flow, at
+/// several times the split's cost), so every size is timed over the same steps of the same
+/// motion, from the scene's start, and the rows differ only in how many chains step.
+fn same_window(sizes: &[usize], effort: Effort) -> Effort {
+    let largest = sizes.iter().copied().max().unwrap_or(1);
+    let window = effort.steps(largest);
+    Effort {
+        min_steps: window,
+        max_steps: window,
+        ..effort
     }
 }
 
@@ -379,4 +402,28 @@ fn stage_rows(sizes: &[usize], effort: &Effort, progress: &mut impl FnMut(&str))
         }
     }
     stages
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every size gets the largest size's steps per timing, so that the rows time the same
+    /// stretch of the motion.
+    #[test]
+    fn every_size_is_timed_over_the_largest_sizes_window() {
+        let effort = same_window(
+            &[1_000, 100_000],
+            Effort {
+                body_steps: 300_000,
+                min_steps: 2,
+                max_steps: 200,
+                repetitions: 5,
+            },
+        );
+        assert_eq!(effort.steps(1_000), 3);
+        assert_eq!(effort.steps(100_000), 3);
+        assert_eq!(effort.steps(10), 3);
+        assert_eq!(effort.repetitions, 5);
+    }
 }
