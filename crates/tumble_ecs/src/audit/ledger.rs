@@ -1,13 +1,14 @@
 //! The energy ledger: what the audit remembers of each spring group between its passes.
 
+use bevy_ecs::change_detection::Tick;
 use bevy_ecs::entity::EntityHashMap;
 use bevy_ecs::prelude::*;
 use tumble_core::math::{Real, Vec3, Widen, same_bits};
 
-use super::memo::BodyMemo;
+use super::memo::{BodyMemo, EndTick};
 use crate::components::{
-    Dynamic, IndexOrder, IndexedQuery, Kinematic, MassProps, Pose, Rejected, RigidBody, Spring,
-    SpringEnd, Static, Velocity, kinetic_energy_f64,
+    Dynamic, IndexOrder, Kinematic, MassProps, Pose, Rejected, RigidBody, Spring, SpringEnd,
+    Static, Velocity, kinetic_energy_f64,
 };
 use crate::parallel::{Parallelism, in_runs};
 
@@ -39,7 +40,7 @@ pub(super) struct Audited {
     /// Its group's index in [`EnergyLedger::groups`], once the start pass has joined every
     /// spring's ends.
     pub(super) group: usize,
-    /// Unchanged since the end of the last step (bit for bit, [`memo`]).
+    /// Unchanged since the end of the last step (nothing written since, [`memo`]).
     pub(super) still: bool,
     /// Kinetic energy at the start of the step.
     pub(super) start_energy: f64,
@@ -75,6 +76,10 @@ pub(super) struct Link {
     /// once the start pass has numbered the groups: the sums over a group's springs read it
     /// here rather than from the bodies.
     pub(super) group: u32,
+    /// Each end is an audited body or a world point: while the audited bodies are the same
+    /// entities at the same indices and the spring is not written, its ends resolve as they
+    /// did (an end on a static, kinematic or missing body is resolved again at every start).
+    pub(super) stable: bool,
 }
 
 /// [`Link::group`] of a link without an audited end.
@@ -83,6 +88,12 @@ pub(super) const NO_GROUP: u32 = u32::MAX;
 impl Link {
     /// The spring `spring` with its ends resolved to `a` and `b`, not measured yet.
     pub(super) fn new(spring: &Spring, a: End, b: End) -> Self {
+        let audited = |end: End| matches!(end, End::Audited(..));
+        let stable = audited(a)
+            && match spring.b {
+                SpringEnd::World(_) => true,
+                SpringEnd::Body { .. } => audited(b),
+            };
         Self {
             stiffness: spring.stiffness,
             rest_length: spring.rest_length,
@@ -91,6 +102,7 @@ impl Link {
             measured: 0,
             elastic: 0.0,
             group: NO_GROUP,
+            stable,
         }
     }
 
@@ -180,6 +192,9 @@ pub struct EnergyLedger {
     pub(super) restored: bool,
     /// End passes so far: what the last one measured carries its number.
     pub(super) end_passes: u64,
+    /// The change tick the last end pass ran at: a body whose pose, velocity and mass were not
+    /// written since is as that pass measured it ([`memo`]).
+    pub(super) end_tick: Option<Tick>,
     /// The groups were closed by an end pass since the last start: their end sums are the
     /// energies the bodies stand at now, if nothing changed ([`EnergyLedger::restart`]).
     pub(super) closed: bool,
@@ -351,16 +366,17 @@ impl EnergyLedger {
     }
 
     /// The kinetic energy at the start of the step of the body read at index `i`, and whether
-    /// it is still as the last end pass measured it there (bit for bit, [`memo`]): then the
+    /// it is still as the last end pass measured it there (nothing written since, [`memo`]): then the
     /// energy is that measurement, else it is measured now.
-    pub(super) fn start_kinetic(
-        &self,
-        i: usize,
-        (entity, t, v, m): (Entity, &Pose, &Velocity, &MassProps),
-    ) -> (f64, bool) {
+    pub(super) fn start_kinetic(&self, i: usize, item: BodyItem, since: &EndTick) -> (f64, bool) {
         match self.bodies.get(i) {
-            Some(last) if last.entity == entity => start_kinetic_of(last, self.end_passes, t, v, m),
-            _ => (kinetic_energy_f64(t, v, m), false),
+            Some(last) if last.entity == item.0 => {
+                start_kinetic_of(last, self.end_passes, item, since)
+            }
+            _ => {
+                let (_, t, v, m, _) = item;
+                (kinetic_energy_f64(t, v, m), false)
+            }
         }
     }
 
@@ -409,19 +425,18 @@ impl EnergyLedger {
     }
 }
 
-/// The kinetic energy at the start of the step of the body at `t`, `v`, `m` whose ledger entry
-/// is `last` (the caller has checked the entity), and whether it is still as end pass `passes`
-/// measured it (bit for bit, [`memo`]): then the energy is that measurement, else it is
+/// The kinetic energy at the start of the step of the body `item` whose ledger entry is `last`
+/// (the caller has checked the entity), and whether it is still as end pass `passes` measured
+/// it (nothing written since, [`memo`]): then the energy is that measurement, else it is
 /// measured now.
 #[inline]
 pub(super) fn start_kinetic_of(
     last: &Audited,
     passes: u64,
-    t: &Pose,
-    v: &Velocity,
-    m: &MassProps,
+    (_, t, v, m, ticks): BodyItem,
+    since: &EndTick,
 ) -> (f64, bool) {
-    if last.memo.still(passes, &last.end, t, v, m) {
+    if last.memo.still(passes, since.any_written(ticks)) {
         (last.memo.kinetic(), true)
     } else {
         (kinetic_energy_f64(t, v, m), false)
@@ -517,12 +532,61 @@ pub(super) fn same_end(a: End, b: End) -> bool {
     }
 }
 
-/// The bodies the audit watches, as its start pass reads them.
-pub(super) type AuditedBodies<'w, 's> =
-    Query<'w, 's, (Entity, &'static Pose, &'static Velocity, &'static MassProps), Dynamic>;
+/// The bodies the audit watches, as its start pass reads them (with the change ticks that say
+/// whether game code wrote them since the last end pass, [`memo`]).
+pub(super) type AuditedBodies<'w, 's> = Query<
+    'w,
+    's,
+    (
+        Entity,
+        Ref<'static, Pose>,
+        Ref<'static, Velocity>,
+        Ref<'static, MassProps>,
+    ),
+    Dynamic,
+>;
 
-/// The springs the audit measures, with their entities (visited in entity index order).
-pub(super) type AuditedSprings<'w, 's> = IndexedQuery<'w, 's, Spring, ()>;
+/// One audited body as the start pass reads it: its state and mass, and when each of its pose,
+/// velocity and mass last changed.
+pub(super) type BodyItem<'a> = (Entity, &'a Pose, &'a Velocity, &'a MassProps, [Tick; 3]);
+
+/// [`BodyItem`] of a query item.
+#[inline(always)]
+pub(super) fn body_item<'w>(
+    (entity, t, v, m): (Entity, Ref<'w, Pose>, Ref<'w, Velocity>, Ref<'w, MassProps>),
+) -> BodyItem<'w> {
+    let ticks = [t.last_changed(), v.last_changed(), m.last_changed()];
+    (
+        entity,
+        t.into_inner(),
+        v.into_inner(),
+        m.into_inner(),
+        ticks,
+    )
+}
+
+/// The springs the audit measures, with their entities (visited in entity index order) and
+/// the change ticks that say whether game code wrote them since the last end pass.
+pub(super) type AuditedSprings<'w, 's> = Query<'w, 's, (Entity, Ref<'static, Spring>)>;
+
+/// Calls `f` on every spring with its last change, in entity index order (`order`, refreshed
+/// by the caller from the same query).
+pub(super) fn for_each_spring(
+    order: &IndexOrder,
+    springs: &AuditedSprings,
+    mut f: impl FnMut(&Spring, Tick),
+) {
+    let mut each = |spring: Ref<Spring>| f(spring.into_inner(), spring.last_changed());
+    if order.is_query_order() {
+        springs.iter().for_each(|(_, spring)| each(spring));
+    } else {
+        for &entity in order.entities() {
+            if let Ok((_, spring)) = springs.get(entity) {
+                each(spring);
+            }
+        }
+    }
+}
 
 /// Calls `f` on every audited body in entity index order: the order of the ledger's table of
 /// bodies, and with it of every sum over a group's bodies, whatever order the query visits its
@@ -530,16 +594,18 @@ pub(super) type AuditedSprings<'w, 's> = IndexedQuery<'w, 's, Spring, ()>;
 pub(super) fn for_each_audited(
     order: &mut IndexOrder,
     bodies: &AuditedBodies,
-    mut f: impl FnMut((Entity, &Pose, &Velocity, &MassProps)),
+    mut f: impl FnMut(BodyItem),
 ) {
     order.refresh_entities(bodies.iter().map(|(e, ..)| e));
     if order.is_query_order() {
-        bodies.iter().for_each(f);
+        for item in bodies {
+            f(body_item(item));
+        }
         return;
     }
     for &entity in order.entities() {
         if let Ok(item) = bodies.get(entity) {
-            f(item);
+            f(body_item(item));
         }
     }
 }

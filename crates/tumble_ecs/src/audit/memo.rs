@@ -2,57 +2,28 @@
 //!
 //! The start of a step measures `T + V` of the state the previous step ended with, unless game
 //! code changed something in between. So the end pass keeps each body's kinetic energy and each
-//! spring's elastic energy together with *every input* they were computed from, and the next
-//! start reuses a value only when those inputs are the same bit for bit: a memo of two pure
-//! functions, so a reused value is the value a fresh evaluation would give. No change ticks are
-//! involved; whatever changed a body (game code, a quarantine putting it back, a rollback) shows
-//! in its bits.
+//! spring's elastic energy, with the number of the pass that measured them, and the next start
+//! reuses a body's value where none of its inputs — its [`Pose`], [`Velocity`] and
+//! [`MassProps`] — was written since that pass: a memo of a pure function, so a reused value is
+//! the value a fresh evaluation would give.
+//!
+//! "Written since" is read from the components' change ticks ([`EndTick`]): three numbers per
+//! body, where comparing every input bit for bit read 21 numbers from the world and 14 from the
+//! ledger at every start (a quarter of the audit's cost in a loaded spring world). Everything
+//! that writes a component through `bevy_ecs` marks it (game code's queries and `get_mut`,
+//! inserts, a quarantine putting a body back, a rollback restore); a write made with
+//! `bypass_change_detection` is not seen, and the next balance then charges what it changed to
+//! the integrator. The spring classification trusts the same ticks
+//! ([`crate::springs`]).
 
-use tumble_core::math::{Real, same_bits};
+use bevy_ecs::change_detection::{MAX_CHANGE_AGE, Tick};
 
-use crate::components::{MassProps, Pose, Velocity, kinetic_energy_f64};
-
-/// Every input of a body's kinetic energy ([`kinetic_energy_f64`]: rotation, velocities,
-/// mass, principal moments and frame) and of its springs' anchors (translation, rotation) but
-/// its pose, which the ledger keeps anyway (the end pose its springs' energies are measured at).
-/// The inverse mass stands for the mass: one decides the other.
-#[inline(always)]
-fn rest_inputs(velocity: &Velocity, mass: &MassProps) -> [Real; 14] {
-    let (v, w) = (velocity.linear, velocity.angular);
-    let (i, f) = (mass.principal_inertia(), mass.principal_frame());
-    [
-        v.x,
-        v.y,
-        v.z,
-        w.x,
-        w.y,
-        w.z,
-        mass.inv_mass(),
-        i.x,
-        i.y,
-        i.z,
-        f.x,
-        f.y,
-        f.z,
-        f.w,
-    ]
-}
-
-/// The pose's inputs.
-#[inline(always)]
-fn pose_inputs(pose: &Pose) -> [Real; 7] {
-    let (t, q) = (pose.translation, pose.rotation);
-    [t.x, t.y, t.z, q.x, q.y, q.z, q.w]
-}
-
-/// A body as the end of the last step measured it, beside the pose it was measured at (the
-/// ledger's end pose) and the entity it was measured for (the ledger entry's).
+/// A body's kinetic energy as an end pass measured it (the ledger entry's entity, at the
+/// ledger's end pose).
 #[derive(Debug, Clone, Copy)]
 pub(super) struct BodyMemo {
     /// The end pass that measured it (0: none).
     pass: u64,
-    /// [`rest_inputs`] at the measurement.
-    inputs: [Real; 14],
     kinetic: f64,
 }
 
@@ -60,18 +31,12 @@ impl BodyMemo {
     /// No measurement.
     pub(super) const NONE: Self = Self {
         pass: 0,
-        inputs: [0.0; 14],
         kinetic: 0.0,
     };
 
-    /// The body at `pose`, moving at `velocity`, and its kinetic energy, measured by end pass
-    /// `pass` (≥ 1).
-    pub(super) fn measure(pass: u64, pose: &Pose, velocity: &Velocity, mass: &MassProps) -> Self {
-        Self {
-            pass,
-            inputs: rest_inputs(velocity, mass),
-            kinetic: kinetic_energy_f64(pose, velocity, mass),
-        }
+    /// A kinetic energy measured by end pass `pass` (≥ 1).
+    pub(super) fn new(pass: u64, kinetic: f64) -> Self {
+        Self { pass, kinetic }
     }
 
     /// True when end pass `pass` (≥ 1) measured it.
@@ -84,20 +49,85 @@ impl BodyMemo {
         self.kinetic
     }
 
-    /// True when end pass `pass` measured this body at `measured_pose`, and `pose`, `velocity`
-    /// and `mass` are what it was measured with, bit for bit: its kinetic energy and its
-    /// springs' anchors are unchanged. (The caller checks that the entity is the one measured.)
+    /// True when end pass `pass` measured it and the body's inputs were not `written` since:
+    /// its kinetic energy and its springs' anchors are as measured. (The caller checks that the
+    /// entity is the one measured.)
     #[inline]
-    pub(super) fn still(
-        &self,
-        pass: u64,
-        measured_pose: &Pose,
-        pose: &Pose,
-        velocity: &Velocity,
-        mass: &MassProps,
-    ) -> bool {
-        self.measured_by(pass)
-            && same_bits(pose_inputs(measured_pose), pose_inputs(pose))
-            && same_bits(self.inputs, rest_inputs(velocity, mass))
+    pub(super) fn still(&self, pass: u64, written: bool) -> bool {
+        !written && self.measured_by(pass)
+    }
+}
+
+/// The change tick of the last end pass, and of the system reading after it: whether a
+/// component was written since that pass.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct EndTick {
+    /// The end pass's tick; `None` where none ran, or so long ago that ticks no longer order
+    /// (every body then counts as written).
+    end: Option<Tick>,
+    /// The reading system's tick.
+    now: Tick,
+}
+
+impl EndTick {
+    /// The end pass that ran at `end` (if any), read from a system running at `now`.
+    pub(super) fn new(end: Option<Tick>, now: Tick) -> Self {
+        // Ticks are compared by their age relative to `now`, clamped at `MAX_CHANGE_AGE`:
+        // an end pass older than half that is not trusted to order them.
+        let end = end.filter(|end| now.get().wrapping_sub(end.get()) < MAX_CHANGE_AGE / 2);
+        Self { end, now }
+    }
+
+    /// True when a component last changed at `changed` was written at or after the end pass
+    /// (the end pass's own deferred commands, a quarantine, count: they carry its tick).
+    #[inline(always)]
+    pub(super) fn written(&self, changed: Tick) -> bool {
+        match self.end {
+            Some(end) => !end.is_newer_than(changed, self.now),
+            None => true,
+        }
+    }
+
+    /// [`written`](Self::written) for any of a body's pose, velocity and mass.
+    #[inline(always)]
+    pub(super) fn any_written(&self, [pose, velocity, mass]: [Tick; 3]) -> bool {
+        self.written(pose) | self.written(velocity) | self.written(mass)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A change before the end pass is older; one at its tick (its own deferred commands) or
+    /// after is written; without an end pass, or with one too old to order, everything is.
+    #[test]
+    fn writes_at_or_after_the_end_pass_count() {
+        let (end, now) = (Tick::new(1_000), Tick::new(1_010));
+        let since = EndTick::new(Some(end), now);
+        assert!(!since.written(Tick::new(999)));
+        assert!(!since.written(Tick::new(3)));
+        assert!(since.written(end));
+        assert!(since.written(Tick::new(1_005)));
+        assert!(since.any_written([Tick::new(3), Tick::new(1_001), Tick::new(3)]));
+        assert!(!since.any_written([Tick::new(3); 3]));
+        assert!(EndTick::new(None, now).written(Tick::new(3)));
+        // Across the wrap of the counter.
+        let wrapped = EndTick::new(Some(Tick::new(u32::MAX - 5)), Tick::new(10));
+        assert!(!wrapped.written(Tick::new(u32::MAX - 9)));
+        assert!(wrapped.written(Tick::new(2)));
+        let ancient = EndTick::new(Some(Tick::new(0)), Tick::new(MAX_CHANGE_AGE));
+        assert!(ancient.written(Tick::new(0)));
+    }
+
+    /// A memo is reused only for the pass that measured it and a body not written since.
+    #[test]
+    fn a_memo_is_still_only_for_its_pass_and_an_unwritten_body() {
+        let memo = BodyMemo::new(7, 2.5);
+        assert!(memo.still(7, false));
+        assert!(!memo.still(7, true));
+        assert!(!memo.still(8, false));
+        assert!(!BodyMemo::NONE.still(0, false));
+        assert_eq!(memo.kinetic(), 2.5);
     }
 }

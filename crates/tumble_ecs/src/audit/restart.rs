@@ -3,16 +3,16 @@
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use bevy_ecs::prelude::*;
 use tumble_core::math::{Vec3, Widen};
 
 use super::ledger::{
-    Audited, AuditedBodies, AuditedSprings, Ends, EnergyLedger, Link, for_each_audited,
-    resolve_ends, start_kinetic_of, zip_table,
+    Audited, AuditedBodies, AuditedSprings, BodyItem, Ends, EnergyLedger, Link, for_each_audited,
+    for_each_spring, resolve_ends, start_kinetic_of, zip_table,
 };
-use super::memo::BodyMemo;
-use crate::components::{MassProps, Pose, Spring, Velocity, dense};
+use super::memo::{BodyMemo, EndTick};
+use crate::components::{Spring, dense};
 use crate::parallel::{Parallelism, all_runs};
+use bevy_ecs::change_detection::Tick;
 
 impl EnergyLedger {
     /// The start of a step when the world's spring graph is as the last step left it: the
@@ -28,12 +28,12 @@ impl EnergyLedger {
         bodies: &AuditedBodies,
         ends: &Ends,
         springs: &AuditedSprings,
-        parallelism: &Parallelism,
+        (since, parallelism): (&EndTick, &Parallelism),
     ) -> bool {
-        let Some(all_still) = self.restart_bodies(bodies, parallelism) else {
+        let Some(all_still) = self.restart_bodies(bodies, since, parallelism) else {
             return false;
         };
-        if !self.same_springs(ends, springs, parallelism) {
+        if !self.same_springs(ends, springs, since, parallelism) {
             return false;
         }
         if all_still {
@@ -65,9 +65,14 @@ impl EnergyLedger {
         &self,
         ends: &Ends,
         springs: &AuditedSprings,
+        since: &EndTick,
         parallelism: &Parallelism,
     ) -> bool {
-        let same_link = |link: &Link, spring: &Spring| {
+        let same_link = |link: &Link, spring: &Spring, changed: Tick| {
+            // The audited bodies are the last step's (checked first, by `restart_bodies`).
+            if link.stable && !since.written(changed) {
+                return true;
+            }
             let (a, b) = resolve_ends(self, ends, spring);
             link.same_inputs(&Link::new(spring, a, b))
         };
@@ -77,12 +82,14 @@ impl EnergyLedger {
                 let Some(links) = self.links.get(k..k + table.len()) else {
                     return false;
                 };
+                let changed = table.changed_ticks_slice();
                 let threads = parallelism.threads_for(links.len());
                 let same = all_runs(threads, links, |at, run| {
                     let springs = &table[at..at + run.len()];
                     run.iter()
                         .zip(springs)
-                        .all(|(link, spring)| same_link(link, spring))
+                        .zip(&changed[at..at + run.len()])
+                        .all(|((link, spring), &changed)| same_link(link, spring, changed))
                 });
                 if !same {
                     return false;
@@ -91,9 +98,9 @@ impl EnergyLedger {
             }
         } else {
             let mut same = true;
-            self.spring_order.for_each(springs, |spring| {
+            for_each_spring(&self.spring_order, springs, |spring, changed| {
                 match self.links.get(k).filter(|_| same) {
-                    Some(link) => same = same_link(link, spring),
+                    Some(link) => same = same_link(link, spring, changed),
                     None => same = false,
                 }
                 k += 1;
@@ -115,6 +122,7 @@ impl EnergyLedger {
     fn restart_bodies(
         &mut self,
         bodies: &AuditedBodies,
+        since: &EndTick,
         parallelism: &Parallelism,
     ) -> Option<bool> {
         let passes = self.end_passes;
@@ -127,9 +135,15 @@ impl EnergyLedger {
         if in_order {
             let moved = AtomicBool::new(false);
             for (entities, poses, velocities, masses) in dense(bodies.contiguous_iter()) {
+                let (pose_ticks, velocity_ticks, mass_ticks) = (
+                    poses.changed_ticks_slice(),
+                    velocities.changed_ticks_slice(),
+                    masses.changed_ticks_slice(),
+                );
                 let same = zip_table(&mut self.bodies, n, entities, parallelism, |body, j| {
-                    let item = (entities[j], &poses[j], &velocities[j], &masses[j]);
-                    let still = restart_entry(body, passes, item);
+                    let ticks = [pose_ticks[j], velocity_ticks[j], mass_ticks[j]];
+                    let item = (entities[j], &poses[j], &velocities[j], &masses[j], ticks);
+                    let still = restart_entry(body, passes, item, since);
                     if still == Some(false) {
                         moved.store(true, Ordering::Relaxed);
                     }
@@ -149,7 +163,7 @@ impl EnergyLedger {
                     same = false;
                     return;
                 };
-                match restart_entry(body, passes, item) {
+                match restart_entry(body, passes, item, since) {
                     None => same = false,
                     Some(still) => all_still &= still,
                 }
@@ -168,17 +182,14 @@ impl EnergyLedger {
 /// (the entry untouched) where it is another entity or its mass changed (a new mass changes its
 /// springs' reduced masses, so their stiffness bound: the groups must be formed again); else
 /// the entry takes the body's start, its kinetic energy reused from the memo where the body is
-/// still as end pass `passes` measured it, and says whether it is.
+/// still as end pass `passes` measured it (nothing written `since`), and says whether it is.
 #[inline]
-fn restart_entry(
-    body: &mut Audited,
-    passes: u64,
-    (entity, t, v, m): (Entity, &Pose, &Velocity, &MassProps),
-) -> Option<bool> {
+fn restart_entry(body: &mut Audited, passes: u64, item: BodyItem, since: &EndTick) -> Option<bool> {
+    let (entity, t, v, m, _) = item;
     if body.entity != entity {
         return None;
     }
-    let (energy, still) = start_kinetic_of(body, passes, t, v, m);
+    let (energy, still) = start_kinetic_of(body, passes, item, since);
     if !still && m.mass().widen().to_bits() != body.mass.to_bits() {
         return None;
     }

@@ -1,16 +1,18 @@
 //! The audit's systems: open the balance, credit the external loads, close it and quarantine.
 
 use bevy_ecs::prelude::*;
+use bevy_ecs::system::SystemChangeTick;
 use tumble_core::math::{Real, Vec3, Widen};
 
 use super::ledger::{
     Account, Audited, AuditedBodies, AuditedSprings, End, Ends, EnergyLedger, GroupStep, Link,
-    OMEGA_DT_CAP, ROUND_OFF_ULPS, elastic_among, for_each_audited, resolve_ends, zip_table,
+    OMEGA_DT_CAP, ROUND_OFF_ULPS, elastic_among, for_each_audited, for_each_spring, resolve_ends,
+    zip_table,
 };
-use super::memo::BodyMemo;
+use super::memo::{BodyMemo, EndTick};
 use crate::components::{
     BodyError, BodyErrorKind, Dynamic, ForceAccumulator, Gravity, GravityScale, ImplicitBody,
-    MassProps, PhysicsSettings, Pose, StepRefusals, Velocity, dense, reject,
+    MassProps, PhysicsSettings, Pose, StepRefusals, Velocity, dense, kinetic_energy_f64, reject,
 };
 use crate::integrate::StageCursor;
 use crate::parallel::{Parallelism, in_runs};
@@ -24,18 +26,25 @@ pub fn audit_energy_start(
     parallelism: Option<Res<Parallelism>>,
     bodies: AuditedBodies,
     ends: Ends,
-    (springs, refusals): (AuditedSprings, Option<ResMut<StepRefusals>>),
+    (springs, refusals, ticks): (
+        AuditedSprings,
+        Option<ResMut<StepRefusals>>,
+        SystemChangeTick,
+    ),
 ) {
     let ledger = &mut *ledger;
     if !cursor.span(&settings).opens_step {
         return;
     }
+    let since = EndTick::new(ledger.end_tick, ticks.this_run());
     // Refusals from before this step (one cut short) are not this step's.
     if let Some(mut refusals) = refusals {
         refusals.drain();
     }
     // Bodies and springs in entity index order, so that every sum over a group follows it.
-    ledger.spring_order.refresh(&springs);
+    ledger
+        .spring_order
+        .refresh_entities(springs.iter().map(|(e, _)| e));
     ledger.dt = settings.dt().widen();
     let stability_span = settings.stages().stability_span(settings.dt()).widen();
     let same_span = stability_span.to_bits() == ledger.stability_span.to_bits();
@@ -44,7 +53,7 @@ pub fn audit_energy_start(
     let parallelism = parallelism.map_or_else(Parallelism::default, |p| *p);
     if std::mem::take(&mut ledger.closed)
         && same_span
-        && ledger.restart(&bodies, &ends, &springs, &parallelism)
+        && ledger.restart(&bodies, &ends, &springs, (&since, &parallelism))
     {
         return;
     }
@@ -61,8 +70,9 @@ pub fn audit_energy_start(
     // Each entry is written over the last step's at its index, after its memo is read.
     let mut i = 0;
     let mut order = std::mem::take(&mut ledger.body_order);
-    for_each_audited(&mut order, &bodies, |(entity, t, v, m)| {
-        let (energy, still) = ledger.start_kinetic(i, (entity, t, v, m));
+    for_each_audited(&mut order, &bodies, |item| {
+        let (energy, still) = ledger.start_kinetic(i, item, &since);
+        let (entity, t, v, m, _) = item;
         ledger.set_slot(entity, i);
         let body = Audited {
             entity,
@@ -91,7 +101,7 @@ pub fn audit_energy_start(
     let old = ledger.links.len();
     let mut k = 0;
     let spring_order = std::mem::take(&mut ledger.spring_order);
-    spring_order.for_each(&springs, |spring| {
+    for_each_spring(&spring_order, &springs, |spring, _| {
         let (a, b) = resolve_ends(ledger, &ends, spring);
         if let (End::Audited(i, _), End::Audited(j, _)) = (a, b) {
             ledger.union(i as usize, j as usize);
@@ -256,13 +266,15 @@ pub fn audit_energy(
     mut ledger: ResMut<EnergyLedger>,
     gravity: Option<Res<Gravity>>,
     parallelism: Option<Res<Parallelism>>,
-    (bodies, refusals): (EndBodies, Option<ResMut<StepRefusals>>),
+    (bodies, refusals, ticks): (EndBodies, Option<ResMut<StepRefusals>>, SystemChangeTick),
     mut commands: Commands,
 ) {
     let ledger = &mut *ledger;
     if !cursor.span(&settings).closes_step {
         return;
     }
+    // What this pass measures is as it left it until something writes it after this tick.
+    ledger.end_tick = Some(ticks.this_run());
     let dt = ledger.dt;
     let gravity = gravity.and_then(|g| g.field());
     // Only what this pass measures may be reused (a body it does not see keeps an older memo,
@@ -360,7 +372,7 @@ impl EndPass {
         let v_mean = 0.5 * (v0.linear.widen() + v.linear.widen());
         let w_mean = 0.5 * (v0.angular.widen() + v.angular.widen());
         body.work = self.dt * (force.widen().dot(v_mean) + torque.widen().dot(w_mean));
-        body.memo = BodyMemo::measure(self.pass, t, v, m);
+        body.memo = BodyMemo::new(self.pass, kinetic_energy_f64(t, v, m));
     }
 
     /// Measures every body table by table, each table zipped with the ledger's entries in the
