@@ -445,6 +445,7 @@ pub(super) fn start_kinetic_of(
 
 /// World anchor of an end among the audited `bodies`, from the pose `pose` gives an audited
 /// body.
+#[inline(always)]
 fn anchor_among(bodies: &[Audited], end: End, pose: impl Fn(&Audited) -> Pose) -> Option<Vec3> {
     match end {
         End::Audited(i, local) => Some(pose(&bodies[i as usize]).transform_point(local)),
@@ -455,6 +456,7 @@ fn anchor_among(bodies: &[Audited], end: End, pose: impl Fn(&Audited) -> Pose) -
 
 /// Elastic energy of a link among the audited `bodies`, with the bodies at the poses `pose`
 /// gives; `None` when an end is kinematic or inactive.
+#[inline]
 pub(super) fn elastic_among(
     bodies: &[Audited],
     link: &Link,

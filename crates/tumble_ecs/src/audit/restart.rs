@@ -9,7 +9,7 @@ use super::ledger::{
     Audited, AuditedBodies, AuditedSprings, BodyItem, Ends, EnergyLedger, Link, for_each_audited,
     for_each_spring, resolve_ends, start_kinetic_of, zip_table,
 };
-use super::memo::{BodyMemo, EndTick};
+use super::memo::EndTick;
 use crate::components::{Spring, dense};
 use crate::parallel::{Parallelism, all_runs};
 use bevy_ecs::change_detection::Tick;
@@ -193,9 +193,10 @@ fn restart_entry(body: &mut Audited, passes: u64, item: BodyItem, since: &EndTic
     if !still && m.mass().widen().to_bits() != body.mass.to_bits() {
         return None;
     }
+    // The end pose and the memo stay the last end pass's: this step's end pass writes both,
+    // and a body it does not measure (one that left the step) is told apart by the memo's
+    // pass number, as are the springs it holds.
     body.start = (*t, *v);
-    body.end = *t;
-    body.memo = BodyMemo::NONE;
     body.load = (Vec3::ZERO, Vec3::ZERO);
     (body.start_energy, body.still) = (energy, still);
     Some(still)
