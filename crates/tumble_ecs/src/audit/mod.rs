@@ -69,8 +69,9 @@
 //! the bodies' accumulators before the springs add to them (the plan runs the springs right
 //! after it, so the other loads are read as they are, not recomputed as the sum less every
 //! spring's force), and one at the end. The end pass measures one kinetic and one elastic
-//! energy per body and spring; the start pass reuses them where the body or spring is, bit for
-//! bit, as that pass left it (`memo`), and measures afresh only what game code changed. When
+//! energy per body and spring; the start pass reuses them where nothing wrote the body or
+//! spring since that pass (its change ticks, `memo`), and measures afresh only what game code
+//! changed. When
 //! the spring graph is as the last step left it (the same bodies, masses and springs), the
 //! start also keeps the last step's groups (`EnergyLedger::restart`); when nothing changed at
 //! all, it takes each group's `T + V` from the sum its end pass closed with: the same number,
