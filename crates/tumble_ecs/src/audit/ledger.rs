@@ -20,30 +20,47 @@ pub(super) const OMEGA_DT_CAP: f64 = 1.99;
 pub(super) const ROUND_OFF_ULPS: f64 = 64.0;
 
 /// What the audit remembers of one body during a step.
+///
+/// Laid out in three cache lines by the passes that touch them: the first holds what the sums
+/// over the groups read, on one thread, at the end of every step (the memo, the work, the
+/// group) and what the start checks; the second the state to put back; the third what the
+/// loads and the end pass write (the springs' energies read the end pose from it).
 #[derive(Debug, Clone, Copy)]
+#[repr(C, align(64))]
 pub(super) struct Audited {
     pub(super) entity: Entity,
+    /// What the last end pass measured of this entry's entity, for the next start ([`memo`]).
+    pub(super) memo: BodyMemo,
+    /// The work of `load` over the step (J), once the end pass has measured it.
+    pub(super) work: f64,
+    /// Kinetic energy at the start of the step.
+    pub(super) start_energy: f64,
+    /// Mass (kg), for the springs' reduced mass.
+    pub(super) mass: f64,
+    /// Union–find parent.
+    pub(super) parent: u32,
+    /// Its group's index in [`EnergyLedger::groups`], once the start pass has joined every
+    /// spring's ends.
+    pub(super) group: u32,
+    /// Unchanged since the end of the last step (nothing written since, [`memo`]).
+    pub(super) still: bool,
     pub(super) start: (Pose, Velocity),
     /// Pose at the end of the step (for the springs' energy; after the end pass, the pose
     /// `memo` was measured at).
     pub(super) end: Pose,
-    /// What the last end pass measured of this entry's entity, for the next start ([`memo`]).
-    pub(super) memo: BodyMemo,
     /// Every load except the springs: force and torque (world frame).
     pub(super) load: (Vec3, Vec3),
-    /// The work of `load` over the step (J), once the end pass has measured it.
-    pub(super) work: f64,
-    /// Mass (kg), for the springs' reduced mass.
-    pub(super) mass: f64,
-    /// Union–find parent.
-    pub(super) parent: usize,
-    /// Its group's index in [`EnergyLedger::groups`], once the start pass has joined every
-    /// spring's ends.
-    pub(super) group: usize,
-    /// Unchanged since the end of the last step (nothing written since, [`memo`]).
-    pub(super) still: bool,
-    /// Kinetic energy at the start of the step.
-    pub(super) start_energy: f64,
+}
+
+// What the end of every step reads of every body, on one thread, fills one cache line.
+const _: () = assert!(std::mem::offset_of!(Audited, still) < 64);
+
+impl Audited {
+    /// Its group's index in [`EnergyLedger::groups`].
+    #[inline(always)]
+    pub(super) fn group(&self) -> usize {
+        self.group as usize
+    }
 }
 
 /// One end of a spring as the audit sees it.
@@ -80,6 +97,12 @@ pub(super) struct Link {
     /// entities at the same indices and the spring is not written, its ends resolve as they
     /// did (an end on a static, kinematic or missing body is resolved again at every start).
     pub(super) stable: bool,
+}
+
+/// `i` as a ledger index (entities are indexed by `u32`, so a world never holds more bodies).
+#[inline]
+pub(super) fn index_u32(i: usize) -> u32 {
+    u32::try_from(i).expect("fewer than 2³² audited bodies")
 }
 
 /// [`Link::group`] of a link without an audited end.
@@ -260,10 +283,10 @@ impl EnergyLedger {
     }
 
     pub(super) fn find(&mut self, mut i: usize) -> usize {
-        while self.bodies[i].parent != i {
-            let grand = self.bodies[self.bodies[i].parent].parent;
+        while self.bodies[i].parent as usize != i {
+            let grand = self.bodies[self.bodies[i].parent as usize].parent;
             self.bodies[i].parent = grand;
-            i = grand;
+            i = grand as usize;
         }
         i
     }
@@ -273,7 +296,7 @@ impl EnergyLedger {
         if ra != rb {
             // Attach to the smaller index so that the root does not depend on spring order.
             let (lo, hi) = if ra < rb { (ra, rb) } else { (rb, ra) };
-            self.bodies[hi].parent = lo;
+            self.bodies[hi].parent = index_u32(lo);
         }
     }
 
@@ -340,7 +363,7 @@ impl EnergyLedger {
     pub(super) fn group_of_ends(&self, link: &Link) -> Option<usize> {
         match (link.a, link.b) {
             (End::Audited(i, _), _) | (_, End::Audited(i, _)) => {
-                Some(self.bodies[i as usize].group)
+                Some(self.bodies[i as usize].group())
             }
             _ => None,
         }
@@ -394,7 +417,7 @@ impl EnergyLedger {
                 start_energy,
                 ..
             } = self.bodies[i];
-            let g = &mut self.groups[group];
+            let g = &mut self.groups[group as usize];
             g.start += start_energy;
             g.magnitude += start_energy;
         }

@@ -6,8 +6,8 @@ use tumble_core::math::{Real, Vec3, Widen};
 
 use super::ledger::{
     Account, Audited, AuditedBodies, AuditedSprings, End, Ends, EnergyLedger, GroupStep, Link,
-    OMEGA_DT_CAP, ROUND_OFF_ULPS, elastic_among, for_each_audited, for_each_spring, resolve_ends,
-    zip_table,
+    OMEGA_DT_CAP, ROUND_OFF_ULPS, elastic_among, for_each_audited, for_each_spring, index_u32,
+    resolve_ends, zip_table,
 };
 use super::memo::{BodyMemo, EndTick};
 use crate::components::{
@@ -82,7 +82,7 @@ pub fn audit_energy_start(
             load: (Vec3::ZERO, Vec3::ZERO),
             work: 0.0,
             mass: m.mass().widen(),
-            parent: i,
+            parent: index_u32(i),
             group: 0,
             still,
             start_energy: energy,
@@ -297,7 +297,7 @@ pub fn audit_energy(
     let pass = end.pass;
     // Summed in the ledger's order (entity index order), not the query's.
     for body in &ledger.bodies {
-        let g = &mut ledger.groups[body.group];
+        let g = &mut ledger.groups[body.group()];
         if !body.memo.measured_by(pass) {
             g.left = true;
             continue;
@@ -313,7 +313,7 @@ pub fn audit_energy(
     if let Some(mut refusals) = refusals {
         for entity in refusals.drain() {
             if let Some(i) = ledger.slot(entity) {
-                let group = ledger.bodies[i].group;
+                let group = ledger.bodies[i].group();
                 ledger.groups[group].left = true;
             }
         }
@@ -423,9 +423,9 @@ impl EnergyLedger {
                 self.groups.push(GroupStep::default());
                 self.groups.len() - 1
             } else {
-                self.bodies[root].group
+                self.bodies[root].group()
             };
-            self.bodies[i].group = group;
+            self.bodies[i].group = index_u32(group);
             let entity = self.bodies[i].entity;
             let g = &mut self.groups[group];
             g.members += 1;
@@ -496,7 +496,7 @@ impl EnergyLedger {
         if std::mem::take(&mut self.restored) {
             for i in 0..self.bodies.len() {
                 let Audited { entity, group, .. } = self.bodies[i];
-                if let Some(key) = self.groups[group].key
+                if let Some(key) = self.groups[group as usize].key
                     && key != entity
                     && let Some(account) = self.accounts.remove(&entity)
                 {
@@ -567,7 +567,7 @@ impl EnergyLedger {
             }
             account.created = before;
             for i in 0..self.bodies.len() {
-                if self.bodies[i].group != group {
+                if self.bodies[i].group() != group {
                     continue;
                 }
                 let body = self.bodies[i];

@@ -40,20 +40,31 @@ pub fn kinetic_and_elastic_energy(world: &mut World) -> f64 {
 
 /// Adds `m g s` to every dynamic body with an accumulator (`s` = [`GravityScale`], default 1).
 /// Only in the schedule when a [`Gravity`] resource exists; nothing while it is not finite
-/// ([`Gravity::field`]).
+/// ([`Gravity::field`]). Table by table, each split over the compute pool's threads as
+/// [`Parallelism`] allows: every body's sum is its own, the same bits on any thread.
 pub fn apply_gravity(
     gravity: Res<Gravity>,
     mut bodies: Query<
         (&MassProps, Option<&GravityScale>, &mut ForceAccumulator),
         crate::components::Dynamic,
     >,
+    parallelism: Option<Res<Parallelism>>,
 ) {
     let Some(g) = gravity.field() else {
         return;
     };
-    for (mass, scale, mut acc) in &mut bodies {
-        let s = scale.map_or(1.0, |s| s.0);
-        acc.force += (mass.mass() * s) * g;
+    let parallelism = parallelism.map_or_else(Parallelism::default, |p| *p);
+    for (masses, scales, accumulators) in dense(bodies.contiguous_iter_mut()) {
+        // Marks the whole column changed, once.
+        let accumulators = bevy_ecs::change_detection::ContiguousMut::split(accumulators).0;
+        let threads = parallelism.threads_for(accumulators.len());
+        crate::parallel::in_runs(threads, accumulators, |at, run| {
+            for (k, acc) in run.iter_mut().enumerate() {
+                let s = scales.map_or(1.0, |s| s[at + k].0);
+                acc.force += (masses[at + k].mass() * s) * g;
+            }
+            true
+        });
     }
 }
 
