@@ -186,10 +186,43 @@ fn big_world_bits(parallelism: Parallelism, integrator: Integrator) -> Vec<u64> 
             });
         }
     }
-    for pair in bodies.chunks(6) {
-        let end = SpringEnd::on_body(pair[3], Vec3::ZERO);
-        let spring = Spring::new(pair[0], Vec3::new(0.1, 0.0, 0.0), end, 10.0, 0.5);
-        world.spawn(spring.with_damping(0.1));
+    // Springs within each group of six (bodies 0, 3 and 5 each held by two), one to a body
+    // half the world away (its ends in different threads' shares of the rows), one to a world
+    // point: every body's spring forces are added in spring order on any thread count.
+    let groups: Vec<&[bevy_ecs::entity::Entity]> = bodies.chunks(6).collect();
+    for (g, pair) in groups.iter().enumerate() {
+        let far = groups[(g + groups.len() / 2) % groups.len()][4];
+        let springs = [
+            (
+                pair[0],
+                Vec3::new(0.1, 0.0, 0.0),
+                SpringEnd::on_body(pair[3], Vec3::ZERO),
+            ),
+            (
+                pair[3],
+                Vec3::new(0.0, 0.05, 0.0),
+                SpringEnd::on_body(pair[5], Vec3::X * 0.1),
+            ),
+            (
+                pair[5],
+                Vec3::new(0.0, 0.0, 0.1),
+                SpringEnd::on_body(pair[0], Vec3::Y * 0.1),
+            ),
+            (
+                pair[1],
+                Vec3::new(0.05, 0.0, 0.0),
+                SpringEnd::on_body(far, Vec3::ZERO),
+            ),
+            (
+                pair[2],
+                Vec3::ZERO,
+                SpringEnd::World(Vec3::new(0.0, 1.0, 0.0)),
+            ),
+        ];
+        for (a, anchor, end) in springs {
+            let spring = Spring::new(a, anchor, end, 10.0, 0.5);
+            world.spawn(spring.with_damping(0.1));
+        }
     }
     run(&mut world, 40);
     let mut bits = Vec::new();
