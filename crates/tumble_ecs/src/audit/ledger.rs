@@ -94,9 +94,12 @@ pub(super) struct Link {
     /// here rather than from the bodies.
     pub(super) group: u32,
     /// Each end is an audited body or a world point: while the audited bodies are the same
-    /// entities at the same indices and the spring is not written, its ends resolve as they
-    /// did (an end on a static, kinematic or missing body is resolved again at every start).
+    /// entities at the same indices and the spring (this entity) is not written, its ends
+    /// resolve as they did (an end on a static, kinematic or missing body is resolved again at
+    /// every start).
     pub(super) stable: bool,
+    /// The spring's entity.
+    pub(super) spring: Entity,
 }
 
 /// `i` as a ledger index (entities are indexed by `u32`, so a world never holds more bodies).
@@ -109,8 +112,9 @@ pub(super) fn index_u32(i: usize) -> u32 {
 pub(super) const NO_GROUP: u32 = u32::MAX;
 
 impl Link {
-    /// The spring `spring` with its ends resolved to `a` and `b`, not measured yet.
-    pub(super) fn new(spring: &Spring, a: End, b: End) -> Self {
+    /// The spring `spring` (of entity `entity`) with its ends resolved to `a` and `b`, not
+    /// measured yet.
+    pub(super) fn new(entity: Entity, spring: &Spring, a: End, b: End) -> Self {
         let audited = |end: End| matches!(end, End::Audited(..));
         let stable = audited(a)
             && match spring.b {
@@ -126,6 +130,7 @@ impl Link {
             elastic: 0.0,
             group: NO_GROUP,
             stable,
+            spring: entity,
         }
     }
 
@@ -594,20 +599,22 @@ pub(super) fn body_item<'w>(
 /// the change ticks that say whether game code wrote them since the last end pass.
 pub(super) type AuditedSprings<'w, 's> = Query<'w, 's, (Entity, Ref<'static, Spring>)>;
 
-/// Calls `f` on every spring with its last change, in entity index order (`order`, refreshed
-/// by the caller from the same query).
+/// Calls `f` on every spring with its entity and last change, in entity index order (`order`,
+/// refreshed by the caller from the same query).
 pub(super) fn for_each_spring(
     order: &IndexOrder,
     springs: &AuditedSprings,
-    mut f: impl FnMut(&Spring, Tick),
+    mut f: impl FnMut(Entity, &Spring, Tick),
 ) {
-    let mut each = |spring: Ref<Spring>| f(spring.into_inner(), spring.last_changed());
+    let mut each = |(entity, spring): (Entity, Ref<Spring>)| {
+        f(entity, spring.into_inner(), spring.last_changed())
+    };
     if order.is_query_order() {
-        springs.iter().for_each(|(_, spring)| each(spring));
+        springs.iter().for_each(&mut each);
     } else {
         for &entity in order.entities() {
-            if let Ok((_, spring)) = springs.get(entity) {
-                each(spring);
+            if let Ok(item) = springs.get(entity) {
+                each(item);
             }
         }
     }

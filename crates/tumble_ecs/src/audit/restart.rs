@@ -13,6 +13,7 @@ use super::memo::EndTick;
 use crate::components::{Spring, dense};
 use crate::parallel::{Parallelism, all_runs};
 use bevy_ecs::change_detection::Tick;
+use bevy_ecs::entity::Entity;
 
 impl EnergyLedger {
     /// The start of a step when the world's spring graph is as the last step left it: the
@@ -68,28 +69,28 @@ impl EnergyLedger {
         since: &EndTick,
         parallelism: &Parallelism,
     ) -> bool {
-        let same_link = |link: &Link, spring: &Spring, changed: Tick| {
-            // The audited bodies are the last step's (checked first, by `restart_bodies`).
-            if link.stable && !since.written(changed) {
+        let same_link = |link: &Link, (entity, spring, changed): (Entity, &Spring, Tick)| {
+            // The same spring, not written since, between the last step's audited bodies
+            // (checked first, by `restart_bodies`): resolved as it was.
+            if link.stable && link.spring == entity && !since.written(changed) {
                 return true;
             }
             let (a, b) = resolve_ends(self, ends, spring);
-            link.same_inputs(&Link::new(spring, a, b))
+            link.same_inputs(&Link::new(entity, spring, a, b))
         };
         let mut k = 0;
         if self.spring_order.is_query_order() {
-            for (_, table) in dense(springs.contiguous_iter()) {
+            for (entities, table) in dense(springs.contiguous_iter()) {
                 let Some(links) = self.links.get(k..k + table.len()) else {
                     return false;
                 };
                 let changed = table.changed_ticks_slice();
                 let threads = parallelism.threads_for(links.len());
                 let same = all_runs(threads, links, |at, run| {
-                    let springs = &table[at..at + run.len()];
-                    run.iter()
-                        .zip(springs)
-                        .zip(&changed[at..at + run.len()])
-                        .all(|((link, spring), &changed)| same_link(link, spring, changed))
+                    run.iter().enumerate().all(|(k, link)| {
+                        let j = at + k;
+                        same_link(link, (entities[j], &table[j], changed[j]))
+                    })
                 });
                 if !same {
                     return false;
@@ -98,9 +99,9 @@ impl EnergyLedger {
             }
         } else {
             let mut same = true;
-            for_each_spring(&self.spring_order, springs, |spring, changed| {
+            for_each_spring(&self.spring_order, springs, |entity, spring, changed| {
                 match self.links.get(k).filter(|_| same) {
-                    Some(link) => same = same_link(link, spring, changed),
+                    Some(link) => same = same_link(link, (entity, spring, changed)),
                     None => same = false,
                 }
                 k += 1;

@@ -101,12 +101,12 @@ pub fn audit_energy_start(
     let old = ledger.links.len();
     let mut k = 0;
     let spring_order = std::mem::take(&mut ledger.spring_order);
-    for_each_spring(&spring_order, &springs, |spring, _| {
+    for_each_spring(&spring_order, &springs, |entity, spring, _| {
         let (a, b) = resolve_ends(ledger, &ends, spring);
         if let (End::Audited(i, _), End::Audited(j, _)) = (a, b) {
             ledger.union(i as usize, j as usize);
         }
-        let mut link = Link::new(spring, a, b);
+        let mut link = Link::new(entity, spring, a, b);
         if k < old {
             let last = ledger.links[k];
             if last.same_inputs(&link) {

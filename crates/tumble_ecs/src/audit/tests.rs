@@ -132,6 +132,15 @@ fn game_code(world: &mut World, step: usize, handles: &Handles) {
             let end = SpringEnd::on_body(free, Vec3::new(0.1, 0.0, 0.0));
             world.spawn(Spring::new(extra, Vec3::ZERO, end, 100.0, 0.8));
         }
+        210 => {
+            // The first spring cut and the last one doubled: as many springs as before, each
+            // unwritten one one place earlier in entity order, and the new one, last, the same
+            // as the last one was. (The empty entity takes the cut spring's index first.)
+            world.despawn(springs[0]);
+            world.spawn_empty();
+            let last = *world.get::<Spring>(*springs.last().unwrap()).unwrap();
+            world.spawn(last);
+        }
         330 => {
             world.entity_mut(post).remove::<Static>().insert(Kinematic);
         }
@@ -233,7 +242,10 @@ fn compare_with_fresh(parallelism: Parallelism, integrator: Integrator) {
         // (Moving the post changes a spring's fixed end while it is static; a kinematic
         // post's group is not balanced, and its pose is nothing the audit measures.)
         let post_moved = step % 40 == 5 && step < 330;
-        if matches!(step % 40, 3 | 11 | 17 | 19) || matches!(step, 150 | 250 | 330) || post_moved {
+        if matches!(step % 40, 3 | 11 | 17 | 19)
+            || matches!(step, 150 | 210 | 250 | 330)
+            || post_moved
+        {
             assert_eq!(ledger.restarts, restarts, "step {step}: a change was seen");
         }
         // A kicked, pushed or turned body keeps the groups: only its energy is measured again
@@ -242,7 +254,10 @@ fn compare_with_fresh(parallelism: Parallelism, integrator: Integrator) {
         if matches!(step % 40, 3 | 7 | 11 | 13 | 31 | 37) {
             assert_eq!(ledger.partial_restarts, partial + 1, "step {step}");
         }
-        if matches!(step % 40, 17 | 19 | 23 | 29) || matches!(step, 150 | 250 | 330) || post_moved {
+        if matches!(step % 40, 17 | 19 | 23 | 29)
+            || matches!(step, 150 | 210 | 250 | 330)
+            || post_moved
+        {
             assert_eq!(ledger.partial_restarts, partial, "step {step}: regrouped");
         }
         if step % 40 == 3 {
