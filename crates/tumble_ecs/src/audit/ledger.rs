@@ -223,6 +223,9 @@ pub struct EnergyLedger {
     /// The change tick the last end pass ran at: a body whose pose, velocity and mass were not
     /// written since is as that pass measured it ([`memo`]).
     pub(super) end_tick: Option<Tick>,
+    /// The change tick the last start pass ran at: a spring not written since is as its link
+    /// says, a body's mass as its entry says ([`memo`]).
+    pub(super) start_tick: Option<Tick>,
     /// The groups were closed by an end pass since the last start: their end sums are the
     /// energies the bodies stand at now, if nothing changed ([`EnergyLedger::restart`]).
     pub(super) closed: bool,

@@ -7,9 +7,13 @@
 //! [`MassProps`] — was written since that pass: a memo of a pure function, so a reused value is
 //! the value a fresh evaluation would give.
 //!
-//! "Written since" is read from the components' change ticks ([`EndTick`]): three numbers per
+//! "Written since" is read from the components' change ticks ([`Marks`]): three numbers per
 //! body, where comparing every input bit for bit read 21 numbers from the world and 14 from the
-//! ledger at every start (a quarter of the audit's cost in a loaded spring world). Everything
+//! ledger at every start (a quarter of the audit's cost in a loaded spring world). A body's
+//! energy is reused where nothing wrote it since the end pass measured it; a spring's link
+//! (its ends, stiffness and rest length, which the start pass resolves) and a body's mass (the
+//! springs' stiffness bound) are kept where nothing wrote them since the last start pass, so
+//! that a force system that rewrites a spring or a mass during a step is seen. Everything
 //! that writes a component through `bevy_ecs` marks it (game code's queries and `get_mut`,
 //! inserts, a quarantine putting a body back, a rollback restore); a write made with
 //! `bypass_change_detection` is not seen, and the next balance then charges what it changed to
@@ -17,6 +21,7 @@
 //! ([`crate::springs`]).
 
 use bevy_ecs::change_detection::{MAX_CHANGE_AGE, Tick};
+use bevy_ecs::system::SystemChangeTick;
 
 /// A body's kinetic energy as an end pass measured it (the ledger entry's entity, at the
 /// ledger's end pose).
@@ -58,7 +63,34 @@ impl BodyMemo {
     }
 }
 
-/// The change tick of the last end pass, and of the system reading after it: whether a
+/// What the start of a step compares change ticks with: the last end pass's tick (a body's
+/// energy) and the last start pass's (a spring's link, a body's mass).
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Marks {
+    /// Since the last end pass.
+    pub(super) end: EndTick,
+    /// Since the last start pass.
+    pub(super) start: EndTick,
+}
+
+impl Marks {
+    /// The ledger's last end and start ticks, read by the start system whose change ticks are
+    /// `ticks`. bevy keeps a system's last run in range as the world's counter wraps
+    /// (`check_change_ticks`) but not the ticks the ledger stores: they are trusted only while
+    /// the start system ran recently (the end pass ran between its last run and this one), so
+    /// that physics paused for 2³² ticks of other systems measures everything afresh.
+    pub(super) fn new(end: Option<Tick>, start: Option<Tick>, ticks: &SystemChangeTick) -> Self {
+        let (now, last) = (ticks.this_run(), ticks.last_run());
+        let recent = now.get().wrapping_sub(last.get()) < MAX_CHANGE_AGE / 4;
+        let keep = |tick: Option<Tick>| tick.filter(|_| recent);
+        Self {
+            end: EndTick::new(keep(end), now),
+            start: EndTick::new(keep(start), now),
+        }
+    }
+}
+
+/// A tick the ledger stored (an end or start pass's), and the reading system's: whether a
 /// component was written since that pass.
 #[derive(Debug, Clone, Copy)]
 pub(super) struct EndTick {

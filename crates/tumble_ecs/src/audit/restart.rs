@@ -9,7 +9,7 @@ use super::ledger::{
     Audited, AuditedBodies, AuditedSprings, BodyItem, Ends, EnergyLedger, Link, for_each_audited,
     for_each_spring, resolve_ends, start_kinetic_of, zip_table,
 };
-use super::memo::EndTick;
+use super::memo::{EndTick, Marks};
 use crate::components::{Spring, dense};
 use crate::parallel::{Parallelism, all_runs};
 use bevy_ecs::change_detection::Tick;
@@ -29,12 +29,12 @@ impl EnergyLedger {
         bodies: &AuditedBodies,
         ends: &Ends,
         springs: &AuditedSprings,
-        (since, parallelism): (&EndTick, &Parallelism),
+        (marks, parallelism): (&Marks, &Parallelism),
     ) -> bool {
-        let Some(all_still) = self.restart_bodies(bodies, since, parallelism) else {
+        let Some(all_still) = self.restart_bodies(bodies, marks, parallelism) else {
             return false;
         };
-        if !self.same_springs(ends, springs, since, parallelism) {
+        if !self.same_springs(ends, springs, &marks.start, parallelism) {
             return false;
         }
         if all_still {
@@ -70,8 +70,8 @@ impl EnergyLedger {
         parallelism: &Parallelism,
     ) -> bool {
         let same_link = |link: &Link, (entity, spring, changed): (Entity, &Spring, Tick)| {
-            // The same spring, not written since, between the last step's audited bodies
-            // (checked first, by `restart_bodies`): resolved as it was.
+            // The same spring, not written since the last start resolved it, between the last
+            // step's audited bodies (checked first, by `restart_bodies`): resolved as it was.
             if link.stable && link.spring == entity && !since.written(changed) {
                 return true;
             }
@@ -123,7 +123,7 @@ impl EnergyLedger {
     fn restart_bodies(
         &mut self,
         bodies: &AuditedBodies,
-        since: &EndTick,
+        marks: &Marks,
         parallelism: &Parallelism,
     ) -> Option<bool> {
         let passes = self.end_passes;
@@ -144,7 +144,7 @@ impl EnergyLedger {
                 let same = zip_table(&mut self.bodies, n, entities, parallelism, |body, j| {
                     let ticks = [pose_ticks[j], velocity_ticks[j], mass_ticks[j]];
                     let item = (entities[j], &poses[j], &velocities[j], &masses[j], ticks);
-                    let still = restart_entry(body, passes, item, since);
+                    let still = restart_entry(body, passes, item, marks);
                     if still == Some(false) {
                         moved.store(true, Ordering::Relaxed);
                     }
@@ -164,7 +164,7 @@ impl EnergyLedger {
                     same = false;
                     return;
                 };
-                match restart_entry(body, passes, item, since) {
+                match restart_entry(body, passes, item, marks) {
                     None => same = false,
                     Some(still) => all_still &= still,
                 }
@@ -183,15 +183,18 @@ impl EnergyLedger {
 /// (the entry untouched) where it is another entity or its mass changed (a new mass changes its
 /// springs' reduced masses, so their stiffness bound: the groups must be formed again); else
 /// the entry takes the body's start, its kinetic energy reused from the memo where the body is
-/// still as end pass `passes` measured it (nothing written `since`), and says whether it is.
+/// still as end pass `passes` measured it (nothing written since, `marks`), and says whether
+/// it is. A mass written since the last start pass (by game code between steps, or a force
+/// system during the last one) is compared with the entry's.
 #[inline]
-fn restart_entry(body: &mut Audited, passes: u64, item: BodyItem, since: &EndTick) -> Option<bool> {
+fn restart_entry(body: &mut Audited, passes: u64, item: BodyItem, marks: &Marks) -> Option<bool> {
     let (entity, t, v, m, _) = item;
     if body.entity != entity {
         return None;
     }
-    let (energy, still) = start_kinetic_of(body, passes, item, since);
-    if !still && m.mass().widen().to_bits() != body.mass.to_bits() {
+    let (energy, still) = start_kinetic_of(body, passes, item, &marks.end);
+    let mass_written = marks.start.written(item.4[2]);
+    if (mass_written || !still) && m.mass().widen().to_bits() != body.mass.to_bits() {
         return None;
     }
     // The end pose and the memo stay the last end pass's: this step's end pass writes both,

@@ -9,7 +9,7 @@ use super::ledger::{
     OMEGA_DT_CAP, ROUND_OFF_ULPS, elastic_among, for_each_audited, for_each_spring, index_u32,
     resolve_ends, zip_table,
 };
-use super::memo::{BodyMemo, EndTick};
+use super::memo::{BodyMemo, Marks};
 use crate::components::{
     BodyError, BodyErrorKind, Dynamic, ForceAccumulator, Gravity, GravityScale, ImplicitBody,
     MassProps, PhysicsSettings, Pose, StepRefusals, Velocity, dense, kinetic_energy_f64, reject,
@@ -36,7 +36,9 @@ pub fn audit_energy_start(
     if !cursor.span(&settings).opens_step {
         return;
     }
-    let since = EndTick::new(ledger.end_tick, ticks.this_run());
+    let marks = Marks::new(ledger.end_tick, ledger.start_tick, &ticks);
+    ledger.start_tick = Some(ticks.this_run());
+    let since = marks.end;
     // Refusals from before this step (one cut short) are not this step's.
     if let Some(mut refusals) = refusals {
         refusals.drain();
@@ -53,7 +55,7 @@ pub fn audit_energy_start(
     let parallelism = parallelism.map_or_else(Parallelism::default, |p| *p);
     if std::mem::take(&mut ledger.closed)
         && same_span
-        && ledger.restart(&bodies, &ends, &springs, (&since, &parallelism))
+        && ledger.restart(&bodies, &ends, &springs, (&marks, &parallelism))
     {
         return;
     }

@@ -3,6 +3,7 @@
 //! bit for bit, whatever game code changes between the steps.
 
 use bevy_ecs::prelude::*;
+use bevy_ecs::schedule::IntoScheduleConfigs;
 use tumble_core::math::{Quat, Real, Vec3};
 
 use super::EnergyLedger;
@@ -282,5 +283,91 @@ fn compare_with_fresh(parallelism: Parallelism, integrator: Integrator) {
     assert!(
         created.iter().any(|a| a.created.abs() > 1e-6),
         "the accounts are not trivially zero: {created:?}"
+    );
+}
+
+/// What [`rewrite_during_the_step`] changes in the next step it runs in.
+#[derive(Resource, Default)]
+struct MidStep {
+    /// A spring to lengthen.
+    spring: Option<Entity>,
+    /// A body to make half as heavy (its springs then the stiffest of its group).
+    body: Option<Entity>,
+}
+
+/// A force system that rewrites a spring and a body's mass in the middle of a step (after the
+/// audit's start pass has resolved the springs and taken the masses, before its end pass),
+/// once each time [`MidStep`] names them; exclusive, so that the mass is inserted at once.
+fn rewrite_during_the_step(world: &mut World) {
+    let MidStep { spring, body } = std::mem::take(&mut *world.resource_mut::<MidStep>());
+    if let Some(spring) = spring {
+        world.get_mut::<Spring>(spring).unwrap().rest_length += 0.1;
+    }
+    if let Some(body) = body {
+        let m = world.get::<MassProps>(body).unwrap().0;
+        let heavier =
+            MassProperties::new(Mass::new(0.5 * m.mass()).unwrap(), m.principal_inertia()).unwrap();
+        world.entity_mut(body).insert(MassProps(heavier));
+    }
+}
+
+/// A spring or a mass a force system rewrites during a step is taken afresh at the next start
+/// (its link resolved again, its group's stiffness bound from the new mass), as a world that
+/// measures everything afresh takes it: the same accounts and bounds, step after step.
+#[test]
+fn springs_and_masses_rewritten_during_a_step_are_seen_at_the_next_start() {
+    let (mut reusing, handles) = spring_world(Parallelism::SINGLE_THREAD, Integrator::Splitting);
+    let (mut fresh, _) = spring_world(Parallelism::SINGLE_THREAD, Integrator::Splitting);
+    let (plan_r, plan_f) = (
+        PhysicsPlan::for_world(&mut reusing),
+        PhysicsPlan::for_world(&mut fresh),
+    );
+    let (mut schedule_r, mut schedule_f) = (plan_r.build_schedule(), plan_f.build_schedule());
+    for (world, schedule) in [
+        (&mut reusing, &mut schedule_r),
+        (&mut fresh, &mut schedule_f),
+    ] {
+        world.init_resource::<MidStep>();
+        schedule.add_systems(rewrite_during_the_step.in_set(PhysicsSet::Forces));
+    }
+    for step in 0..120 {
+        for world in [&mut reusing, &mut fresh] {
+            let mut mid = world.resource_mut::<MidStep>();
+            match step {
+                20 | 60 => mid.spring = Some(handles.springs[3]),
+                40 | 80 => mid.body = Some(handles.chain[2]),
+                _ => {}
+            }
+        }
+        fresh.resource_mut::<EnergyLedger>().forget_measurements();
+        plan_r.run_step(&mut schedule_r, &mut reusing);
+        plan_f.run_step(&mut schedule_f, &mut fresh);
+        let (r, f) = (
+            reusing.resource::<EnergyLedger>(),
+            fresh.resource::<EnergyLedger>(),
+        );
+        let accounts = |l: &EnergyLedger| {
+            let saved = l.saved_accounts();
+            saved
+                .iter()
+                .map(|a| a.created.to_bits())
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(accounts(r), accounts(f), "step {step}");
+        let bounds = |l: &EnergyLedger| {
+            l.groups
+                .iter()
+                .map(|g| g.omega_dt.to_bits())
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(bounds(r), bounds(f), "step {step}");
+        reusing.clear_trackers();
+        fresh.clear_trackers();
+    }
+    assert!(
+        reusing
+            .get_resource::<PhysicsErrors>()
+            .is_none_or(|e| e.is_empty()),
+        "a stable chain is never flagged"
     );
 }
