@@ -566,7 +566,8 @@ pub(super) fn same_end(a: End, b: End) -> bool {
 }
 
 /// The bodies the audit watches, as its start pass reads them (with the change ticks that say
-/// whether game code wrote them since the last end pass, [`memo`]).
+/// whether anything wrote them since the last end pass, or their mass since the last start
+/// pass, [`memo`]).
 pub(super) type AuditedBodies<'w, 's> = Query<
     'w,
     's,
@@ -599,7 +600,8 @@ pub(super) fn body_item<'w>(
 }
 
 /// The springs the audit measures, with their entities (visited in entity index order) and
-/// the change ticks that say whether game code wrote them since the last end pass.
+/// the change ticks that say whether anything wrote them since the last start pass resolved
+/// them ([`memo`]).
 pub(super) type AuditedSprings<'w, 's> = Query<'w, 's, (Entity, Ref<'static, Spring>)>;
 
 /// Calls `f` on every spring with its entity and last change, in entity index order (`order`,

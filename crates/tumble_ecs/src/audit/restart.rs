@@ -188,12 +188,12 @@ impl EnergyLedger {
 /// system during the last one) is compared with the entry's.
 #[inline]
 fn restart_entry(body: &mut Audited, passes: u64, item: BodyItem, marks: &Marks) -> Option<bool> {
-    let (entity, t, v, m, _) = item;
+    let (entity, t, v, m, [_, _, mass_changed]) = item;
     if body.entity != entity {
         return None;
     }
     let (energy, still) = start_kinetic_of(body, passes, item, &marks.end);
-    let mass_written = marks.start.written(item.4[2]);
+    let mass_written = marks.start.written(mass_changed);
     if (mass_written || !still) && m.mass().widen().to_bits() != body.mass.to_bits() {
         return None;
     }

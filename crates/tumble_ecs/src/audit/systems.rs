@@ -38,7 +38,6 @@ pub fn audit_energy_start(
     }
     let marks = Marks::new(ledger.end_tick, ledger.start_tick, &ticks);
     ledger.start_tick = Some(ticks.this_run());
-    let since = marks.end;
     // Refusals from before this step (one cut short) are not this step's.
     if let Some(mut refusals) = refusals {
         refusals.drain();
@@ -73,7 +72,7 @@ pub fn audit_energy_start(
     let mut i = 0;
     let mut order = std::mem::take(&mut ledger.body_order);
     for_each_audited(&mut order, &bodies, |item| {
-        let (energy, still) = ledger.start_kinetic(i, item, &since);
+        let (energy, still) = ledger.start_kinetic(i, item, &marks.end);
         let (entity, t, v, m, _) = item;
         ledger.set_slot(entity, i);
         let body = Audited {
