@@ -10,7 +10,7 @@ use crate::components::{
     Dynamic, IndexOrder, Kinematic, MassProps, Pose, Rejected, RigidBody, Spring, SpringEnd,
     Static, Velocity, kinetic_energy_f64,
 };
-use crate::parallel::{Parallelism, in_runs};
+use crate::parallel::{Parallelism, Runs, in_runs};
 
 /// The audit's largest `ωΔt` in the stable-spring factor: at 2 the factor is infinite, and
 /// beyond it the spring is unstable and grows geometrically past any finite bound anyway.
@@ -198,6 +198,16 @@ pub(super) struct GroupStep {
     pub(super) omega_dt: f64,
 }
 
+/// The bodies and the links of the ledger cut into runs of whole groups, for `threads` threads:
+/// each group's sums take their terms in ledger order on one thread (see
+/// [`crate::parallel::Runs`]), so the accounts are the same bits on any number of threads.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct GroupRuns {
+    threads: usize,
+    pub(super) bodies: Runs,
+    pub(super) links: Runs,
+}
+
 /// The audit's bookkeeping (reused every step so that steps do not allocate).
 #[derive(Resource, Debug, Default)]
 pub struct EnergyLedger {
@@ -234,6 +244,9 @@ pub struct EnergyLedger {
     pub(super) body_order: IndexOrder,
     /// The springs in entity index order (scratch).
     pub(super) spring_order: IndexOrder,
+    /// The bodies and the links cut into runs of whole groups for the end pass's sums
+    /// ([`EnergyLedger::group_runs`]); `None` once the groups are numbered again.
+    pub(super) group_runs: Option<GroupRuns>,
     /// Starts that took the unchanged world's shortcut (for tests).
     #[cfg(test)]
     pub(super) restarts: usize,
@@ -359,6 +372,35 @@ impl EnergyLedger {
         self.accounts.clear();
         self.accounts.extend(from.accounts.iter().copied());
         self.restored = from.restored;
+    }
+
+    /// The bodies and the links cut into runs of whole groups for `threads` threads, kept
+    /// until the groups are numbered again. Groups are numbered in the order of their first
+    /// member, so bodies and springs spawned group by group cut between groups near every even
+    /// cut; a world whose groups interleave sums on one thread.
+    pub(super) fn group_runs(&mut self, threads: usize) -> GroupRuns {
+        if let Some(runs) = self.group_runs
+            && runs.threads == threads
+            && runs.bodies.len() == self.bodies.len()
+            && runs.links.len() == self.links.len()
+        {
+            return runs;
+        }
+        let bodies = Runs::of_keys(self.bodies.len(), threads, |i| {
+            let g = u64::from(self.bodies[i].group);
+            Some((g, g))
+        });
+        let links = Runs::of_keys(self.links.len(), threads, |k| {
+            let g = self.group_of(&self.links[k])? as u64;
+            Some((g, g))
+        });
+        let runs = GroupRuns {
+            threads,
+            bodies,
+            links,
+        };
+        self.group_runs = Some(runs);
+        runs
     }
 
     /// The group a link belongs to (as the start pass numbered it), if it touches an audited

@@ -6,8 +6,8 @@ use tumble_core::math::{Real, Vec3, Widen};
 
 use super::ledger::{
     Account, Audited, AuditedBodies, AuditedSprings, End, Ends, EnergyLedger, GroupStep, Link,
-    OMEGA_DT_CAP, ROUND_OFF_ULPS, elastic_among, for_each_audited, for_each_spring, index_u32,
-    resolve_ends, zip_table,
+    NO_GROUP, OMEGA_DT_CAP, ROUND_OFF_ULPS, elastic_among, for_each_audited, for_each_spring,
+    index_u32, resolve_ends, zip_table,
 };
 use super::memo::{BodyMemo, Marks};
 use crate::components::{
@@ -15,7 +15,7 @@ use crate::components::{
     MassProps, PhysicsSettings, Pose, StepRefusals, Velocity, dense, kinetic_energy_f64, reject,
 };
 use crate::integrate::StageCursor;
-use crate::parallel::{Parallelism, in_runs};
+use crate::parallel::{Parallelism, in_runs, in_runs_of_sums};
 
 /// Start of an audited step (first in the plan): remembers each dynamic body's state, resolves
 /// the springs' ends, forms the spring groups and measures each group's `T + V`.
@@ -296,18 +296,23 @@ pub fn audit_energy(
         }
     }
     let pass = end.pass;
-    // Summed in the ledger's order (entity index order), not the query's.
-    for body in &ledger.bodies {
-        let g = &mut ledger.groups[body.group()];
-        if !body.memo.measured_by(pass) {
-            g.left = true;
-            continue;
+    // Summed in the ledger's order (entity index order), not the query's: each group on one
+    // thread.
+    let runs = ledger.group_runs(parallelism.threads_for(ledger.bodies.len()));
+    let bodies = &ledger.bodies;
+    in_runs_of_sums(&runs.bodies, &mut ledger.groups, |items, groups, first| {
+        for body in &bodies[items] {
+            let g = &mut groups[body.group() - first];
+            if !body.memo.measured_by(pass) {
+                g.left = true;
+                continue;
+            }
+            let (energy, work) = (body.memo.kinetic(), body.work);
+            g.end += energy;
+            g.work += work;
+            g.magnitude += energy + work.abs();
         }
-        let (energy, work) = (body.memo.kinetic(), body.work);
-        g.end += energy;
-        g.work += work;
-        g.magnitude += energy + work.abs();
-    }
+    });
     // A body refused in this step's last stage is still measured (its quarantine is a deferred
     // command), with the state it kept: its group has no verdict this step, as one refused in
     // an earlier stage.
@@ -418,6 +423,7 @@ impl EnergyLedger {
     /// of their roots. A root is its group's smallest index (`union` attaches to the smaller),
     /// so it is met first and its group numbered before any other member asks for it.
     fn number_groups(&mut self) {
+        self.group_runs = None;
         for i in 0..self.bodies.len() {
             let root = self.find(i);
             let group = if root == i {
@@ -479,16 +485,18 @@ impl EnergyLedger {
             }
             true
         });
-        for k in 0..self.links.len() {
-            let link = self.links[k];
-            let Some(group) = self.group_of(&link) else {
-                continue;
-            };
-            if link.measured == pass {
-                self.groups[group].end += link.elastic;
-                self.groups[group].magnitude += link.elastic;
+        // Added in spring order, each group on one thread.
+        let runs = self.group_runs(parallelism.threads_for(self.bodies.len()));
+        let links = &self.links;
+        in_runs_of_sums(&runs.links, &mut self.groups, |items, groups, first| {
+            for link in &links[items] {
+                if link.group != NO_GROUP && link.measured == pass {
+                    let g = &mut groups[link.group as usize - first];
+                    g.end += link.elastic;
+                    g.magnitude += link.elastic;
+                }
             }
-        }
+        });
     }
 
     /// After a rollback restore, moves each account to its group's key (the smallest entity of

@@ -4,12 +4,13 @@ use crate::components::{IndexOrder, IndexedQuery};
 use bevy_ecs::prelude::*;
 use tumble_core::math::{Vec3, quat_rotate};
 
-use super::targets::{ForceTargets, TargetRows, Targets};
+use super::push_blocks::{Push, PushBuffer, push_in_blocks};
+use super::targets::{ForceTargets, PushTarget, TargetRows, Targets};
 use crate::components::{
     ConstantForce, ConstantLocalForce, ConstantTorque, ForceAccumulator, Gravity, GravityScale,
     ImplicitBody, MassProps, Pose, Spring, SpringEnd, Velocity, dense,
 };
-use crate::parallel::{Parallelism, scope};
+use crate::parallel::Parallelism;
 
 /// Kinetic energy of every body with a velocity plus the elastic energy of every spring (J), in
 /// `f64`. Panics if a spring names a body without a [`Pose`].
@@ -118,7 +119,7 @@ impl ForcePush {
     /// Adds the push to `body`'s accumulator (the bits of
     /// [`ForceAccumulator::add_force_at_point`] for a force at a point).
     #[inline]
-    fn apply(self, body: Entity, targets: &mut Targets) {
+    fn apply(self, body: Entity, targets: &mut impl PushTarget) {
         match self {
             Self::Nothing => {}
             Self::Force(force) => targets.push(body, |acc| acc.add_force(force)),
@@ -130,10 +131,25 @@ impl ForcePush {
     }
 }
 
+impl<G: ForceGenerator> Push<G> for ForcePush {
+    #[inline]
+    fn bodies(&self, generator: &G) -> [Option<Entity>; 2] {
+        match self {
+            Self::Nothing => [None, None],
+            _ => [Some(generator.parts().0), None],
+        }
+    }
+
+    #[inline]
+    fn apply(self, generator: &G, targets: &mut impl PushTarget) {
+        ForcePush::apply(self, generator.parts().0, targets);
+    }
+}
+
 /// The pushes of one run of [`apply_constant_forces`] on the compute pool, kept between steps
 /// so that a step does not allocate.
 #[derive(Debug, Default)]
-pub struct ForcePushes(Vec<ForcePush>);
+pub struct ForcePushes(PushBuffer<ForcePush>);
 
 /// Applies every [`ConstantForce`] and [`ConstantLocalForce`]: its force, and the torque of a
 /// force at a body point about the centre of mass (for a body of an implicit spring group, the
@@ -206,7 +222,7 @@ impl ForceGenerator for ConstantLocalForce {
 
 /// What [`apply_constant_forces`] applies each kind of generator with.
 struct ForceKind<'p, 'a, 'w, 's> {
-    pushes: &'p mut Vec<ForcePush>,
+    pushes: &'p mut PushBuffer<ForcePush>,
     targets: &'p mut Targets<'a, 'w, 's>,
     any_implicit: bool,
 }
@@ -233,7 +249,6 @@ impl ForceKind<'_, '_, '_, '_> {
                         let (body, force, point) = g.parts();
                         ForcePush::of(body, force, G::IN_BODY_FRAME, point, targets)
                     },
-                    |g, push, targets| push.apply(g.parts().0, targets),
                 );
             }
         } else {
@@ -407,7 +422,7 @@ impl SpringPush {
 
     /// Adds the push to the accumulators of `spring`'s bodies.
     #[inline]
-    fn apply(self, spring: &Spring, targets: &mut Targets) {
+    fn apply(self, spring: &Spring, targets: &mut impl PushTarget) {
         match self {
             Self::Nothing => {}
             Self::OnA { f, pa, com_a } => {
@@ -428,15 +443,26 @@ impl SpringPush {
     }
 }
 
-/// Springs (or forces) whose pushes [`apply_springs`] ([`apply_constant_forces`]) computes on
-/// the pool at once, then adds in order: the buffer stays a few megabytes however many there
-/// are, and a block is long enough that handing it out costs little beside its work.
-const PUSH_BLOCK: usize = 1 << 15;
+impl Push<Spring> for SpringPush {
+    #[inline]
+    fn bodies(&self, spring: &Spring) -> [Option<Entity>; 2] {
+        match *self {
+            Self::Nothing => [None, None],
+            Self::OnA { .. } => [Some(spring.a), None],
+            Self::OnBoth { b, .. } => [Some(spring.a), Some(b)],
+        }
+    }
+
+    #[inline]
+    fn apply(self, spring: &Spring, targets: &mut impl PushTarget) {
+        SpringPush::apply(self, spring, targets);
+    }
+}
 
 /// The springs' pushes of one run of [`apply_springs`] on the compute pool, kept between steps
 /// so that a step does not allocate.
 #[derive(Debug, Default)]
-pub struct SpringPushes(Vec<SpringPush>);
+pub struct SpringPushes(PushBuffer<SpringPush>);
 
 /// Applies every [`Spring`]'s elastic force, for the springs stepped explicitly (the implicit
 /// step of [`crate::springs`] handles the others; every damper is [`crate::springs`]'s).
@@ -466,14 +492,7 @@ pub fn apply_springs(
         return;
     }
     for (_, table) in dense(springs.contiguous_iter()) {
-        push_in_blocks(
-            table,
-            threads,
-            &mut pushes.0,
-            &mut targets,
-            SpringPush::of,
-            |spring, push, targets| push.apply(spring, targets),
-        );
+        push_in_blocks(table, threads, &mut pushes.0, &mut targets, SpringPush::of);
     }
 }
 
@@ -492,38 +511,5 @@ fn push_threads(
         Targets::Tables { .. } => parallelism.threads_for(count),
         // The query's own lookups are not shared between threads.
         Targets::Query(_) => 1,
-    }
-}
-
-/// Computes `of(item, targets)` for every item of `table` on `threads` threads of the compute
-/// pool, [`PUSH_BLOCK`] items at a time into `pushes`, then hands each item and its push to
-/// `apply` on this thread, in table order: the work that only reads the bodies runs at once,
-/// the additions to the accumulators in one fixed order, so the sums are the same bits on any
-/// number of threads.
-fn push_in_blocks<T: Sync, P: Copy + Default + Send + Sync>(
-    table: &[T],
-    threads: usize,
-    pushes: &mut Vec<P>,
-    targets: &mut Targets,
-    of: impl Fn(&T, &Targets) -> P + Sync,
-    mut apply: impl FnMut(&T, P, &mut Targets),
-) {
-    for block in table.chunks(PUSH_BLOCK) {
-        pushes.clear();
-        pushes.resize(block.len(), P::default());
-        let per = block.len().div_ceil(threads).max(1);
-        let (shared, of) = (&*targets, &of);
-        scope(|spawn| {
-            for (items, out) in block.chunks(per).zip(pushes.chunks_mut(per)) {
-                spawn(Box::new(move || {
-                    for (item, push) in items.iter().zip(out) {
-                        *push = of(item, shared);
-                    }
-                }));
-            }
-        });
-        for (item, push) in block.iter().zip(pushes.iter()) {
-            apply(item, *push, targets);
-        }
     }
 }

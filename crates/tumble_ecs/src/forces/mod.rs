@@ -34,6 +34,7 @@
 
 mod apply;
 mod body_forces;
+mod push_blocks;
 mod targets;
 
 pub use apply::{apply_constant_forces, apply_constant_torques, apply_gravity, apply_springs};

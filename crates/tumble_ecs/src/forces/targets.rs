@@ -17,6 +17,7 @@ use bevy_ecs::prelude::*;
 use crate::components::Rejected;
 use crate::components::dense;
 use crate::components::{ForceAccumulator, MassProps, Pose, RigidBody, Velocity};
+use crate::parallel::MAX_RUNS;
 
 /// The bodies force generators write to: valid rigid bodies (with a velocity) that have an
 /// accumulator.
@@ -40,6 +41,11 @@ const MAX_TABLES: usize = 16;
 /// finds. Grows with the world, never per step.
 #[derive(Debug, Default)]
 pub struct TargetRows(Vec<(u32, u32)>);
+
+/// Where a target sits, as one ordered number: its table in the high half, its row in the low
+/// (see [`Targets::key`]). Pushes whose targets' keys fall in disjoint ranges write disjoint
+/// rows, so they can be added on different threads ([`Targets::shares`]).
+pub(crate) type TargetKey = u64;
 
 /// One table of targets as column slices.
 pub(crate) struct TargetTable<'a> {
@@ -127,6 +133,67 @@ impl<'a, 'w, 's> Targets<'a, 'w, 's> {
         }
     }
 
+    /// The key of target `entity` (`None` where it is not one, or where the targets are the
+    /// query's: those have no rows to share).
+    #[inline]
+    pub(crate) fn key(&self, entity: Entity) -> Option<TargetKey> {
+        let Targets::Tables { tables, rows } = self else {
+            return None;
+        };
+        let (t, row) = Self::slot(rows, entity)?;
+        let table = tables.get(t)?.as_ref()?;
+        table
+            .holds(row, entity)
+            .then_some(((t as u64) << 32) | row as u64)
+    }
+
+    /// The accumulators cut into consecutive shares at `bounds` (increasing keys, at most
+    /// [`MAX_RUNS`]` − 1`): share `k` holds the targets with keys from `bounds[k − 1]` (the
+    /// first: from 0) up to `bounds[k]` (the last: every key after), the rows of each table
+    /// that hold them, and pushes to nothing else. `None` for the query's targets.
+    pub(crate) fn shares(
+        &mut self,
+        bounds: &[TargetKey],
+    ) -> Option<[Option<TargetShare<'_>>; MAX_RUNS]> {
+        let Targets::Tables { tables, rows } = self else {
+            return None;
+        };
+        assert!(bounds.len() < MAX_RUNS, "at most MAX_RUNS shares");
+        let rows: &[(u32, u32)] = rows;
+        let mut shares: [Option<TargetShare<'_>>; MAX_RUNS] = std::array::from_fn(|k| {
+            (k <= bounds.len()).then(|| TargetShare {
+                rows,
+                tables: std::array::from_fn(|_| None),
+            })
+        });
+        for (t, table) in tables.iter_mut().enumerate() {
+            let Some(table) = table else { continue };
+            let entities = table.entities;
+            let mut rest: &mut [ForceAccumulator] = &mut *table.accumulators;
+            let mut first_row = 0;
+            for (k, share) in shares.iter_mut().flatten().enumerate() {
+                // The rows of table `t` below the next share's first key.
+                let end = bounds.get(k).map_or(entities.len(), |&bound| {
+                    match (bound >> 32).cmp(&(t as u64)) {
+                        std::cmp::Ordering::Less => 0,
+                        std::cmp::Ordering::Equal => (bound as u32 as usize).min(entities.len()),
+                        std::cmp::Ordering::Greater => entities.len(),
+                    }
+                });
+                let (mine, after) =
+                    std::mem::take(&mut rest).split_at_mut(end.max(first_row) - first_row);
+                share.tables[t] = Some(ShareTable {
+                    entities,
+                    first_row,
+                    accumulators: mine,
+                });
+                first_row = end.max(first_row);
+                rest = after;
+            }
+        }
+        Some(shares)
+    }
+
     /// Applies `add` to the accumulator of target `entity` (nothing if it is not a target).
     #[inline]
     pub(crate) fn push(&mut self, entity: Entity, add: impl FnOnce(&mut ForceAccumulator)) {
@@ -143,6 +210,52 @@ impl<'a, 'w, 's> Targets<'a, 'w, 's> {
                 if let Ok((_, _, _, mut acc)) = query.get_mut(entity) {
                     add(&mut acc);
                 }
+            }
+        }
+    }
+}
+
+/// What force pushes are added to: every target ([`Targets`]) or one thread's share of them
+/// ([`TargetShare`]).
+pub(crate) trait PushTarget {
+    /// Applies `add` to the accumulator of target `entity` (nothing if it is not a target).
+    fn push(&mut self, entity: Entity, add: impl FnOnce(&mut ForceAccumulator));
+}
+
+impl PushTarget for Targets<'_, '_, '_> {
+    #[inline]
+    fn push(&mut self, entity: Entity, add: impl FnOnce(&mut ForceAccumulator)) {
+        Targets::push(self, entity, add);
+    }
+}
+
+/// One thread's share of the targets' accumulators ([`Targets::shares`]).
+pub(crate) struct TargetShare<'a> {
+    rows: &'a [(u32, u32)],
+    tables: [Option<ShareTable<'a>>; MAX_TABLES],
+}
+
+/// The rows of one table a [`TargetShare`] holds: `accumulators[k]` is row `first_row + k`.
+struct ShareTable<'a> {
+    entities: &'a [Entity],
+    first_row: usize,
+    accumulators: &'a mut [ForceAccumulator],
+}
+
+impl PushTarget for TargetShare<'_> {
+    #[inline]
+    fn push(&mut self, entity: Entity, add: impl FnOnce(&mut ForceAccumulator)) {
+        if let Some((t, row)) = Targets::slot(self.rows, entity)
+            && let Some(Some(table)) = self.tables.get_mut(t)
+            && table.entities.get(row) == Some(&entity)
+        {
+            let at = row.wrapping_sub(table.first_row);
+            debug_assert!(
+                at < table.accumulators.len(),
+                "a push outside its share: the shares were cut between pushes to one body"
+            );
+            if let Some(acc) = table.accumulators.get_mut(at) {
+                add(acc);
             }
         }
     }

@@ -6,6 +6,10 @@
 //! debug assertion when it hands out part of a table.) Every body is stepped by the same code whichever batch or thread it
 //! lands in, so the results are bit-identical for any thread count (tested).
 
+mod cuts;
+
+pub(crate) use cuts::{MAX_RUNS, Runs, in_runs_of_sums};
+
 use bevy_ecs::prelude::*;
 
 /// Threading policy of the physics systems. Optional resource: without it the defaults apply.
