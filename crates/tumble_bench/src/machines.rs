@@ -100,7 +100,12 @@ pub fn read_runs(dir: &Path) -> Result<Vec<(String, RunSummary)>, SummaryError> 
         move |source| SummaryError::Io { path, source }
     };
     let mut files: Vec<PathBuf> = Vec::new();
-    for entry in std::fs::read_dir(dir).map_err(io(dir))? {
+    let entries = match std::fs::read_dir(dir) {
+        // A directory still to be made keeps no runs (it is made when the files go in).
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
+        entries => entries.map_err(io(dir))?,
+    };
+    for entry in entries {
         let path = entry.map_err(io(dir))?.path();
         let is_run = path.extension().is_some_and(|e| e == "json")
             && path

@@ -96,17 +96,20 @@ pub(crate) fn run(scene: &Scene, settings: Settings) -> Result<(), Failure> {
         "exact Δx tumble/rapier",
         "exact angle t/r"
     );
-    let pair =
-        |p: Option<(f64, f64)>| p.map_or("—".to_owned(), |(t, r)| format!("{t:.2e} / {r:.2e}"));
+    let pair = |p: Option<(f64, f64)>| {
+        p.map_or("—".to_owned(), |(t, r)| {
+            format!("{} / {}", difference(t, 2), difference(r, 2))
+        })
+    };
     for d in &result.bodies {
         let _ = writeln!(
             out,
-            "{:<16} {:>11.3e} {:>12.3e} {:>11.3e} {:>11.3e} {:>21} {:>21}",
+            "{:<16} {:>11} {:>12} {:>11} {:>11} {:>21} {:>21}",
             d.name,
-            d.position,
-            d.angle,
-            d.linear_velocity,
-            d.angular_velocity,
+            difference(d.position, 3),
+            difference(d.angle, 3),
+            difference(d.linear_velocity, 3),
+            difference(d.angular_velocity, 3),
             pair(d.exact_position),
             pair(d.exact_angle)
         );
@@ -201,6 +204,20 @@ impl<'a> ExactSolutions<'a> {
     }
 }
 
+/// A difference for the table, with `digits` after the point: `overflow` where it is past the
+/// largest number (two states that are each finite can differ by more), `not finite` where a
+/// state was not, never a bare `inf` or `NaN`.
+fn difference(x: impl Into<f64>, digits: usize) -> String {
+    let x: f64 = x.into();
+    if x.is_finite() {
+        format!("{x:.digits$e}")
+    } else if x.is_infinite() {
+        "overflow".to_owned()
+    } else {
+        "not finite".to_owned()
+    }
+}
+
 /// Names the bodies that did not run cleanly in either engine; an error if any did not.
 fn report_unclean(result: &Comparison) -> Result<(), Failure> {
     let unclean: Vec<_> = result.bodies.iter().filter(|d| !d.is_clean()).collect();
@@ -213,7 +230,7 @@ fn report_unclean(result: &Comparison) -> Result<(), Failure> {
             tracing::error!(target: "tumble", "body `{name}`: rapier quarantined it at step {step} (its state went non-finite; rapier froze it); its differences after that step compare a frozen state");
         }
         if let Some(step) = d.non_finite_at {
-            tracing::error!(target: "tumble", "body `{name}`: a state went non-finite at step {step} (NaN in the table)");
+            tracing::error!(target: "tumble", "body `{name}`: a state went non-finite at step {step} (`not finite` in the table)");
         }
     }
     if !unclean.is_empty() {

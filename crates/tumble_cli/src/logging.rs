@@ -40,6 +40,15 @@ pub(crate) fn init(verbose: u8, quiet: bool) -> Result<(), Failure> {
                     ),
                 )
             })?,
+        Err(std::env::VarError::NotUnicode(directives)) => {
+            return Err(Failure::new(
+                exit::ERROR,
+                format!(
+                    "RUST_LOG `{}` is not a log filter: not valid Unicode",
+                    terminal_safe(&directives.to_string_lossy())
+                ),
+            ));
+        }
         // The CLI names bodies and springs as the scene does when it reports predictions and
         // quarantines (target `tumble`); the engine's own events say the same with entity ids,
         // so by default they are kept to errors. `RUST_LOG` shows them.

@@ -156,6 +156,20 @@ fn warnings_reach_stderr_and_follow_rust_log_and_the_flags() {
         "{line}"
     );
     assert!(!stderr(&bad).contains('\u{1b}') && !stderr(&bad).contains('\u{202e}'));
+    // Bytes that are not UTF-8 are no filter either (they were ignored without a word).
+    #[cfg(unix)]
+    {
+        use std::os::unix::ffi::OsStrExt;
+        let bytes = std::ffi::OsStr::from_bytes(b"\xff\xfe=trace");
+        let bad = tumble()
+            .args(&args)
+            .env("RUST_LOG", bytes)
+            .output()
+            .unwrap();
+        let line = failure(&bad, 1);
+        assert!(line.starts_with("error: RUST_LOG `"), "{line}");
+        assert!(line.contains("not valid Unicode"), "{line}");
+    }
     // -vv lowers the level: the warnings stay; -q and -v together are a usage error.
     let verbose = tumble().arg("-vv").args(&args).output().unwrap();
     assert!(stderr(&verbose).contains("WARN"));
@@ -302,6 +316,30 @@ fn compare_from_zero_energy_prints_no_nan() {
         .unwrap();
     assert!(energy.contains("from 0"), "{energy}");
     assert!(!text.contains("NaN") && !text.contains("inf"), "{text}");
+}
+
+/// A spring anchored far outside the body overflows the bodies' states: the table names the
+/// differences it cannot give (`overflow`, `not finite`) rather than printing `inf`, and the
+/// run is an error naming the bodies.
+#[test]
+fn compare_names_differences_past_the_largest_number() {
+    let scene = "name = \"far\"\n[world]\ndt = 0.01\nsteps = 50\n\
+                 [[bodies]]\nname = \"a\"\nmass = 1.0\ninertia = [1.0, 1.0, 1.0]\n\
+                 [[bodies]]\nname = \"b\"\nmass = 1.0\ninertia = [1.0, 1.0, 1.0]\n\
+                 position = [1.0, 0.0, 0.0]\n\
+                 [[forces]]\ntype = \"spring\"\na = \"a\"\nb = \"b\"\nstiffness = 10.0\n\
+                 anchor_a = [1e38, 0.0, 0.0]\n";
+    let (_dir, path) = scratch_file("far.toml", scene);
+    let output = tumble_run(&["compare", path.to_str().unwrap()]);
+    let text = String::from_utf8_lossy(&output.stdout);
+    assert!(!text.contains("NaN") && !text.contains("inf"), "{text}");
+    assert!(
+        text.lines()
+            .filter(|l| l.starts_with("a ") || l.starts_with("b "))
+            .all(|l| l.contains("overflow") || l.contains("not finite") || !l.contains('e')),
+        "{text}"
+    );
+    assert_eq!(output.status.code(), Some(3), "{}", stderr(&output));
 }
 
 #[cfg(target_os = "linux")]

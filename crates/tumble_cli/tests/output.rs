@@ -631,6 +631,16 @@ fn report_and_bench_refuse_an_unwritable_destination_before_working() {
             vec!["--readme".into(), readme.clone().into()],
             format!("error: {}: no <!-- frame-budget:begin", readme.display()),
         ),
+        (
+            "bench",
+            vec![
+                "--out".into(),
+                fresh.join("a/b/c").into(),
+                "--readme".into(),
+                readme.clone().into(),
+            ],
+            format!("error: {}: no <!-- frame-budget:begin", readme.display()),
+        ),
     ];
     for (command, args, expected) in cases {
         let mut child = tumble()
@@ -664,6 +674,63 @@ fn report_and_bench_refuse_an_unwritable_destination_before_working() {
         "no markers here\n"
     );
     assert_eq!(listing(&read_only), ["bench-targets.md", "report.md"]);
+    // The missing directories were checked, not made: a refused run leaves none behind.
+    assert!(!fresh.exists(), "a refused run made {}", fresh.display());
+}
+
+/// A link planted by another user in a shared sticky directory is not followed on the way to
+/// the output either (`sticky/theirs/out.csv`, `theirs` a link to a directory): the kernel
+/// follows such links itself, and guards them only where the system enables
+/// `protected_symlinks`. Root only (giving a link away); elsewhere the test says so and skips.
+#[cfg(unix)]
+#[test]
+fn a_directory_link_planted_in_a_sticky_directory_is_not_followed() {
+    use std::os::unix::fs::{MetadataExt, PermissionsExt, lchown, symlink};
+
+    let dir = scratch_dir();
+    let sticky = dir.path().join("sticky");
+    std::fs::create_dir(&sticky).unwrap();
+    std::fs::set_permissions(&sticky, std::fs::Permissions::from_mode(0o1777)).unwrap();
+    let elsewhere = dir.path().join("elsewhere");
+    std::fs::create_dir(&elsewhere).unwrap();
+    let link = sticky.join("theirs");
+    symlink(&elsewhere, &link).unwrap();
+    let me = std::fs::symlink_metadata(&link).unwrap().uid();
+    let other = if me == 65534 { 65533 } else { 65534 };
+    if lchown(&link, Some(other), None).is_err() {
+        eprintln!("skipped: giving the link to another user needs root");
+        return;
+    }
+    // Through the link as a directory, and again behind a `..` and a second, trusted link.
+    let mine = dir.path().join("mine");
+    symlink("sticky/theirs", &mine).unwrap();
+    for out in [
+        link.join("out.csv"),
+        mine.join("../elsewhere/../sticky/theirs/out.csv"),
+    ] {
+        for command in [
+            &["run", "projectile", "--out"][..],
+            &["gen", "many", "--out"],
+        ] {
+            let output = tumble().args(command).arg(&out).output().unwrap();
+            let line = failure(&output, 1);
+            assert!(
+                line.contains("belongs to another user"),
+                "{command:?} {out:?}: {line}"
+            );
+            assert!(listing(&elsewhere).is_empty(), "{command:?} {out:?}");
+        }
+    }
+    // The caller's own link there is followed.
+    lchown(&link, Some(me), None).unwrap();
+    let status = tumble()
+        .args(["run", "projectile", "--out"])
+        .arg(link.join("out.csv"))
+        .stdout(Stdio::null())
+        .status()
+        .unwrap();
+    assert!(status.success());
+    assert_eq!(listing(&elsewhere), ["out.csv"]);
 }
 
 /// Memory exhausted under a limit (`ulimit -v`) is one `error:` line and exit code 1, not an

@@ -45,6 +45,16 @@ pub enum InvalidInput {
     /// The time step must be strictly positive and finite.
     #[error("time step must be > 0 and finite, got {}", compact(*.0))]
     NonPositiveTimeStep(Real),
+    /// A positive time step too small or too large for the build precision ([`Real`]) to
+    /// step: see [`check_time_step`].
+    #[error(
+        "time step {} s cannot be stepped in {REAL_NAME}: the parts of a step, from a third of \
+         it to 1.7 times it, must be normal, finite numbers; expected a value between {} and {}",
+        compact(*.0),
+        compact(TIME_STEP_RANGE.0),
+        compact(TIME_STEP_RANGE.1)
+    )]
+    TimeStepOutOfRange(Real),
     /// A mass or principal moment whose reciprocal is not a finite, normal number in the build
     /// precision ([`Real`]): the engine stores `1/m` and `1/I`, so such a body would be
     /// quarantined at its first step (or move with a garbage inverse).
@@ -140,12 +150,23 @@ pub fn check_unit_quat(field: &'static str, q: Quat) -> Result<(), InvalidInput>
     Ok(())
 }
 
-/// Checks that a time step is strictly positive and finite.
+/// The time steps every integrator can step, `[8 MIN_POSITIVE, MAX / 4]` of [`Real`]: a step
+/// takes stages of up to `1.71 Δt` in size (the middle stage of `yoshida4`, negative) and
+/// parts of stages down to `0.34 Δt` (a drift of half an outer stage of `yoshida4`, `1.35 Δt`,
+/// is `0.68 Δt`, and a splitting's half-flows halve that), and each must be a normal, finite
+/// number: a part that underflows to zero (or to a subnormal, most of its digits gone) leaves
+/// a body where it was while its velocity says it moves, and a stage that overflows sends every
+/// moving body to infinity. The range keeps a factor of two beyond both.
+pub const TIME_STEP_RANGE: (Real, Real) = (8.0 * Real::MIN_POSITIVE, Real::MAX / 4.0);
+
+/// Checks that a time step is strictly positive and finite, and within [`TIME_STEP_RANGE`].
 pub fn check_time_step(dt: Real) -> Result<(), InvalidInput> {
-    if dt.is_finite() && dt > 0.0 {
-        Ok(())
-    } else {
+    if !(dt.is_finite() && dt > 0.0) {
         Err(InvalidInput::NonPositiveTimeStep(dt))
+    } else if !(TIME_STEP_RANGE.0..=TIME_STEP_RANGE.1).contains(&dt) {
+        Err(InvalidInput::TimeStepOutOfRange(dt))
+    } else {
+        Ok(())
     }
 }
 

@@ -177,6 +177,55 @@ fn the_planner_picks_the_spring_method_and_can_be_overridden() {
 /// `n` springs to world points, each soft on its own (`√(k/m)Δt = 0.2`, below the 0.3 threshold),
 /// moves at `√n` times that along their common axis. The planner counts a body's springs
 /// together: one spring stays explicit, eight make the group implicit.
+/// A spring too stiff for the precision (`k/μ` past its largest number on light bodies) is
+/// still predicted, from `f64`, and its warning gives a number, never `inf`.
+#[test]
+fn a_spring_past_the_precision_is_predicted_with_a_number() {
+    let mut world = World::new();
+    world.insert_resource(PhysicsSettings::default().with_springs(SpringSolver::Explicit));
+    let tiny = Real::MIN_POSITIVE * 16.0;
+    let mass = MassProperties::new(Mass::new(tiny).unwrap(), Vec3::splat(1.0)).unwrap();
+    let spawn = |world: &mut World, x: Real| {
+        world
+            .spawn((
+                RigidBody,
+                MassProps(mass),
+                Pose::from_translation(Vec3::new(x, 0.0, 0.0)),
+                Velocity::default(),
+            ))
+            .id()
+    };
+    let (a, b) = (spawn(&mut world, 0.0), spawn(&mut world, 1.0));
+    let stiffness = Real::MAX / 2.0;
+    world.spawn(Spring::new(
+        a,
+        Vec3::ZERO,
+        SpringEnd::on_body(b, Vec3::ZERO),
+        stiffness,
+        1.0,
+    ));
+    let warnings = check_stability(&mut world);
+    let stiff = warnings
+        .iter()
+        .find(|w| matches!(w, StabilityWarning::StiffSpring { .. }))
+        .expect("predicted");
+    let text = stiff.to_string();
+    assert!(!text.contains("inf") && !text.contains("NaN"), "{text}");
+    if tumble_core::math::DOUBLE_PRECISION {
+        // `k/μ` past even f64's largest number.
+        assert!(text.contains("or more"), "{text}");
+    } else {
+        // √(k/μ)Δt ≈ 7.1e35 (in f32, `k/μ` alone overflowed): a short number, not 36 digits.
+        assert!(text.contains("= 7.089e35 ≥"), "{text}");
+    }
+    // A step so long that even that product passes the precision's largest number says so.
+    let past = StabilityWarning::StiffSpring {
+        spring: Entity::PLACEHOLDER,
+        omega_dt: Real::MAX,
+    };
+    assert!(past.to_string().contains("or more"), "{past}");
+}
+
 #[test]
 fn the_planner_counts_every_spring_on_a_body() {
     let implicit_with = |n: usize| {

@@ -86,6 +86,22 @@ impl SceneSyntax {
     }
 }
 
+/// The dotted path of the table a missing field is missing from (`toml` for the top level),
+/// by a parse that tracks the path; `None` if that parse does not fail the same way.
+fn missing_field_table(text: &str) -> Option<String> {
+    let de = toml::Deserializer::parse(text).ok()?;
+    let err = serde_path_to_error::deserialize::<_, SceneFile>(de).err()?;
+    if !err.inner().message().starts_with("missing field") {
+        return None;
+    }
+    let path = err.path().to_string();
+    Some(if path.is_empty() || path == "." {
+        "toml".to_owned()
+    } else {
+        path
+    })
+}
+
 impl Scene {
     /// Parses and validates scene text; `file` names it in errors.
     pub fn parse(file: &str, text: &str) -> Result<Self, SceneError> {
@@ -128,6 +144,15 @@ impl Scene {
                         .filter(|k| !k.is_empty() && !k.starts_with('['))
                 })
                 .unwrap_or_else(|| "toml".to_owned());
+            // A missing field is reported with the span of the table that lacks it, which
+            // for the top level is the whole file: no key holds it, and the first key at its
+            // start (`[world]`) is not the one to blame. The table's path comes from a second
+            // parse that tracks it, on this error path only.
+            let field = if e.message().starts_with("missing field") {
+                missing_field_table(text).unwrap_or(field)
+            } else {
+                field
+            };
             SceneError::at(file, line, field, message)
         })?;
         Self::validate(file, &TomlText(text), parsed)

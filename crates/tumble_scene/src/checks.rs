@@ -98,6 +98,23 @@ pub(crate) fn validate_world(ck: &Checker<'_>, w: &WorldDef) -> Result<CheckedWo
         .with_springs(springs)
         .with_substeps(substeps)
         .with_free_flow(free_flow);
+    // Substeps divide the step: each must be a step the precision can take too.
+    let substep = dt / substeps.get() as Real;
+    if substeps.get() > 1 && tumble_core::error::check_time_step(substep).is_err() {
+        return Err(ck.error(
+            "world",
+            None,
+            "substeps",
+            format!(
+                "{substeps} substeps of a {} s step are {} s each, too short to step in {}: \
+                 expected at least {} s a substep",
+                compact(dt),
+                compact(substep),
+                REAL_NAME,
+                compact(tumble_core::error::TIME_STEP_RANGE.0)
+            ),
+        ));
+    }
     let gravity = w
         .gravity
         .map(|g| ck.vec3("world", None, "gravity", g))

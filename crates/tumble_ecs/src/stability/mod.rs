@@ -75,7 +75,7 @@
 use bevy_ecs::prelude::*;
 use tumble_core::Integrator;
 use tumble_core::integrate::{ExactSwitch, FreeFlow};
-use tumble_core::math::{Real, Vec3, Widen};
+use tumble_core::math::{Narrow, Real, Vec3, Widen};
 
 use crate::components::{
     Gravity, GravityScale, Kinematic, MassProps, PhysicsSettings, Pose, RigidBody, Static,
@@ -200,6 +200,23 @@ fn check_springs(world: &mut World, dt: Real, warnings: &mut Vec<StabilityWarnin
             (None, _) => continue,
         };
         let omega_dt = (spring.stiffness / reduced).sqrt() * dt;
+        // As the step's precision computes it (at the limit itself, the bits decide); where
+        // that is not a number (`k/μ` past the precision's largest number, or `μ` rounded to
+        // 0), from `f64`, capped at that number.
+        let omega_dt = if omega_dt.is_finite() {
+            omega_dt
+        } else {
+            let reduced = match spring.b {
+                SpringEnd::World(_) => mass_of(spring.a).map(Widen::widen),
+                SpringEnd::Body { body, .. } => mass_of(spring.a)
+                    .zip(mass_of(body))
+                    .map(|(a, b)| a.widen() * b.widen() / (a.widen() + b.widen())),
+            };
+            let wide = reduced.map_or(f64::INFINITY, |m| {
+                (spring.stiffness.widen() / m).sqrt() * dt.widen()
+            });
+            wide.min(Real::MAX.widen()).narrow()
+        };
         if omega_dt >= SPRING_LIMIT {
             warnings.push(StabilityWarning::StiffSpring {
                 spring: entity,

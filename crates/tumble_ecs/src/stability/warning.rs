@@ -170,9 +170,16 @@ impl std::fmt::Display for StabilityWarning {
         match *self {
             StabilityWarning::StiffSpring { spring, omega_dt } => write!(
                 f,
-                "spring {spring}: √(k/μ)Δt = {omega_dt:.3} ≥ {SPRING_LIMIT}, outside the stable \
+                "spring {spring}: √(k/μ)Δt = {} ≥ {SPRING_LIMIT}, outside the stable \
                  region of the explicit spring step; use the implicit one (springs = `auto` or \
-                 `implicit`), or lower the stiffness or the time step"
+                 `implicit`), or lower the stiffness or the time step",
+                if omega_dt >= Real::MAX {
+                    format!("{} or more", tumble_core::error::compact(Real::MAX))
+                } else if omega_dt < 1e6 {
+                    format!("{omega_dt:.3}")
+                } else {
+                    format!("{omega_dt:.3e}")
+                }
             ),
             StabilityWarning::ExplicitGyroscopic {
                 body,

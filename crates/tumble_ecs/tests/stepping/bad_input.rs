@@ -287,6 +287,29 @@ fn bad_time_steps_are_rejected() {
     }
 }
 
+/// A positive step whose parts would underflow (a subnormal `Δt`: half a step rounds to
+/// nothing) or whose stages would overflow is refused too; the range's ends are accepted.
+#[test]
+fn time_steps_the_precision_cannot_take_are_rejected() {
+    let (min, max) = tumble_core::error::TIME_STEP_RANGE;
+    for dt in [Real::MIN_POSITIVE, min * 0.99, max * 1.01, Real::MAX] {
+        let err = PhysicsSettings::new(dt, Integrator::Yoshida4).unwrap_err();
+        assert!(
+            matches!(err, tumble_core::InvalidInput::TimeStepOutOfRange(_)),
+            "{dt}: {err}"
+        );
+    }
+    for dt in [min, max] {
+        let settings = PhysicsSettings::new(dt, Integrator::Yoshida4).unwrap();
+        // Every stage, and half of it, is a normal, finite number.
+        for span in settings.stages().spans(dt) {
+            for part in [span.h, 0.5 * span.h, 0.25 * span.h] {
+                assert!(part.is_normal(), "{dt}: a part {part} of a stage");
+            }
+        }
+    }
+}
+
 #[test]
 fn bad_mass_data_cannot_be_constructed() {
     use tumble_core::InvalidInput;

@@ -13,8 +13,8 @@ use std::path::Path;
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicU64, Ordering};
 
-/// The paths of the live temporary files, by registration number.
-static LIVE: Mutex<Vec<(u64, CString)>> = Mutex::new(Vec::new());
+/// The paths of the live temporary files and directories (`true`), by registration number.
+static LIVE: Mutex<Vec<(u64, CString, bool)>> = Mutex::new(Vec::new());
 static NEXT: AtomicU64 = AtomicU64::new(0);
 
 /// A registered temporary file; dropping it deregisters the path.
@@ -25,12 +25,21 @@ impl LiveTemporary {
     /// Registers `path` (a path that cannot be a C string, with a NUL byte, is not registered:
     /// no file can have it).
     pub(crate) fn register(path: &Path) -> Self {
+        Self::register_as(path, false)
+    }
+
+    /// Registers a directory made for outputs: removed at such an exit if it is empty then.
+    pub(crate) fn register_directory(path: &Path) -> Self {
+        Self::register_as(path, true)
+    }
+
+    fn register_as(path: &Path, directory: bool) -> Self {
         let Ok(c_path) = CString::new(path.as_os_str().as_encoded_bytes()) else {
             return Self(None);
         };
         let id = NEXT.fetch_add(1, Ordering::Relaxed);
         if let Ok(mut live) = LIVE.lock() {
-            live.push((id, c_path));
+            live.push((id, c_path, directory));
         }
         Self(Some(id))
     }
@@ -41,26 +50,31 @@ impl Drop for LiveTemporary {
         if let Some(id) = self.0
             && let Ok(mut live) = LIVE.lock()
         {
-            live.retain(|(i, _)| *i != id);
+            live.retain(|(i, _, _)| *i != id);
         }
     }
 }
 
-/// Unlinks every temporary file still registered, allocating nothing, for an exit that will not
-/// run destructors. Does nothing if the registry is busy (an exit from inside a registration):
-/// waiting there could wait forever.
+/// Unlinks every temporary file still registered, then removes every registered directory
+/// that is empty then (the newest first: a directory's files and subdirectories were made
+/// after it), allocating nothing, for an exit that will not run destructors. Does nothing if
+/// the registry is busy (an exit from inside a registration): waiting there could wait forever.
 pub fn remove_live_temporary_files() {
     let Ok(mut live) = LIVE.try_lock() else {
         return;
     };
-    for (_, path) in live.iter() {
+    for (_, path, directory) in live.iter().rev() {
         #[cfg(unix)]
         {
-            let _ = rustix::fs::unlink(path.as_c_str());
+            let _ = if *directory {
+                rustix::fs::rmdir(path.as_c_str())
+            } else {
+                rustix::fs::unlink(path.as_c_str())
+            };
         }
         #[cfg(not(unix))]
         {
-            let _ = path;
+            let _ = (path, directory);
         }
     }
     live.clear();
@@ -71,7 +85,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn live_files_are_removed_and_finished_ones_left() {
+    fn live_files_and_empty_made_directories_are_removed_and_finished_ones_left() {
         let dir = tempfile::tempdir().unwrap();
         let (kept, left) = (dir.path().join("kept"), dir.path().join("left"));
         std::fs::write(&kept, "a").unwrap();
@@ -79,8 +93,28 @@ mod tests {
         let finished = LiveTemporary::register(&kept);
         drop(finished);
         let _live = LiveTemporary::register(&left);
+        // Directories made for outputs go when empty once the files are gone; one holding
+        // anything else stays. (One test calls the removal: it empties the whole registry.)
+        let (empty, full) = (dir.path().join("empty"), dir.path().join("full"));
+        let inner = empty.join("inner");
+        std::fs::create_dir_all(&inner).unwrap();
+        std::fs::create_dir(&full).unwrap();
+        let temporary = inner.join(".t");
+        std::fs::write(&temporary, "x").unwrap();
+        std::fs::write(full.join("kept"), "y").unwrap();
+        let _made = [
+            LiveTemporary::register_directory(&empty),
+            LiveTemporary::register_directory(&inner),
+            LiveTemporary::register(&temporary),
+            LiveTemporary::register_directory(&full),
+        ];
         remove_live_temporary_files();
         assert!(kept.exists());
         assert!(!left.exists());
+        assert!(!empty.exists(), "its file and subdirectory went first");
+        assert!(
+            full.join("kept").exists(),
+            "a directory with other files stays"
+        );
     }
 }

@@ -16,7 +16,9 @@
 //!   directory (world-writable with the sticky bit, as `/tmp`) is followed only if it belongs to
 //!   the user running tumble or to the directory's owner — the kernel's `protected_symlinks`
 //!   rule, which cannot apply here since tumble reads the link itself: otherwise another user
-//!   could plant a link there and make a run (as root, say) replace any file;
+//!   could plant a link there and make a run (as root, say) replace any file. The same holds
+//!   for every link in the directories on the way (`/tmp/theirs/out.csv`), which the kernel
+//!   follows itself but guards only where the system enables the rule;
 //! - an existing file without write permission is refused, as a shell redirect would refuse it
 //!   (also for root, who could write it: read-only is taken as the owner's intent);
 //! - an existing file keeps its permission bits (and its owner and group where the process may
@@ -354,11 +356,13 @@ fn without_temp_path(e: io::Error) -> io::Error {
 }
 
 /// `path` with the symbolic links of its last component followed; links in the directories
-/// above are left to the operating system (they lead the temporary file and the rename to the
-/// same directory).
+/// above are left to the operating system to follow (they lead the temporary file and the
+/// rename to the same directory), after [`check_directory_links`] has checked them.
 fn resolve_links(path: &Path) -> Result<PathBuf, OutputError> {
     let mut current = path.to_path_buf();
     for _ in 0..=MAX_SYMLINKS {
+        #[cfg(unix)]
+        check_directory_links(path, &current)?;
         match std::fs::symlink_metadata(&current) {
             Ok(meta) if meta.file_type().is_symlink() => {
                 #[cfg(unix)]
@@ -377,6 +381,77 @@ fn resolve_links(path: &Path) -> Result<PathBuf, OutputError> {
     Err(OutputError::SymlinkLoop {
         path: path.to_owned(),
     })
+}
+
+/// The links in the directories on the way to `current` (a step of resolving the output
+/// `path`), each checked as [`check_link_is_trusted`] checks the last component's: the kernel
+/// follows these itself, and applies its `protected_symlinks` rule to them only where the
+/// system enables it, so a link another user planted in a shared sticky directory, as a
+/// directory of the path (`/tmp/dir/out.csv` with `/tmp/dir` theirs), would redirect the output
+/// as surely as one at its end. The directories are walked as the kernel walks them: a link's
+/// target is walked in its place, a `..` goes up from where the walk is.
+#[cfg(unix)]
+fn check_directory_links(path: &Path, current: &Path) -> Result<(), OutputError> {
+    use std::ffi::OsString;
+    use std::path::Component;
+    /// What is left to walk, last first.
+    enum Step {
+        Root,
+        Up,
+        Name(OsString),
+    }
+    let Some(dir) = current.parent() else {
+        return Ok(());
+    };
+    let push_all = |pending: &mut Vec<Step>, p: &Path| {
+        for c in p.components().rev() {
+            pending.push(match c {
+                Component::RootDir | Component::Prefix(_) => Step::Root,
+                Component::ParentDir => Step::Up,
+                Component::CurDir => continue,
+                Component::Normal(name) => Step::Name(name.to_owned()),
+            });
+        }
+    };
+    let mut walked = if dir.is_absolute() {
+        PathBuf::from("/")
+    } else {
+        std::env::current_dir().map_err(|e| OutputError::io(path, e))?
+    };
+    let mut pending = Vec::new();
+    push_all(&mut pending, dir);
+    let mut links = 0;
+    while let Some(step) = pending.pop() {
+        let name = match step {
+            Step::Root => {
+                walked = PathBuf::from("/");
+                continue;
+            }
+            Step::Up => {
+                walked.pop();
+                continue;
+            }
+            Step::Name(name) => name,
+        };
+        let next = walked.join(&name);
+        match std::fs::symlink_metadata(&next) {
+            Ok(meta) if meta.file_type().is_symlink() => {
+                links += 1;
+                if links > MAX_SYMLINKS {
+                    return Err(OutputError::SymlinkLoop {
+                        path: path.to_owned(),
+                    });
+                }
+                check_link_is_trusted(path, &next, &meta)?;
+                let target = std::fs::read_link(&next).map_err(|e| OutputError::io(path, e))?;
+                push_all(&mut pending, &target);
+            }
+            Ok(_) => walked = next,
+            // Nothing further exists to follow: the write itself reports what is missing.
+            Err(_) => return Ok(()),
+        }
+    }
+    Ok(())
 }
 
 /// The kernel's `protected_symlinks` rule for a link tumble is about to follow: in a directory
