@@ -35,8 +35,8 @@ pub(super) trait Push<T>: Copy + Default + Send + Sync {
 #[derive(Debug, Default)]
 pub(super) struct PushBuffer<P> {
     pushes: Vec<P>,
-    /// Per push, within the run of pushes one thread computed: the largest key of any body of
-    /// the pushes from the run's start up to it, and the smallest from it to the run's end.
+    /// Per push, within the run of pushes one thread computed: the smallest key of any body of
+    /// the pushes from it to the run's end, and the largest from the run's start up to it.
     keys: Vec<(TargetKey, TargetKey)>,
 }
 
