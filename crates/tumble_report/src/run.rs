@@ -51,14 +51,17 @@ pub fn run_report(options: &ReportOptions) -> Result<(), Box<dyn std::error::Err
     }
     let cases = cases();
     let results = measure_everything(options.quick, &cases)?;
-    // The plots are drawn into a private directory (plotters opens its path as it is), then
-    // each joins the set by the same safe route as the other files.
+    // The plots are drawn into a private directory in `out` (plotters opens its path as it
+    // is), then each joins the set by the same safe route as the other files. `out` is made
+    // for it by the set, which removes it again unless it commits; the staging directory,
+    // declared after the set, goes first.
+    let mut files = OutputSet::new();
+    files.make_directory(out)?;
     let staging = tempfile::Builder::new()
         .prefix(".tumble-plots-")
         .tempdir_in(out)
         .map_err(|e| OutputError::io(out, e))?;
     let plots = draw_plots(staging.path(), &cases, &results)?;
-    let mut files = OutputSet::new();
     for plot in &plots {
         let drawn = staging.path().join(plot);
         // A scene without finite points gets no plot file (see `plot_scene`).

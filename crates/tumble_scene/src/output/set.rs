@@ -57,7 +57,7 @@ impl OutputSet {
     /// making its directory (and the ones above it) where missing; the output itself is not
     /// touched until [`commit`](Self::commit). A path added twice keeps the bytes added last.
     pub fn add(&mut self, path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
-        self.make_directories(directory_of(path))?;
+        self.make_directory(directory_of(path))?;
         let mut file = OutputFile::create(path, &[])?;
         file.write_all(bytes)
             .and_then(|()| file.flush())
@@ -68,8 +68,10 @@ impl OutputSet {
         Ok(())
     }
 
-    /// Makes `dir` and every missing directory above it, one at a time, remembering each.
-    fn make_directories(&mut self, dir: &Path) -> Result<(), OutputError> {
+    /// Makes `dir` and every missing directory above it, one at a time, as [`add`](Self::add)
+    /// does for a file's directory: removed again (if empty) unless the set commits. For work
+    /// that needs the outputs' directory before their files (a private staging directory there).
+    pub fn make_directory(&mut self, dir: &Path) -> Result<(), OutputError> {
         let existing = nearest_existing(dir)?;
         let missing: Vec<&Path> = dir
             .ancestors()
@@ -232,6 +234,12 @@ mod tests {
         // The check makes nothing, however deep the missing directories go.
         OutputSet::check(&report).unwrap();
         OutputSet::check(&plot).unwrap();
+        assert!(listing(dir.path()).is_empty());
+        // A directory made for work before the files, then the set dropped: gone again.
+        let mut set = OutputSet::new();
+        set.make_directory(&deep).unwrap();
+        assert!(deep.is_dir());
+        drop(set);
         assert!(listing(dir.path()).is_empty());
         // Files added, then the set dropped (the work failed after them): nothing is left.
         let mut set = OutputSet::new();
