@@ -54,7 +54,16 @@ pub fn measure(
     for _ in 0..repetitions.max(1) {
         let mut built = scene.build();
         let file = match dir {
-            Some(dir) => tempfile::tempfile_in(dir)?,
+            // An output directory still to be made (it is made when the files go in) is on
+            // the file system of the nearest directory above it that exists.
+            Some(dir) => {
+                let existing = dir
+                    .ancestors()
+                    .find(|a| a.is_dir())
+                    .filter(|a| !a.as_os_str().is_empty())
+                    .unwrap_or(std::path::Path::new("."));
+                tempfile::tempfile_in(existing)?
+            }
             None => tempfile::tempfile()?,
         };
         let stats = tumble_scene::write_trajectory(
