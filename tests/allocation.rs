@@ -114,8 +114,10 @@ fn physics_steps_do_not_allocate() {
     let one_stage = [(Integrator::Splitting, 1), (Integrator::SymplecticEuler, 1)];
     for (integrator, substeps) in one_stage.into_iter().chain(stages::SEVERAL_STAGES) {
         let mut world = world(integrator, 1000);
-        world.resource_mut::<PhysicsSettings>().substeps =
-            std::num::NonZeroU32::new(substeps).unwrap();
+        world
+            .resource_mut::<PhysicsSettings>()
+            .set_substeps(std::num::NonZeroU32::new(substeps).unwrap())
+            .unwrap();
         let mut physics = PhysicsRunner::new(&mut world);
         // Warm-up: the first steps may size buffers (command queues, trackers) once.
         for _ in 0..3 {

@@ -19,7 +19,11 @@ fn world(integrator: Integrator, substeps: u32) -> World {
     let mut world = reference_world(integrator);
     let settings = *world.resource::<PhysicsSettings>();
     let substeps = std::num::NonZeroU32::new(substeps).expect("substeps ≥ 1");
-    world.insert_resource(settings.with_substeps(substeps));
+    world.insert_resource(
+        settings
+            .with_substeps(substeps)
+            .expect("a substep in range"),
+    );
     let rising = Velocity::linear(Vec3::new(0.0, 1.0, 0.0));
     let a = spawn_body(&mut world, 0.5, [0.02, 0.03, 0.04], rising);
     let beside = Pose::from_translation(Vec3::new(0.6, 0.0, 0.0));

@@ -20,7 +20,8 @@ fn a_load_added_before_a_step_of_several_stages_is_applied_once() {
         w.insert_resource(
             PhysicsSettings::new(dt, integrator)
                 .unwrap()
-                .with_substeps(NonZeroU32::new(substeps).unwrap()),
+                .with_substeps(NonZeroU32::new(substeps).unwrap())
+                .unwrap(),
         );
         let mass = MassProperties::new(Mass::new(2.0).unwrap(), Vec3::new(1.0, 2.0, 3.0)).unwrap();
         let body = w
@@ -80,7 +81,8 @@ fn game_force_systems_run_in_every_stage_on_its_state() {
     w.insert_resource(
         PhysicsSettings::new(dt, Integrator::Splitting)
             .unwrap()
-            .with_substeps(NonZeroU32::new(4).unwrap()),
+            .with_substeps(NonZeroU32::new(4).unwrap())
+            .unwrap(),
     );
     w.init_resource::<Samples>();
     let body = w
@@ -115,7 +117,8 @@ fn the_runner_keeps_game_force_systems_across_re_plans() {
     w.insert_resource(
         PhysicsSettings::new(0.4, Integrator::Yoshida4)
             .unwrap()
-            .with_substeps(NonZeroU32::new(2).unwrap()),
+            .with_substeps(NonZeroU32::new(2).unwrap())
+            .unwrap(),
     );
     w.init_resource::<Samples>();
     let mut forces = ForceSystems::default();

@@ -90,7 +90,8 @@ impl SpringWorld {
             tumble
                 .world_mut()
                 .resource_mut::<PhysicsSettings>()
-                .substeps = substeps;
+                .set_substeps(substeps)
+                .expect("substeps of a step the precision can take");
         }
         Self {
             tumble,

@@ -36,7 +36,7 @@ fn stages_line(world: &World) -> Option<String> {
     Some(format!(
         "stages per step: {} ({} substep(s) × {} of `{}`), h/Δt = {}",
         stages.count(),
-        settings.substeps,
+        settings.substeps(),
         settings.integrator.composition().len(),
         settings.integrator,
         spans.join(", ")

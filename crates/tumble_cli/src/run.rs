@@ -275,7 +275,7 @@ impl Summary<'_> {
         let body_steps = (steps as f64) * built.bodies.len().max(1) as f64;
         let (dt, integrator) = {
             let settings = built.world.resource::<PhysicsSettings>();
-            let integrator = match settings.substeps.get() {
+            let integrator = match settings.substeps().get() {
                 1 => settings.integrator.to_string(),
                 n => format!("{}, {n} substeps", settings.integrator),
             };

@@ -55,6 +55,21 @@ pub enum InvalidInput {
         compact(TIME_STEP_RANGE.1)
     )]
     TimeStepOutOfRange(Real),
+    /// Substeps that divide a valid time step into parts too short for the build precision
+    /// ([`Real`]) to step: `Δt / N` is below [`TIME_STEP_RANGE`] (see [`check_substeps`]).
+    #[error(
+        "{substeps} substeps of a {} s step are {} s each, too short to step in {REAL_NAME}: \
+         expected at least {} s a substep",
+        compact(*.dt),
+        compact(*.dt / *.substeps as Real),
+        compact(TIME_STEP_RANGE.0)
+    )]
+    SubstepOutOfRange {
+        /// The time step `Δt` (s).
+        dt: Real,
+        /// The number of substeps `N`.
+        substeps: u32,
+    },
     /// A mass or principal moment whose reciprocal is not a finite, normal number in the build
     /// precision ([`Real`]): the engine stores `1/m` and `1/I`, so such a body would be
     /// quarantined at its first step (or move with a garbage inverse).
@@ -165,6 +180,21 @@ pub fn check_time_step(dt: Real) -> Result<(), InvalidInput> {
         Err(InvalidInput::NonPositiveTimeStep(dt))
     } else if !(TIME_STEP_RANGE.0..=TIME_STEP_RANGE.1).contains(&dt) {
         Err(InvalidInput::TimeStepOutOfRange(dt))
+    } else {
+        Ok(())
+    }
+}
+
+/// Checks that `substeps` substeps of the valid time step `dt` are each a step the precision
+/// can take: `Δt / N` within [`TIME_STEP_RANGE`] (a step is `N` substeps of `Δt / N`, each with
+/// the stages [`TIME_STEP_RANGE`] describes). Checks `dt` itself first.
+pub fn check_substeps(dt: Real, substeps: std::num::NonZeroU32) -> Result<(), InvalidInput> {
+    check_time_step(dt)?;
+    if check_time_step(dt / substeps.get() as Real).is_err() {
+        Err(InvalidInput::SubstepOutOfRange {
+            dt,
+            substeps: substeps.get(),
+        })
     } else {
         Ok(())
     }

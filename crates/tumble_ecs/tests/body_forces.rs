@@ -90,7 +90,10 @@ fn forces_at_points_take_the_centre_of_mass_from_the_body() {
 fn impulses_change_momentum_by_exactly_j_once() {
     for (integrator, substeps) in [(Integrator::SymplecticEuler, 1), (Integrator::Yoshida4, 3)] {
         let mut world = world(integrator);
-        world.resource_mut::<PhysicsSettings>().substeps = NonZeroU32::new(substeps).unwrap();
+        world
+            .resource_mut::<PhysicsSettings>()
+            .set_substeps(NonZeroU32::new(substeps).unwrap())
+            .unwrap();
         let body = offset_body(&mut world);
         world.spawn((RigidBody, ForceAccumulator::default())); // a second body, with forces
         let j = Vec3::new(3.0, -1.0, 0.5);

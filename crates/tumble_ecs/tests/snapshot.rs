@@ -133,6 +133,21 @@ fn snapshots_round_trip_and_bad_ones_are_refused() {
     assert_ne!(bad_dt, text);
     let err = serde_json::from_str::<Snapshot>(&bad_dt).unwrap_err();
     assert!(err.to_string().contains("time step"), "{err}");
+    // Substeps too short for the precision are refused like the step itself.
+    let shortest = 8.0 * tumble_core::error::TIME_STEP_RANGE.0;
+    let eight = PhysicsSettings::new(shortest, Integrator::Splitting)
+        .unwrap()
+        .with_substeps(std::num::NonZeroU32::new(8).unwrap())
+        .unwrap();
+    let text_eight = serde_json::to_string(&eight).unwrap();
+    assert_eq!(
+        serde_json::from_str::<PhysicsSettings>(&text_eight).unwrap(),
+        eight
+    );
+    let nine = text_eight.replacen("\"substeps\":8", "\"substeps\":9", 1);
+    assert_ne!(nine, text_eight);
+    let err = serde_json::from_str::<PhysicsSettings>(&nine).unwrap_err();
+    assert!(err.to_string().contains("9 substeps"), "{err}");
     let bad_mass = text.replacen("\"inv_mass\":1.0", "\"inv_mass\":-1.0", 1);
     assert_ne!(bad_mass, text);
     assert!(serde_json::from_str::<Snapshot>(&bad_mass).is_err());

@@ -127,7 +127,8 @@ fn stiff_springs_keep_their_energy_in_steps_of_several_stages() {
         for omega_dt in [10.0, 100.0] {
             let settings = PhysicsSettings::new(DT, integrator)
                 .unwrap()
-                .with_substeps(std::num::NonZeroU32::new(substeps).unwrap());
+                .with_substeps(std::num::NonZeroU32::new(substeps).unwrap())
+                .unwrap();
             let (worst, last, plan) = run(
                 |w| {
                     w.insert_resource(settings);

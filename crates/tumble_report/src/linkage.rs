@@ -90,7 +90,8 @@ pub fn world(integrator: Integrator, dt: Real, substeps: u32) -> (World, [Entity
         .expect("a valid time step")
         .with_springs(SpringSolver::Explicit)
         .with_free_flow(FreeFlow::Method)
-        .with_substeps(NonZeroU32::new(substeps).expect("at least one substep"));
+        .with_substeps(NonZeroU32::new(substeps).expect("at least one substep"))
+        .expect("substeps of a step the precision can take");
     world.insert_resource(settings);
     world.insert_resource(Gravity(v3(GRAVITY)));
     let bodies = spawn(&mut world);

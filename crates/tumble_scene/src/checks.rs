@@ -97,24 +97,8 @@ pub(crate) fn validate_world(ck: &Checker<'_>, w: &WorldDef) -> Result<CheckedWo
         .map_err(|e| ck.error("world", None, "dt", e.to_string()))?
         .with_springs(springs)
         .with_substeps(substeps)
+        .map_err(|e| ck.error("world", None, "substeps", e.to_string()))?
         .with_free_flow(free_flow);
-    // Substeps divide the step: each must be a step the precision can take too.
-    let substep = dt / substeps.get() as Real;
-    if substeps.get() > 1 && tumble_core::error::check_time_step(substep).is_err() {
-        return Err(ck.error(
-            "world",
-            None,
-            "substeps",
-            format!(
-                "{substeps} substeps of a {} s step are {} s each, too short to step in {}: \
-                 expected at least {} s a substep",
-                compact(dt),
-                compact(substep),
-                REAL_NAME,
-                compact(tumble_core::error::TIME_STEP_RANGE.0)
-            ),
-        ));
-    }
     let gravity = w
         .gravity
         .map(|g| ck.vec3("world", None, "gravity", g))
@@ -209,14 +193,30 @@ pub(crate) fn checked_force(
                     ),
                 ));
             }
+            let k = non_negative("stiffness", *stiffness)?;
+            let rest = non_negative("rest_length", *rest_length)?;
+            if !(k * rest).is_finite() {
+                return Err(ck.error(
+                    "forces",
+                    Some(i),
+                    "rest_length",
+                    format!(
+                        "stiffness {} times rest_length {} overflows {REAL_NAME}: the spring's \
+                         force at zero length must be a finite number; expected a shorter rest \
+                         length or a softer spring",
+                        compact(k),
+                        compact(rest)
+                    ),
+                ));
+            }
             SceneForce::Spring {
                 a: a_index,
                 anchor_a: v("anchor_a", *anchor_a)?,
                 b: b_index,
                 anchor_b: v("anchor_b", *anchor_b)?,
-                k: non_negative("stiffness", *stiffness)?,
+                k,
                 c: non_negative("damping", *damping)?,
-                rest: non_negative("rest_length", *rest_length)?,
+                rest,
             }
         }
     })

@@ -112,6 +112,13 @@ pub(super) fn index_u32(i: usize) -> u32 {
 pub(super) const NO_GROUP: u32 = u32::MAX;
 
 impl Link {
+    /// The group the link belongs to (as the start pass numbered it), if it touches an audited
+    /// body.
+    #[inline]
+    pub(super) fn group(&self) -> Option<usize> {
+        (self.group != NO_GROUP).then_some(self.group as usize)
+    }
+
     /// The spring `spring` (of entity `entity`) with its ends resolved to `a` and `b`, not
     /// measured yet.
     pub(super) fn new(entity: Entity, spring: &Spring, a: End, b: End) -> Self {
@@ -391,7 +398,7 @@ impl EnergyLedger {
             Some((g, g))
         });
         let links = Runs::of_keys(self.links.len(), threads, |k| {
-            let g = self.group_of(&self.links[k])? as u64;
+            let g = self.links[k].group()? as u64;
             Some((g, g))
         });
         let runs = GroupRuns {
@@ -401,12 +408,6 @@ impl EnergyLedger {
         };
         self.group_runs = Some(runs);
         runs
-    }
-
-    /// The group a link belongs to (as the start pass numbered it), if it touches an audited
-    /// body.
-    pub(super) fn group_of(&self, link: &Link) -> Option<usize> {
-        (link.group != NO_GROUP).then_some(link.group as usize)
     }
 
     /// The group of a link's first audited end, from the bodies (for numbering the links).
@@ -473,7 +474,7 @@ impl EnergyLedger {
         }
         for k in 0..self.links.len() {
             let link = self.links[k];
-            let Some(group) = self.group_of(&link) else {
+            let Some(group) = link.group() else {
                 continue;
             };
             if let Some(v) = self.start_elastic(&link) {

@@ -6,8 +6,8 @@ use tumble_core::math::{Real, Vec3, Widen};
 
 use super::ledger::{
     Account, Audited, AuditedBodies, AuditedSprings, End, Ends, EnergyLedger, GroupStep, Link,
-    NO_GROUP, OMEGA_DT_CAP, ROUND_OFF_ULPS, elastic_among, for_each_audited, for_each_spring,
-    index_u32, resolve_ends, zip_table,
+    OMEGA_DT_CAP, ROUND_OFF_ULPS, elastic_among, for_each_audited, for_each_spring, index_u32,
+    resolve_ends, zip_table,
 };
 use super::memo::{BodyMemo, Marks};
 use crate::components::{
@@ -490,8 +490,8 @@ impl EnergyLedger {
         let links = &self.links;
         in_runs_of_sums(&runs.links, &mut self.groups, |items, groups, first| {
             for link in &links[items] {
-                if link.group != NO_GROUP && link.measured == pass {
-                    let g = &mut groups[link.group as usize - first];
+                if let Some(group) = link.group().filter(|_| link.measured == pass) {
+                    let g = &mut groups[group - first];
                     g.end += link.elastic;
                     g.magnitude += link.elastic;
                 }

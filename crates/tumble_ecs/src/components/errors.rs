@@ -3,7 +3,8 @@
 
 use bevy_ecs::prelude::*;
 use thiserror::Error;
-use tumble_core::math::Real;
+use tumble_core::error::compact;
+use tumble_core::math::{REAL_NAME, Real};
 use tumble_core::{InvalidInput, StepError};
 
 /// Why a body was rejected.
@@ -149,6 +150,21 @@ pub enum GeneratorErrorKind {
         field: &'static str,
         /// The offending value.
         value: Real,
+    },
+    /// A spring whose force at zero length, `k ℓ₀`, is not a finite number in the build
+    /// precision: wherever its ends come closer than `ℓ₀ − Real::MAX / k`, its force overflows,
+    /// and at the scale of such a rest length the precision cannot place its ends at all.
+    #[error(
+        "stiffness {} times rest_length {} overflows {REAL_NAME}: the spring's force at zero \
+         length, k·rest_length, must be a finite number",
+        compact(*.stiffness),
+        compact(*.rest_length)
+    )]
+    ForceOverflow {
+        /// The stiffness `k` (N/m).
+        stiffness: Real,
+        /// The rest length `ℓ₀` (m).
+        rest_length: Real,
     },
     /// A spring whose two ends are on the same body.
     #[error("both ends are on body {0}: a spring joins two bodies, or a body and a world point")]

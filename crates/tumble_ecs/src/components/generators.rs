@@ -244,7 +244,15 @@ impl Generator for Spring {
         }
         non_negative("stiffness", self.stiffness)?;
         non_negative("damping", self.damping)?;
-        non_negative("rest_length", self.rest_length)
+        non_negative("rest_length", self.rest_length)?;
+        if (self.stiffness * self.rest_length).is_finite() {
+            Ok(())
+        } else {
+            Err(GeneratorErrorKind::ForceOverflow {
+                stiffness: self.stiffness,
+                rest_length: self.rest_length,
+            })
+        }
     }
 
     fn bodies(&self) -> impl Iterator<Item = (&'static str, Entity)> {
@@ -363,5 +371,18 @@ mod tests {
         let mut s = spring();
         s.b = SpringEnd::on_body(s.a, Vec3::X);
         assert_eq!(s.check_values(), Err(GeneratorErrorKind::SelfSpring(s.a)));
+        // Each value finite, but the force at zero length, k ℓ₀, overflows.
+        let mut s = spring();
+        s.stiffness = 100.0;
+        s.rest_length = Real::MAX / 10.0;
+        assert_eq!(
+            s.check_values(),
+            Err(GeneratorErrorKind::ForceOverflow {
+                stiffness: 100.0,
+                rest_length: Real::MAX / 10.0
+            })
+        );
+        s.stiffness = 1.0;
+        assert_eq!(s.check_values(), Ok(()), "k ℓ₀ = MAX / 10 is finite");
     }
 }

@@ -26,8 +26,9 @@ impl Gravity {
     }
 }
 
-/// The step size and integrator of a world. The time step is validated on construction and the
-/// field is private, so a world never holds `Δt ≤ 0` or a non-finite `Δt`.
+/// The step size and integrator of a world. The time step and the substeps are validated on
+/// construction and their fields are private, so a world never holds a `Δt` (or a substep
+/// `Δt/N`) that is not a positive, finite step the precision can take.
 #[derive(Resource, Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(
     feature = "serde",
@@ -42,13 +43,9 @@ pub struct PhysicsSettings {
     /// that are stiff for `dt` with the energy-conserving implicit step and the others with the
     /// integrator (see [`crate::springs`]).
     pub springs: SpringSolver,
-    /// Substeps per step, `N` (default 1): every step is `N` substeps of `Δt/N`, each running
-    /// the force stage afresh (see [`Stages`]); `N` substeps of `Δt` are bit for bit `N` steps of
-    /// `Δt/N`, except that a load game code added before the step is held over all of them
-    /// (see [`ForceAccumulator`](super::ForceAccumulator)). Costs `N` times the step; use it when a force changes
-    /// faster than the step resolves (a stiff contact-like spring, a control loop), not for
-    /// accuracy alone — `yoshida4` is the cheaper way to a small error.
-    pub substeps: NonZeroU32,
+    /// Substeps per step, `N`: see [`PhysicsSettings::substeps`]. Private, like `dt`, so that
+    /// `Δt/N` is always a step the precision can take.
+    substeps: NonZeroU32,
     /// Which free rotation a split method (`splitting`, `splitting-xyz`, `yoshida4`) gives each
     /// body: under [`FreeFlow::Auto`] (the default) a body whose split free rotation would err by
     /// more than [`SPLIT_ERROR_LIMIT`](tumble_core::integrate::SPLIT_ERROR_LIMIT) in a stage
@@ -71,10 +68,32 @@ impl PhysicsSettings {
         })
     }
 
-    /// The same settings with `substeps` substeps per step.
-    pub fn with_substeps(mut self, substeps: NonZeroU32) -> Self {
+    /// The same settings with `substeps` substeps per step (see
+    /// [`substeps`](Self::substeps)); rejects a count that makes `Δt/N` too short for the
+    /// precision to step ([`InvalidInput::SubstepOutOfRange`]).
+    pub fn with_substeps(mut self, substeps: NonZeroU32) -> Result<Self, InvalidInput> {
+        self.set_substeps(substeps)?;
+        Ok(self)
+    }
+
+    /// Substeps per step, `N` (default 1): every step is `N` substeps of `Δt/N`, each running
+    /// the force stage afresh (see [`Stages`]); `N` substeps of `Δt` are bit for bit `N` steps of
+    /// `Δt/N`, except that a load game code added before the step is held over all of them
+    /// (see [`ForceAccumulator`](super::ForceAccumulator)). Costs `N` times the step; use it
+    /// when a force changes faster than the step resolves (a stiff contact-like spring, a
+    /// control loop), not for accuracy alone — `yoshida4` is the cheaper way to a small error.
+    #[inline]
+    pub fn substeps(&self) -> NonZeroU32 {
+        self.substeps
+    }
+
+    /// Changes the substeps per step; rejects a count that makes `Δt/N` too short for the
+    /// precision to step ([`InvalidInput::SubstepOutOfRange`]) and then leaves the settings
+    /// unchanged.
+    pub fn set_substeps(&mut self, substeps: NonZeroU32) -> Result<(), InvalidInput> {
+        tumble_core::error::check_substeps(self.dt, substeps)?;
         self.substeps = substeps;
-        self
+        Ok(())
     }
 
     /// The stages of one step: the substeps times the integrator's composition.
@@ -101,9 +120,11 @@ impl PhysicsSettings {
         self.dt
     }
 
-    /// Changes the time step; rejects `dt ≤ 0` and NaN/Inf and then leaves the settings unchanged.
+    /// Changes the time step; rejects `dt ≤ 0`, NaN/Inf, a step outside
+    /// [`TIME_STEP_RANGE`](tumble_core::error::TIME_STEP_RANGE) and one whose substeps would be
+    /// too short ([`InvalidInput::SubstepOutOfRange`]), and then leaves the settings unchanged.
     pub fn set_dt(&mut self, dt: Real) -> Result<(), InvalidInput> {
-        tumble_core::error::check_time_step(dt)?;
+        tumble_core::error::check_substeps(dt, self.substeps)?;
         self.dt = dt;
         Ok(())
     }
@@ -135,7 +156,7 @@ impl TryFrom<PhysicsSettingsData> for PhysicsSettings {
     fn try_from(d: PhysicsSettingsData) -> Result<Self, InvalidInput> {
         Ok(PhysicsSettings::new(d.dt, d.integrator)?
             .with_springs(d.springs)
-            .with_substeps(d.substeps)
+            .with_substeps(d.substeps)?
             .with_free_flow(d.free_flow))
     }
 }

@@ -35,8 +35,7 @@ pub(super) trait Push<T>: Copy + Default + Send + Sync {
 #[derive(Debug, Default)]
 pub(super) struct PushBuffer<P> {
     pushes: Vec<P>,
-    /// Per push, within the run of pushes one thread computed: the smallest key of any body of
-    /// the pushes from it to the run's end, and the largest from the run's start up to it.
+    /// Per push, the smallest and the largest key of its bodies (`(MAX, 0)` for none).
     keys: Vec<(TargetKey, TargetKey)>,
 }
 
@@ -69,15 +68,15 @@ pub(super) fn push_in_blocks<T: Sync, P: Push<T>>(
                 .zip(keys.chunks_mut(per))
             {
                 spawn(Box::new(move || {
-                    for ((item, push), span) in items.iter().zip(out.iter_mut()).zip(&mut *spans) {
+                    for ((item, push), span) in items.iter().zip(out.iter_mut()).zip(spans) {
                         *push = of(item, shared);
                         *span = key_span(push.bodies(item), shared);
                     }
-                    running_extremes(spans);
                 }));
             }
         });
-        let runs = clean_runs(keys, per, threads);
+        let keys = &*keys;
+        let runs = Runs::of_keys(block.len(), threads, |i| Some(keys[i]));
         fewest = fewest.min(runs.count());
         let Some(parts) = (runs.count() > 1)
             .then(|| targets.shares(runs.bounds()))
@@ -115,42 +114,6 @@ fn key_span(bodies: [Option<Entity>; 2], targets: &Targets) -> (TargetKey, Targe
         .fold((TargetKey::MAX, 0), |(lo, hi), key| {
             (lo.min(key), hi.max(key))
         })
-}
-
-/// Turns each push's `(lo, hi)` key span into `(smallest lo from it, largest hi up to it)`
-/// over one run.
-fn running_extremes(spans: &mut [(TargetKey, TargetKey)]) {
-    let mut hi = 0;
-    for span in spans.iter_mut() {
-        hi = hi.max(span.1);
-        span.1 = hi;
-    }
-    let mut lo = TargetKey::MAX;
-    for span in spans.iter_mut().rev() {
-        lo = lo.min(span.0);
-        span.0 = lo;
-    }
-}
-
-/// The runs of pushes that share no body, from their keys in runs of `per` (after
-/// [`running_extremes`]).
-fn clean_runs(keys: &[(TargetKey, TargetKey)], per: usize, threads: usize) -> Runs {
-    let len = keys.len();
-    let computed = len.div_ceil(per);
-    // Per run of the computation: the largest key before it and the smallest after it.
-    let mut before = [0; MAX_RUNS];
-    let mut after = [TargetKey::MAX; MAX_RUNS];
-    for r in 1..computed {
-        before[r] = before[r - 1].max(keys[r * per - 1].1);
-    }
-    for r in (0..computed.saturating_sub(1)).rev() {
-        after[r] = after[r + 1].min(keys[(r + 1) * per].0);
-    }
-    Runs::choose(len, threads, |s| {
-        let largest_before = before[(s - 1) / per].max(keys[s - 1].1);
-        let smallest_from = after[s / per].min(keys[s].0);
-        (largest_before < smallest_from).then_some(smallest_from)
-    })
 }
 
 #[cfg(test)]

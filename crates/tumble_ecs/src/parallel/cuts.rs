@@ -62,19 +62,6 @@ impl Runs {
         self.starts[self.count]
     }
 
-    /// Chooses the cuts of `len` items into at most `threads` runs: for each even cut
-    /// `k·len/threads`, the clean cut nearest it within [`CUT_WINDOW`] after the last one
-    /// taken, if any. `clean(s)` (`0 < s < len`) is the smallest key of items `s..` when every
-    /// key of items `..s` is below it, `None` otherwise.
-    pub(crate) fn choose(len: usize, threads: usize, clean: impl Fn(usize) -> Option<u64>) -> Self {
-        let threads = threads.clamp(1, MAX_RUNS);
-        let mut runs = Self::whole(len);
-        for k in 1..threads {
-            runs.cut_near(k * len / threads, &clean);
-        }
-        runs
-    }
-
     /// Takes the clean cut nearest `even` within [`CUT_WINDOW`] after the last cut, if any.
     fn cut_near(&mut self, even: usize, clean: impl Fn(usize) -> Option<u64>) {
         let (last, len) = (self.starts[self.count - 1], self.starts[self.count]);
@@ -90,10 +77,11 @@ impl Runs {
         }
     }
 
-    /// [`choose`](Self::choose) for items whose keys `key(i)` (the smallest and the largest
-    /// key of item `i`, `None` for an item with none) are read where they lie: one pass over
-    /// the items for the extremes outside the windows around the even cuts, and each window
-    /// item by item. No memory per item.
+    /// Chooses the cuts of `len` items into at most `threads` runs: for each even cut
+    /// `k·len/threads`, the clean cut nearest it within [`CUT_WINDOW`] after the last one
+    /// taken, if any. `key(i)` is the smallest and the largest key of item `i` (`None` for an
+    /// item with none), read where it lies: one pass over the items for the extremes outside
+    /// the windows around the even cuts, and each window item by item. No memory per item.
     pub(crate) fn of_keys(
         len: usize,
         threads: usize,

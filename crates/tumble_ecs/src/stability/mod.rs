@@ -191,14 +191,16 @@ fn check_springs(world: &mut World, dt: Real, warnings: &mut Vec<StabilityWarnin
     let mut bodies = world.query_filtered::<&MassProps, With<RigidBody>>();
     for (entity, spring) in springs {
         let mut mass_of = |e: Entity| bodies.get(world, e).ok().map(|m| m.mass());
-        let reduced = match (mass_of(spring.a), spring.b) {
-            (Some(ma), SpringEnd::World(_)) => ma,
+        // The ends' masses: one for a spring to a world point.
+        let (ma, mb) = match (mass_of(spring.a), spring.b) {
+            (Some(ma), SpringEnd::World(_)) => (ma, None),
             (Some(ma), SpringEnd::Body { body, .. }) => match mass_of(body) {
-                Some(mb) => ma * mb / (ma + mb),
+                Some(mb) => (ma, Some(mb)),
                 None => continue,
             },
             (None, _) => continue,
         };
+        let reduced = mb.map_or(ma, |mb| ma * mb / (ma + mb));
         let omega_dt = (spring.stiffness / reduced).sqrt() * dt;
         // As the step's precision computes it (at the limit itself, the bits decide); where
         // that is not a number (`k/μ` past the precision's largest number, or `μ` rounded to
@@ -206,15 +208,9 @@ fn check_springs(world: &mut World, dt: Real, warnings: &mut Vec<StabilityWarnin
         let omega_dt = if omega_dt.is_finite() {
             omega_dt
         } else {
-            let reduced = match spring.b {
-                SpringEnd::World(_) => mass_of(spring.a).map(Widen::widen),
-                SpringEnd::Body { body, .. } => mass_of(spring.a)
-                    .zip(mass_of(body))
-                    .map(|(a, b)| a.widen() * b.widen() / (a.widen() + b.widen())),
-            };
-            let wide = reduced.map_or(f64::INFINITY, |m| {
-                (spring.stiffness.widen() / m).sqrt() * dt.widen()
-            });
+            let (ma, mb) = (ma.widen(), mb.map(Widen::widen));
+            let reduced = mb.map_or(ma, |mb| ma * mb / (ma + mb));
+            let wide = (spring.stiffness.widen() / reduced).sqrt() * dt.widen();
             wide.min(Real::MAX.widen()).narrow()
         };
         if omega_dt >= SPRING_LIMIT {

@@ -83,7 +83,7 @@ fn settings(world: &World, out: &mut Stream) {
         out.real(s.dt());
         out.text(s.integrator.name());
         out.text(s.springs.name());
-        out.bytes(&s.substeps.get().to_le_bytes());
+        out.bytes(&s.substeps().get().to_le_bytes());
         // Only when not the default, so that the checksums of worlds that never set it stay
         // what they were before the setting existed.
         if s.free_flow != FreeFlow::default() {

@@ -310,6 +310,50 @@ fn time_steps_the_precision_cannot_take_are_rejected() {
     }
 }
 
+/// Substeps that cut a valid step into parts the precision cannot take are refused by every
+/// way of setting them (the constructor, the setters of the count and of `Δt`), which then
+/// leave the settings unchanged; the shortest substep accepted steps with normal parts.
+#[test]
+fn substeps_too_short_for_the_precision_are_rejected() {
+    use std::num::NonZeroU32;
+    use tumble_core::InvalidInput;
+    let (min, _) = tumble_core::error::TIME_STEP_RANGE;
+    // `min` is a power of two, so `8 min / 8` is exactly `min` and `8 min / 9` is below it.
+    let dt = 8.0 * min;
+    let n = |k: u32| NonZeroU32::new(k).unwrap();
+    let settings = PhysicsSettings::new(dt, Integrator::Yoshida4).unwrap();
+    let err = settings.with_substeps(n(9)).unwrap_err();
+    assert_eq!(
+        err,
+        InvalidInput::SubstepOutOfRange { dt, substeps: 9 },
+        "{err}"
+    );
+    assert!(err.to_string().contains("9 substeps"), "{err}");
+    let mut changed = settings;
+    assert!(changed.set_substeps(n(1000)).is_err());
+    assert_eq!(changed, settings, "a failed set_substeps changes nothing");
+
+    let shortest = settings.with_substeps(n(8)).unwrap();
+    assert_eq!(shortest.substeps(), n(8));
+    for span in shortest.stages().spans(dt) {
+        for part in [span.h, 0.5 * span.h, 0.25 * span.h] {
+            assert!(part.is_normal(), "a part {part} of a substep's stage");
+        }
+    }
+    // Halving Δt under eight substeps would make each too short: refused, Δt kept.
+    let mut halved = shortest;
+    assert!(matches!(
+        halved.set_dt(0.5 * dt),
+        Err(InvalidInput::SubstepOutOfRange { substeps: 8, .. })
+    ));
+    assert_eq!(halved, shortest, "a failed set_dt changes nothing");
+    // The everyday case is untouched.
+    let mut game = PhysicsSettings::default();
+    game.set_substeps(n(1000)).unwrap();
+    game.set_dt(1.0 / 240.0).unwrap();
+    assert_eq!((game.substeps(), game.dt()), (n(1000), 1.0 / 240.0));
+}
+
 #[test]
 fn bad_mass_data_cannot_be_constructed() {
     use tumble_core::InvalidInput;

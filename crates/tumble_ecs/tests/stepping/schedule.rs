@@ -205,7 +205,10 @@ fn user_force_system_in_forces_set_runs_before_integration() {
 fn a_world_needing_everything_plans_every_stage_in_order() {
     let mut world = world_with(0.01, Integrator::Splitting);
     // Substeps: the stage cursor's two systems.
-    world.resource_mut::<PhysicsSettings>().substeps = std::num::NonZeroU32::new(2).unwrap();
+    world
+        .resource_mut::<PhysicsSettings>()
+        .set_substeps(std::num::NonZeroU32::new(2).unwrap())
+        .unwrap();
     world.insert_resource(Gravity::EARTH_Y_DOWN);
     let wall = world
         .spawn((RigidBody, Static, ForceAccumulator::default()))
