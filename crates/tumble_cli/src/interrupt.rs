@@ -1,5 +1,8 @@
 //! SIGINT / SIGTERM (and SIGHUP, and on Unix every other signal whose default action ends the
-//! process: SIGUSR1, SIGUSR2, SIGALRM, SIGVTALRM, SIGPROF, SIGXCPU, SIGQUIT): a flag that long
+//! process and that another process can send: SIGUSR1, SIGUSR2, SIGALRM, SIGVTALRM, SIGPROF,
+//! SIGXCPU, SIGQUIT, SIGIO, SIGTRAP, SIGSYS, SIGABRT, and on Linux SIGPWR, SIGSTKFLT and the
+//! real-time signals SIGRTMIN–SIGRTMAX; not the faults SIGSEGV, SIGBUS, SIGILL and SIGFPE,
+//! whose handler would return to the faulting instruction, nor SIGKILL): a flag that long
 //! loops poll, so that they return an error, drop their temporary file and exit with
 //! [`exit::INTERRUPTED`]. SIGXFSZ (a write past the file-size limit, `ulimit -f`) is caught and
 //! ignored, so that the write fails with `EFBIG` and takes the ordinary error path, which
@@ -46,7 +49,8 @@ fn on_signal() {
 #[cfg(unix)]
 fn install_other_signals() {
     use signal_hook::consts::signal::{
-        SIGALRM, SIGPROF, SIGQUIT, SIGUSR1, SIGUSR2, SIGVTALRM, SIGXCPU, SIGXFSZ,
+        SIGABRT, SIGALRM, SIGIO, SIGPROF, SIGQUIT, SIGSYS, SIGTRAP, SIGUSR1, SIGUSR2, SIGVTALRM,
+        SIGXCPU, SIGXFSZ,
     };
     // A handler of its own replaces the default action (terminate): the write that crossed
     // the limit then fails with EFBIG.
@@ -56,9 +60,16 @@ fn install_other_signals() {
             "cannot handle SIGXFSZ ({e}); a run over `ulimit -f` may leave a temporary file"
         );
     }
-    let ending = [
-        SIGUSR1, SIGUSR2, SIGALRM, SIGVTALRM, SIGPROF, SIGXCPU, SIGQUIT,
+    let mut ending = vec![
+        SIGUSR1, SIGUSR2, SIGALRM, SIGVTALRM, SIGPROF, SIGXCPU, SIGQUIT, SIGIO, SIGTRAP, SIGSYS,
+        SIGABRT,
     ];
+    #[cfg(target_os = "linux")]
+    ending.extend(
+        [libc::SIGPWR, libc::SIGSTKFLT]
+            .into_iter()
+            .chain(libc::SIGRTMIN()..=libc::SIGRTMAX()),
+    );
     match signal_hook::iterator::Signals::new(ending) {
         Ok(mut signals) => {
             std::thread::spawn(move || {

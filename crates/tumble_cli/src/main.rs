@@ -108,12 +108,24 @@ fn usage_error(e: &clap::Error) -> ExitCode {
             Failure::new(exit::USAGE, non_utf8_argument(std::env::args_os())).report()
         }
         _ => {
+            // clap's first line, with the indented lines that complete it (the missing
+            // arguments' names), up to the blank line before its usage.
             let text = e.to_string();
-            let first = text.lines().next().unwrap_or_default();
+            let mut lines = text.lines();
+            let first = lines.next().unwrap_or_default();
             let first = first.strip_prefix("error: ").unwrap_or(first);
+            let rest: Vec<&str> = lines
+                .take_while(|l| l.starts_with(' '))
+                .map(str::trim)
+                .collect();
+            let message = if rest.is_empty() {
+                first.to_owned()
+            } else {
+                format!("{first} {}", rest.join(", "))
+            };
             Failure::new(
                 exit::USAGE,
-                format!("{} (see --help)", terminal_safe(first)),
+                format!("{} (see --help)", terminal_safe(&message)),
             )
             .report()
         }

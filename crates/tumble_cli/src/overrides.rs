@@ -85,6 +85,31 @@ fn override_error(
         "world.springs" if springs => "--springs",
         "world.free_flow" if free_flow => "--free-flow",
         "world.substeps" if substeps => "--substeps",
+        field if field.starts_with("world.") => {
+            // A setting the file gave, refused only beside a flag's value (the file's
+            // substeps under a shorter `--dt`): blame the flags, and name the file's field.
+            let given = [
+                ("--dt", dt.is_some()),
+                ("--steps", steps.is_some()),
+                ("--integrator", integrator),
+                ("--springs", springs),
+                ("--free-flow", free_flow),
+                ("--substeps", substeps),
+            ];
+            let flags: Vec<&str> = given
+                .iter()
+                .filter(|(_, on)| *on)
+                .map(|(flag, _)| *flag)
+                .collect();
+            return Failure::new(
+                exit::ERROR,
+                format!(
+                    "{}: with the scene file's `{field}`: {}",
+                    flags.join(", "),
+                    e.message
+                ),
+            );
+        }
         _ => return e.into(),
     };
     Failure::new(exit::ERROR, format!("{flag}: {}", e.message))

@@ -284,7 +284,10 @@ impl Summary<'_> {
         let mut lines = vec![
             format!("scene      {}", self.scene_name),
             format!("bodies     {}", built.bodies.len()),
-            format!("steps      {steps} × {dt} s ({integrator})"),
+            format!(
+                "steps      {steps} × {} s ({integrator})",
+                tumble_core::error::compact(dt)
+            ),
             format!(
                 "wall time  {:.3} s, {:.1} ns per body-step",
                 wall.as_secs_f64(),

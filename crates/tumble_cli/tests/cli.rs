@@ -97,6 +97,27 @@ fn bad_scene_exits_non_zero_with_file_and_line_and_writes_nothing() {
         let stderr = String::from_utf8_lossy(&output.stderr);
         assert!(stderr.starts_with(expected), "{stderr}");
     }
+    // The file's substeps, valid with its own step, too short under `--dt`: the flag is blamed
+    // and the file's field named, never the scene's `name` as if it were the file.
+    let (_dir, path) = scratch_file(
+        "sub.toml",
+        "name = \"SCENE-NAME\"\n[world]\ndt = 0.01\nsteps = 5\nsubsteps = 9\n\
+         [[bodies]]\nname = \"a\"\nmass = 1.0\ninertia = [1.0, 1.0, 1.0]\n",
+    );
+    let shortest = 8.0 * tumble_core::error::TIME_STEP_RANGE.0;
+    let output = tumble()
+        .arg("run")
+        .arg(&path)
+        .args(["--dt", &shortest.to_string()])
+        .output()
+        .unwrap();
+    assert_eq!(output.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        stderr.starts_with("error: --dt: with the scene file's `world.substeps`: 9 substeps"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("SCENE-NAME"), "{stderr}");
 }
 
 #[test]

@@ -245,7 +245,22 @@ fn start_long_run(dir: &Path, out: &Path, extra: &[&str]) -> Child {
 #[cfg(unix)]
 #[test]
 fn ending_signals_remove_the_temporary_file_and_exit_130() {
-    for signal in ["-INT", "-TERM", "-USR1", "-USR2", "-ALRM", "-QUIT"] {
+    let mut signals: Vec<String> = [
+        "INT", "TERM", "USR1", "USR2", "ALRM", "QUIT", "IO", "TRAP", "SYS",
+    ]
+    .map(|name| format!("-{name}"))
+    .into();
+    #[cfg(target_os = "linux")]
+    signals.extend(
+        [
+            libc::SIGPWR,
+            libc::SIGSTKFLT,
+            libc::SIGRTMIN(),
+            libc::SIGRTMAX(),
+        ]
+        .map(|n| format!("-{n}")),
+    );
+    for signal in &signals {
         let dir = scratch_dir();
         let out = dir.path().join("long.csv");
         let mut child = start_long_run(dir.path(), &out, &["--every", "100000"]);

@@ -107,3 +107,60 @@ fn a_body_farther_than_the_precision_can_count_is_warned_with_its_distance() {
     assert!(!text.contains("inf") && !text.contains("NaN"), "{text}");
     assert!(text.contains("a whole step can be lost"), "{text}");
 }
+
+/// A rod `I = (1, 1, r)` spinning at `w` rad/s about its axis, tipped by 1 rad/s: its `|L|`
+/// relative drift over `STEPS` steps, and whether the planner warned of its angular velocity's
+/// rounding.
+fn spinning_rod(r: Real, w: Real) -> (bool, f64) {
+    let mut world = World::new();
+    world.insert_resource(PhysicsSettings::new(DT, Integrator::Splitting).unwrap());
+    let inertia = Vec3::new(1.0, 1.0, r);
+    let mass = MassProperties::new(Mass::new(1.0).unwrap(), inertia).unwrap();
+    let angular = Vec3::new(1.0, 1.0, w);
+    let body = world
+        .spawn((
+            RigidBody,
+            MassProps(mass),
+            Pose::IDENTITY,
+            Velocity::angular(angular),
+        ))
+        .id();
+    let warned = check_stability(&mut world).iter().any(|w| {
+        matches!(w, StabilityWarning::CoarseAngularVelocity { .. }) && !w.is_instability()
+    });
+    let momentum = |world: &World| {
+        let v = world.get::<Velocity>(body).unwrap().angular;
+        let q = world.get::<Pose>(body).unwrap().rotation;
+        mass.world_inertia_mul(q, v).widen().length()
+    };
+    let start = momentum(&world);
+    let mut physics = PhysicsRunner::new(&mut world);
+    let mut worst: f64 = 0.0;
+    for _ in 0..STEPS {
+        physics.step(&mut world);
+        world.clear_trackers();
+        worst = worst.max((momentum(&world) / start - 1.0).abs());
+    }
+    (warned, worst)
+}
+
+/// The rule `I_max ε |ω| / |L| > 1e-3` warns of a fast spin about an axis of small moment,
+/// whose `|L|` then wanders by more than 1e-3 (`f32`: `r = 1e-12`, `|ω| = 1e8`, about 8× `|L|`
+/// per step; `r = 1e-6`, `|ω| = 1e5`, 0.8 %), and stays quiet where rounding moves `|L|` by
+/// far less (`r = 1e-2`, `|ω| = 100`: 9e-6), as it does for every case in `f64`.
+#[test]
+fn fast_spins_about_a_small_moment_are_warned_where_rounding_moves_l() {
+    for (r, w, warn_in_f32) in [(1e-12, 1e8, true), (1e-6, 1e5, true), (1e-2, 100.0, false)] {
+        let (warned, drift) = spinning_rod(r, w);
+        let expected = warn_in_f32 && !DOUBLE_PRECISION;
+        assert_eq!(warned, expected, "r = {r}, |ω| = {w}: warned {warned}");
+        if warned {
+            assert!(drift > 1e-3, "r = {r}: warned, but |L| drifts by {drift:e}");
+        } else {
+            assert!(
+                drift < 1e-3,
+                "r = {r}: not warned, but |L| drifts by {drift:e}"
+            );
+        }
+    }
+}

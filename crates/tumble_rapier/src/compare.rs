@@ -1,7 +1,7 @@
 //! Stepping both engines side by side and measuring their differences.
 
 use std::time::Instant;
-use tumble_core::math::{Real, to_f64};
+use tumble_core::math::{Vec3, Widen, to_f64};
 
 use tumble_core::rotation::angle_between;
 use tumble_core::{BodyState, Integrator};
@@ -51,14 +51,16 @@ impl Default for ComparisonOptions {
 pub struct BodyDifference {
     /// Body name.
     pub name: String,
-    /// max |x_tumble − x_rapier| (m), centre of mass.
-    pub position: Real,
+    /// max |x_tumble − x_rapier| (m), centre of mass, in `f64` (two finite states can differ by
+    /// more than the precision's largest number, and their difference's square overflows it
+    /// far sooner).
+    pub position: f64,
     /// max orientation angle between the engines (rad).
     pub angle: f64,
-    /// max |v_tumble − v_rapier| (m/s).
-    pub linear_velocity: Real,
-    /// max |ω_tumble − ω_rapier| (rad/s).
-    pub angular_velocity: Real,
+    /// max |v_tumble − v_rapier| (m/s), in `f64`.
+    pub linear_velocity: f64,
+    /// max |ω_tumble − ω_rapier| (rad/s), in `f64`.
+    pub angular_velocity: f64,
     /// Against the exact solution, when one was given: (tumble, rapier) max position error (m).
     pub exact_position: Option<(f64, f64)>,
     /// Against the exact solution: (tumble, rapier) max orientation error (rad).
@@ -224,18 +226,19 @@ impl BodyDifference {
         if self.non_finite_at.is_none() && !(a.is_finite() && b.is_finite()) {
             self.non_finite_at = Some(step);
         }
-        self.position = max_keep_nan(self.position, (a.position - b.position).length());
+        let apart = |x: Vec3, y: Vec3| (x.widen() - y.widen()).length();
+        self.position = max_keep_nan(self.position, apart(a.position, b.position));
         self.angle = max_keep_nan(self.angle, angle_between(a.rotation, b.rotation));
         self.linear_velocity = max_keep_nan(
             self.linear_velocity,
-            (a.linear_velocity - b.linear_velocity).length(),
+            apart(a.linear_velocity, b.linear_velocity),
         );
         self.angular_velocity = max_keep_nan(
             self.angular_velocity,
-            (a.angular_velocity - b.angular_velocity).length(),
+            apart(a.angular_velocity, b.angular_velocity),
         );
         if let Some(reference) = reference {
-            let pos = |s: &BodyState| to_f64((s.position - reference.position).length());
+            let pos = |s: &BodyState| apart(s.position, reference.position);
             let (pt, pr) = self.exact_position.unwrap_or((0.0, 0.0));
             self.exact_position = Some((max_keep_nan(pt, pos(a)), max_keep_nan(pr, pos(b))));
             let (at, ar) = self.exact_angle.unwrap_or((0.0, 0.0));

@@ -8,7 +8,7 @@ use tumble_rapier::{ComparisonBody, ComparisonOptions, ComparisonScene, Load, co
 use tumble_reference::rk4::free_body;
 
 /// Round-off unit of the comparison: rapier runs in f32 whatever tumble's precision.
-const RAPIER_EPS: Real = f32::EPSILON as Real;
+const RAPIER_EPS: f64 = f32::EPSILON as f64;
 
 fn mass(m: Real, inertia: [Real; 3]) -> MassProperties {
     MassProperties::new(Mass::new(m).unwrap(), inertia.into()).unwrap()

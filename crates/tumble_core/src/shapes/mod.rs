@@ -516,5 +516,21 @@ mod tests {
             convex_hull_mass_properties(&bad, rho),
             Err(HullError::NonFinitePoint(4))
         );
+        // A needle 1e12 m long and about 1 m thick: refused before a hull is built, with the
+        // sizes it has, not zeros. Its bounding box is (1e12 m)³ (the unit points add less
+        // than the precision holds), and the largest tetrahedron of its points,
+        // |p₁ − p₀| d₂ d₃ / 6, is about 1.7e12 × 0.82 × 0.71 / 6 ≈ 1.7e11 m³.
+        let needle = [Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z, Vec3::splat(1e12)];
+        match convex_hull_mass_properties(&needle, rho) {
+            Err(HullError::Degenerate {
+                volume,
+                bounding_box_volume,
+            }) => {
+                let bounding_box = (1e12_f64 + 1.0).powi(3);
+                assert!((bounding_box_volume / bounding_box - 1.0).abs() < 1e-6);
+                assert!((1e11..3e11).contains(&volume), "{volume}");
+            }
+            other => panic!("{other:?}"),
+        }
     }
 }

@@ -111,10 +111,6 @@ fn quickhull(points: &[DVec3]) -> Result<Vec<[u32; 3]>, HullError> {
 /// their line, the point farthest from their plane; the base `(i0, i1, i2)` oriented so that
 /// `i3` is below it. An error when the points span less than a volume (within `eps`).
 fn initial_tetrahedron(points: &[DVec3], eps: f64) -> Result<[u32; 4], HullError> {
-    let degenerate = || HullError::Degenerate {
-        volume: 0.0,
-        bounding_box_volume: 0.0,
-    };
     let mut extremes = [0usize; 6];
     for (i, p) in points.iter().enumerate() {
         for axis in 0..3 {
@@ -126,6 +122,15 @@ fn initial_tetrahedron(points: &[DVec3], eps: f64) -> Result<[u32; 4], HullError
             }
         }
     }
+    let bounding_box_volume = (0..3)
+        .map(|axis| points[extremes[2 * axis + 1]][axis] - points[extremes[2 * axis]][axis])
+        .product::<f64>();
+    // The volume of the largest tetrahedron found, `|p₁ − p₀| d₂ d₃ / 6`, from the
+    // distances measured before the points were found to span less than a volume.
+    let degenerate = |spans: [f64; 3]| HullError::Degenerate {
+        volume: spans.iter().product::<f64>() / 6.0,
+        bounding_box_volume,
+    };
     let mut best = (0.0, 0, 0);
     for &i in &extremes {
         for &j in &extremes {
@@ -136,8 +141,9 @@ fn initial_tetrahedron(points: &[DVec3], eps: f64) -> Result<[u32; 4], HullError
         }
     }
     let (i0, i1) = (best.1, best.2);
-    if best.0.sqrt() <= eps {
-        return Err(degenerate());
+    let span = best.0.sqrt();
+    if span <= eps {
+        return Err(degenerate([span, 0.0, 0.0]));
     }
     let (p0, p1) = (points[i0], points[i1]);
     let line = (p1 - p0).normalize();
@@ -150,13 +156,10 @@ fn initial_tetrahedron(points: &[DVec3], eps: f64) -> Result<[u32; 4], HullError
             .fold((0.0, 0), |a, b| if b.0 > a.0 { b } else { a })
     };
     let (d2, i2) = farthest(&|d| d.reject_from_normalized(line).length());
-    if d2 <= eps {
-        return Err(degenerate());
-    }
-    let plane = (p1 - p0).cross(points[i2] - p0).normalize();
+    let plane = (p1 - p0).cross(points[i2] - p0).normalize_or_zero();
     let (d3, i3) = farthest(&|d| d.dot(plane).abs());
-    if d3 <= eps {
-        return Err(degenerate());
+    if d2 <= eps || d3 <= eps {
+        return Err(degenerate([span, d2, d3]));
     }
     let [i0, i1, i2, i3] = [i0, i1, i2, i3].map(|i| i as u32);
     // Orient the base (i0, i1, i2) so that i3 is below it.

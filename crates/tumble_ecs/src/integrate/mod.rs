@@ -31,7 +31,7 @@ pub use systems::{
 };
 
 // Schedule state between two systems of one stage, in their signatures; not for game code.
-#[doc(hidden)]
-pub use systems::HalfDrifted;
 pub(crate) use systems::gravity_applies;
+#[doc(hidden)]
+pub use systems::{HalfDrifted, StageStarts};
 pub(crate) use table::damp;

@@ -2,12 +2,13 @@
 //! batched step (the `table` module: a table run of bodies as a `BodyBatch`).
 //!
 //! A body whose data is bad or whose step diverges is quarantined with [`Rejected`] and keeps its
-//! last valid state, and the others step on unharmed.
+//! last valid state — the state the stage found it in, even when the stage's first half drift
+//! had moved it ([`StageStarts`]) — and the others step on unharmed.
 
 use bevy_ecs::prelude::*;
 use tumble_core::StepPhase;
 
-use super::table::{Bodies, Loads, StageTiming, step_table};
+use super::table::{Bodies, Loads, StageTiming, TableStarts, step_table};
 use crate::components::{
     BodyError, Dynamic, ForceAccumulator, Gravity, GravityScale, ImplicitBody, Kinematic,
     PhysicsSettings, Pose, Refusals, Rejected, RigidBody, Static, Stepped, Velocity, check_body,
@@ -21,12 +22,23 @@ use crate::parallel::Parallelism;
 /// component's contiguous column as a type of its own that borrows the query table by table,
 /// which a closure parameter of a function cannot name.
 macro_rules! step_each_table {
-    ($bodies:ident, $stage:ident, $parallelism:ident, $refusals:ident, |$load:pat_param| $loads:expr) => {{
+    ($bodies:ident, $stage:ident, $parallelism:ident, $refusals:ident, |$load:pat_param| $loads:expr) => {
+        step_each_table!(
+            $bodies,
+            $stage,
+            $parallelism,
+            $refusals,
+            |_e| TableStarts::Unused,
+            |$load| $loads
+        )
+    };
+    ($bodies:ident, $stage:ident, $parallelism:ident, $refusals:ident, |$e:ident| $starts:expr, |$load:pat_param| $loads:expr) => {{
         let parallelism = $parallelism.map_or_else(Parallelism::default, |p| *p);
         let mut errors = Vec::new();
         for (entities, mut t, mut v, masses, $load, dampings, turns) in
             dense($bodies.contiguous_iter_mut())
         {
+            let $e = entities;
             let bodies = Bodies {
                 entities,
                 transforms: &mut t,
@@ -35,6 +47,7 @@ macro_rules! step_each_table {
                 dampings,
                 turns,
                 loads: $loads,
+                starts: $starts,
             };
             step_table(&$stage, &parallelism, bodies, &mut errors);
         }
@@ -97,6 +110,49 @@ pub fn check_fixed_bodies(
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct HalfDrifted(pub bool);
 
+/// The state of each body [`begin_stage`] half drifted, from before it did, table by table:
+/// a body that [`integrate_with_forces`] then refuses (a load game code or a force made bad,
+/// or a step outside the method's stable region) is put back to the state the stage found it
+/// in, never left half a stage on. Kept between steps so that a step does not allocate.
+#[derive(Resource, Debug, Default)]
+pub struct StageStarts {
+    /// Per table: its first entity and its bodies' states, in the table's order.
+    tables: Vec<(Entity, Vec<(Pose, Velocity)>)>,
+    /// The tables saved since the stage began (the rest are left over from earlier stages).
+    saved: usize,
+}
+
+impl StageStarts {
+    /// Where the first half drift saves the bodies of the table `entities` lists.
+    fn save(&mut self, entities: &[Entity]) -> TableStarts<'_> {
+        let Some(&first) = entities.first() else {
+            return TableStarts::Unused;
+        };
+        if self.saved == self.tables.len() {
+            self.tables.push((first, Vec::new()));
+        }
+        let (key, states) = &mut self.tables[self.saved];
+        self.saved += 1;
+        *key = first;
+        states.resize(entities.len(), (Pose::default(), Velocity::default()));
+        TableStarts::Save(states)
+    }
+
+    /// The saved states of the table `entities` lists, if this stage saved it: a table is the
+    /// same between the two halves of a stage (structural changes wait for the end of the
+    /// schedule run), so its first entity and length find it.
+    fn restore(&self, entities: &[Entity]) -> TableStarts<'_> {
+        self.tables[..self.saved]
+            .iter()
+            .find(|(first, states)| {
+                entities.first() == Some(first) && states.len() == entities.len()
+            })
+            .map_or(TableStarts::Unused, |(_, states)| {
+                TableStarts::Restore(states)
+            })
+    }
+}
+
 /// First phase of a drift–kick–drift stage for bodies with a [`ForceAccumulator`]: the first
 /// half of the [`Damping`](crate::components::Damping) flow (when the stage opens a substep), then half a drift before the
 /// force systems run, so forces are sampled at the midpoint of the stage. Does nothing for
@@ -106,7 +162,7 @@ pub fn begin_stage(
     settings: Res<PhysicsSettings>,
     cursor: Res<crate::integrate::StageCursor>,
     parallelism: Option<Res<Parallelism>>,
-    mut drifted: ResMut<HalfDrifted>,
+    (mut drifted, mut starts): (ResMut<HalfDrifted>, ResMut<StageStarts>),
     gravity: Option<Res<Gravity>>,
     mut refusals: Refusals,
     mut bodies: Query<
@@ -114,18 +170,24 @@ pub fn begin_stage(
         (Dynamic, Without<ImplicitBody>),
     >,
 ) {
+    starts.saved = 0;
     if !settings.integrator.samples_forces_at_midpoint() {
         return;
     }
     drifted.0 = true;
     let stage = StageTiming::new(&settings, *cursor, StepPhase::Begin);
     let weighed = gravity_applies(gravity);
-    step_each_table!(bodies, stage, parallelism, refusals, |(accs, scales)| {
-        Loads::Checked {
+    step_each_table!(
+        bodies,
+        stage,
+        parallelism,
+        refusals,
+        |entities| starts.save(entities),
+        |(accs, scales)| Loads::Checked {
             accs,
             scales: scales.filter(|_| weighed),
         }
-    });
+    );
 }
 
 /// Integrates bodies that have a [`ForceAccumulator`], consuming (reading and zeroing) it.
@@ -139,7 +201,7 @@ pub fn integrate_with_forces(
     settings: Res<PhysicsSettings>,
     cursor: Res<crate::integrate::StageCursor>,
     parallelism: Option<Res<Parallelism>>,
-    mut drifted: ResMut<HalfDrifted>,
+    (mut drifted, mut starts): (ResMut<HalfDrifted>, ResMut<StageStarts>),
     (mut warned, gravity): (Local<bool>, Option<Res<Gravity>>),
     mut refusals: Refusals,
     mut bodies: Query<
@@ -163,15 +225,22 @@ pub fn integrate_with_forces(
     drifted.0 = false;
     let stage = StageTiming::new(&settings, *cursor, phase);
     let weighed = gravity_applies(gravity);
-    step_each_table!(bodies, stage, parallelism, refusals, |(
-        mut accs,
-        scales,
-    )| {
-        Loads::Consumed {
+    step_each_table!(
+        bodies,
+        stage,
+        parallelism,
+        refusals,
+        |entities| match phase {
+            StepPhase::Finish => starts.restore(entities),
+            _ => TableStarts::Unused,
+        },
+        |(mut accs, scales)| Loads::Consumed {
             accs: &mut accs,
             scales: scales.filter(|_| weighed),
         }
-    });
+    );
+    // What the stage saved is spent: a later second half without a first finds nothing.
+    starts.saved = 0;
 }
 
 /// True while a gravity field applies (a finite [`Gravity`]): only then does a body's

@@ -134,6 +134,35 @@ impl Loads<'_> {
     }
 }
 
+/// What a phase does with the state its bodies had before the first half drift of a
+/// drift–kick–drift stage.
+pub(crate) enum TableStarts<'a> {
+    /// Nothing: a whole stage (nothing is left half done).
+    Unused,
+    /// Saves each body's state as it is read, before the first half drift changes it.
+    Save(&'a mut [(Pose, Velocity)]),
+    /// Puts a body refused in the second half back to its saved state, so that it keeps the
+    /// state the stage found, not one drifted half a stage.
+    Restore(&'a [(Pose, Velocity)]),
+}
+
+impl TableStarts<'_> {
+    /// Splits at `mid` like `split_at_mut`.
+    fn split_at(self, mid: usize) -> (Self, Self) {
+        match self {
+            TableStarts::Unused => (TableStarts::Unused, TableStarts::Unused),
+            TableStarts::Save(s) => {
+                let (a, b) = s.split_at_mut(mid);
+                (TableStarts::Save(a), TableStarts::Save(b))
+            }
+            TableStarts::Restore(s) => {
+                let (a, b) = s.split_at(mid);
+                (TableStarts::Restore(a), TableStarts::Restore(b))
+            }
+        }
+    }
+}
+
 /// A run of bodies from one table, as plain slices.
 pub(crate) struct Bodies<'a> {
     pub(crate) entities: &'a [Entity],
@@ -144,6 +173,7 @@ pub(crate) struct Bodies<'a> {
     /// How fast each body's springs can turn it (see [`SpringTurn`]), where the table has them.
     pub(crate) turns: Option<&'a [SpringTurn]>,
     pub(crate) loads: Loads<'a>,
+    pub(crate) starts: TableStarts<'a>,
 }
 
 impl<'a> Bodies<'a> {
@@ -160,6 +190,7 @@ impl<'a> Bodies<'a> {
         let (d0, d1) = split_column(self.dampings, mid);
         let (s0, s1) = split_column(self.turns, mid);
         let (l0, l1) = self.loads.split_at(mid);
+        let (b0, b1) = self.starts.split_at(mid);
         (
             Bodies {
                 entities: e0,
@@ -169,6 +200,7 @@ impl<'a> Bodies<'a> {
                 dampings: d0,
                 turns: s0,
                 loads: l0,
+                starts: b0,
             },
             Bodies {
                 entities: e1,
@@ -178,6 +210,7 @@ impl<'a> Bodies<'a> {
                 dampings: d1,
                 turns: s1,
                 loads: l1,
+                starts: b1,
             },
         )
     }
@@ -266,6 +299,9 @@ impl BodyBatch for TableBatch<'_, '_> {
     fn take(&mut self, i: usize, state: &mut BodyState) -> Option<Wrench> {
         let bodies = &mut self.bodies;
         let (transform, velocity) = (&bodies.transforms[i], &bodies.velocities[i]);
+        if let TableStarts::Save(starts) = &mut bodies.starts {
+            starts[i] = (*transform, *velocity);
+        }
         let mass = &bodies.masses[i];
         // Only the rotation is checked here, and the damping (its flow would ignore a bad rate
         // silently); a non-finite translation or velocity is found in the stepped state and
@@ -292,6 +328,7 @@ impl BodyBatch for TableBatch<'_, '_> {
                     entity: bodies.entities[i],
                     kind,
                 });
+                self.put_back(i);
                 None
             }
         }
@@ -337,6 +374,19 @@ impl BodyBatch for TableBatch<'_, '_> {
             entity: bodies.entities[i],
             kind,
         });
+        self.put_back(i);
+    }
+}
+
+impl TableBatch<'_, '_> {
+    /// Puts refused body `i` back to the state the stage found it in, where the first half
+    /// drift changed it (see [`TableStarts::Restore`]).
+    #[cold]
+    fn put_back(&mut self, i: usize) {
+        let bodies = &mut self.bodies;
+        if let TableStarts::Restore(starts) = &bodies.starts {
+            (bodies.transforms[i], bodies.velocities[i]) = starts[i];
+        }
     }
 }
 

@@ -17,8 +17,8 @@ use crate::components::{ForceAccumulator, Gravity, Kinematic, PhysicsSettings, R
 use crate::components::{ImplicitBody, ImplicitSpring};
 use crate::forces::{apply_constant_forces, apply_constant_torques, apply_gravity, apply_springs};
 use crate::integrate::{
-    HalfDrifted, begin_stage, check_fixed_bodies, discard_fixed_body_forces, integrate_with_forces,
-    integrate_without_forces,
+    HalfDrifted, StageStarts, begin_stage, check_fixed_bodies, discard_fixed_body_forces,
+    integrate_with_forces, integrate_without_forces,
 };
 use crate::integrate::{StageCursor, hold_game_loads, next_stage};
 use crate::springs::solve_implicit_springs;
@@ -237,6 +237,7 @@ impl PhysicsPlan {
             tracing::warn!("{warning}");
         }
         world.init_resource::<HalfDrifted>();
+        world.init_resource::<StageStarts>();
         // Game code reads the record from the first step on, errors or not.
         world.init_resource::<crate::components::PhysicsErrors>();
         world.init_resource::<EnergyLedger>();

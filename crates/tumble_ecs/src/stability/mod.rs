@@ -62,7 +62,7 @@
 //!   (`splitting`: 1e-5 to 2e-4 rad). A warning naming `splitting` and `exact` is raised above
 //!   [`RK4_STIFFNESS_LIMIT`].
 //!
-//! And one limit of the precision, not of the method:
+//! And two limits of the precision, not of the method:
 //!
 //! - **Positions far from the origin.** A stored coordinate `r` is rounded to the spacing of
 //!   the precision there, at most `r ε` (`ε` = 1.2e-7 in `f32`). A body whose origin moves
@@ -71,6 +71,13 @@
 //!   relative error `r ε / (2 s Δt)` that does not shrink with time and *grows* as `Δt`
 //!   shrinks. A warning is raised when it exceeds [`POSITION_RESOLUTION_LIMIT`] (in `f32`:
 //!   1 m/s at 60 Hz from about 280 m out); the cure is the `f64` feature.
+//! - **Fast spins about an axis of small moment.** The angular velocity is stored in world
+//!   coordinates, each component rounded to at most `½ ε |ω|`, so the angular momentum it
+//!   stands for, `L = I ω`, is off by up to `I_max ε |ω|` after every step that writes it: a
+//!   relative error `I_max ε |ω| / |L|` that is at most `ε I_max / I_min`, so only a lopsided
+//!   body spinning about its small axis reaches [`ANGULAR_RESOLUTION_LIMIT`] (in `f32`, a rod
+//!   with `I = (1, 1, 10⁻⁶)` spinning at 10⁵ rad/s about its axis: 0.8 %). `|L|` and the energy
+//!   then wander by that much every step, whatever the method; the cure is the `f64` feature.
 
 use bevy_ecs::prelude::*;
 use tumble_core::Integrator;
@@ -94,6 +101,10 @@ pub const EXPLICIT_GYROSCOPIC_HORIZON: Real = 600.0;
 /// Largest relative error `r ε / (2 s Δt)` of one step's motion, from position rounding, that
 /// passes without a warning.
 pub const POSITION_RESOLUTION_LIMIT: Real = 1e-3;
+
+/// Largest relative error `I_max ε |ω| / |L|` of a body's angular momentum, from the rounding
+/// of its stored angular velocity in one step, that passes without a warning.
+pub const ANGULAR_RESOLUTION_LIMIT: Real = 1e-3;
 
 pub use tumble_core::integrate::{
     ACCURACY_HORIZON, COMPOSED_SPLIT_ERROR_LIMIT, SPLIT_DRIFT_TOLERANCE, SPLIT_ERROR_LIMIT,
@@ -222,8 +233,9 @@ fn check_springs(world: &mut World, dt: Real, warnings: &mut Vec<StabilityWarnin
     }
 }
 
-/// Moving bodies that turn about a locked axis, or sit so far out that their position
-/// rounds away a visible part of each step.
+/// Moving bodies that turn about a locked axis, spin so fast about an axis of small moment
+/// that their angular velocity's rounding moves a visible part of their angular momentum, or
+/// sit so far out that their position rounds away a visible part of each step.
 fn check_positions(world: &mut World, dt: Real, warnings: &mut Vec<StabilityWarning>) {
     let gravity = world
         .get_resource::<Gravity>()
@@ -243,8 +255,22 @@ fn check_positions(world: &mut World, dt: Real, warnings: &mut Vec<StabilityWarn
                 warnings.push(StabilityWarning::LockedAxisRate { body, rate });
             }
         }
+        let spin = length_f64(v.angular);
+        let momentum = length_f64(m.world_inertia_mul(t.rotation, v.angular));
+        if spin > 0.0 && momentum > 0.0 && momentum.is_finite() {
+            let largest_moment = m.principal_inertia().max_element().widen();
+            let relative_error = largest_moment * Real::EPSILON.widen() * spin / momentum;
+            if relative_error > ANGULAR_RESOLUTION_LIMIT.widen() {
+                warnings.push(StabilityWarning::CoarseAngularVelocity {
+                    body,
+                    spin,
+                    momentum,
+                    relative_error,
+                });
+            }
+        }
         let distance = length_f64(t.translation);
-        let swing = length_f64(v.angular) * length_f64(t.rotation * m.local_center_of_mass());
+        let swing = spin * length_f64(t.rotation * m.local_center_of_mass());
         let fall = length_f64(gravity) * scale.map_or(1.0, |s| s.0).widen().abs() * dt.widen();
         let step_motion = (length_f64(v.linear) + swing + fall) * dt.widen();
         if step_motion > 0.0 {

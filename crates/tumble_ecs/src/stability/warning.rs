@@ -119,6 +119,20 @@ pub enum StabilityWarning {
         /// `r ε / (2 s Δt)`, compared with [`POSITION_RESOLUTION_LIMIT`](super::POSITION_RESOLUTION_LIMIT).
         relative_error: f64,
     },
+    /// A body spinning so fast about an axis of small moment that rounding of its stored
+    /// (world-frame) angular velocity moves its angular momentum by a visible part of it every
+    /// step (not an instability: the spin stays bounded, but `|L|` and the energy wander).
+    CoarseAngularVelocity {
+        /// The body.
+        body: Entity,
+        /// `|ω|` (rad/s), in `f64`.
+        spin: f64,
+        /// Its angular momentum `|L|` (kg·m²/s), in `f64`.
+        momentum: f64,
+        /// `I_max ε |ω| / |L|`, compared with
+        /// [`ANGULAR_RESOLUTION_LIMIT`](super::ANGULAR_RESOLUTION_LIMIT).
+        relative_error: f64,
+    },
     /// A body that turns about a locked principal axis (a zero moment of inertia): every
     /// integrator holds that rate at 0, so the first step drops it (not an instability, but the
     /// motion is not the one given).
@@ -144,6 +158,7 @@ impl StabilityWarning {
             | StabilityWarning::InexactFreeRotation { body, .. }
             | StabilityWarning::StiffRk4Rotation { body, .. }
             | StabilityWarning::CoarsePosition { body, .. }
+            | StabilityWarning::CoarseAngularVelocity { body, .. }
             | StabilityWarning::LockedAxisRate { body, .. } => body,
         }
     }
@@ -155,6 +170,7 @@ impl StabilityWarning {
         !matches!(
             self,
             StabilityWarning::CoarsePosition { .. }
+                | StabilityWarning::CoarseAngularVelocity { .. }
                 | StabilityWarning::LockedAxisRate { .. }
                 | StabilityWarning::FirstOrderGyroscopic { .. }
                 | StabilityWarning::ImplicitGroups { .. }
@@ -268,6 +284,29 @@ impl std::fmt::Display for StabilityWarning {
                     "; move the origin closer"
                 } else {
                     "; build with the `f64` feature (or move the origin closer)"
+                }
+            ),
+            StabilityWarning::CoarseAngularVelocity {
+                body,
+                spin,
+                momentum,
+                relative_error,
+            } => write!(
+                f,
+                "rigid body {body}: spins at {spin:.3e} rad/s with |L| = {momentum:.3e} kg·m²/s: \
+                 {REAL_NAME} rounds its world-frame angular velocity by up to {:.1e} kg·m²/s of \
+                 angular momentum, {}, so |L| and the energy wander by about that every step \
+                 (a fast spin about an axis of small moment){}",
+                relative_error * momentum,
+                if relative_error < 1.0 {
+                    format!("{:.2} % of |L|", 100.0 * relative_error)
+                } else {
+                    format!("{relative_error:.1e} times |L|")
+                },
+                if DOUBLE_PRECISION {
+                    ""
+                } else {
+                    "; build with the `f64` feature"
                 }
             ),
             StabilityWarning::LockedAxisRate { body, rate } => write!(

@@ -1180,3 +1180,84 @@ fn a_non_finite_force_is_recorded_once() {
         }
     }
 }
+
+#[derive(Component)]
+struct Sabotaged;
+
+/// Game code's force system that writes a non-finite force into the sabotaged bodies, in the
+/// force stage: after a drift–kick–drift method's first half drift.
+fn sabotage(mut bodies: Query<&mut ForceAccumulator, With<Sabotaged>>) {
+    for mut acc in &mut bodies {
+        acc.add_force(Vec3::new(Real::NAN, 0.0, 0.0));
+    }
+}
+
+/// A body refused in the second half of a drift–kick–drift stage — a force made bad in the
+/// force stage, or a kick that overflows — keeps, to the bit, the state the stage found it in,
+/// not the one its first half drift had reached (which a quarantine would report as the
+/// body's last valid state); its neighbour in the same table steps on.
+#[test]
+fn a_body_refused_after_its_first_half_drift_keeps_the_state_before_it() {
+    let midpoint = Integrator::ALL
+        .iter()
+        .copied()
+        .filter(|m| m.samples_forces_at_midpoint());
+    for integrator in midpoint {
+        for overflow in [false, true] {
+            let case = format!("{integrator}, overflow {overflow}");
+            // A kick of `g Δt` past the precision's largest number, from a finite half drift.
+            let dt = if overflow {
+                tumble_core::error::TIME_STEP_RANGE.1 / 2.0
+            } else {
+                1.0 / 60.0
+            };
+            let mut world = world_with(dt, integrator);
+            world.insert_resource(Gravity(Vec3::new(0.0, -1.0e3, 0.0)));
+            let moving = |world: &mut World, x: Real| {
+                world
+                    .spawn((
+                        RigidBody,
+                        mass_props(1.0, [1.0, 2.0, 3.0]),
+                        Pose::from_translation(Vec3::new(x, 0.0, 0.0)),
+                        Velocity {
+                            linear: Vec3::new(1.0, 0.5, 0.25),
+                            angular: Vec3::new(0.3, 1.0, 0.2),
+                        },
+                        ForceAccumulator::default(),
+                    ))
+                    .id()
+            };
+            let bad = moving(&mut world, 0.0);
+            let neighbour = moving(&mut world, 3.0);
+            if !overflow {
+                world.entity_mut(bad).insert(Sabotaged);
+                let mut forces = ForceSystems::default();
+                forces.add(sabotage);
+                world.insert_resource(forces);
+            }
+            let before = (
+                *world.get::<Pose>(bad).unwrap(),
+                *world.get::<Velocity>(bad).unwrap(),
+            );
+            let mut physics = PhysicsRunner::new(&mut world);
+            run_steps(&mut world, &mut physics, 1);
+            let refused = world.get::<Rejected>(bad).expect("refused");
+            let expected = if overflow {
+                matches!(refused.0.kind, BodyErrorKind::Diverged(_))
+            } else {
+                invalid("ForceAccumulator")(&refused.0.kind)
+            };
+            assert!(expected, "{case}: {}", refused.0);
+            let after = (
+                *world.get::<Pose>(bad).unwrap(),
+                *world.get::<Velocity>(bad).unwrap(),
+            );
+            assert_eq!(state_bits(after), state_bits(before), "{case}");
+            if !overflow {
+                assert!(world.get::<Rejected>(neighbour).is_none(), "{case}");
+                let moved = world.get::<Pose>(neighbour).unwrap().translation;
+                assert!(moved.x > 3.0 && moved.is_finite(), "{case}: {moved}");
+            }
+        }
+    }
+}
