@@ -14,6 +14,7 @@ use std::path::Path;
 use crate::error::SceneError;
 use crate::format::SceneFile;
 use crate::json_locate::{Step, array_member_of_len, line_of, number_at};
+use crate::json_strings::LimitedStrings;
 use crate::validate::Locate;
 
 /// Where the JSON text can be read again to locate a field: the scene is parsed once, as a
@@ -78,11 +79,18 @@ pub(crate) fn parse(
     source: JsonSource<'_>,
 ) -> Result<SceneFile, SceneError> {
     skip_byte_order_mark(&mut input);
-    let mut de = serde_json::Deserializer::from_reader(input);
+    let mut limited = LimitedStrings::new(input);
+    let mut de = serde_json::Deserializer::from_reader(&mut limited);
     let model = SceneFile::deserialize(&mut de).and_then(|model| de.end().map(|()| model));
-    model.map_err(|e| match source.open() {
-        Some(again) => located(file, again, source).unwrap_or_else(|| unlocated(file, &e)),
-        None => unlocated(file, &e),
+    model.map_err(|e| {
+        if let Some(too_long) = limited.too_long() {
+            // Not parsed again: the path tracking would read the same string.
+            return SceneError::at(file, too_long.line, "json", too_long.to_string());
+        }
+        match source.open() {
+            Some(again) => located(file, again, source).unwrap_or_else(|| unlocated(file, &e)),
+            None => unlocated(file, &e),
+        }
     })
 }
 

@@ -19,6 +19,7 @@ mod error;
 mod format;
 mod json;
 mod json_locate;
+mod json_strings;
 pub mod many;
 mod model;
 pub mod output;
@@ -32,6 +33,7 @@ pub use build::{BuiltScene, Scene, SceneBody, SceneSyntax};
 pub use checks::MAX_NAME_BYTES;
 pub use error::{SaveError, SceneError};
 pub use format::{BodyDef, ForceDef, SceneFile, ShapeDef, WorldDef};
+pub use json_strings::MAX_JSON_STRING_BYTES;
 pub use model::{MAX_STEPS, MAX_SUBSTEPS, SceneForce};
 pub use trajectory::{
     CSV_HEADER, Recording, TrajectoryError, TrajectoryStats, csv_text_cell, write_trajectory,

@@ -213,6 +213,33 @@ fn parse_errors_name_the_line_and_the_field() {
     }
 }
 
+/// A string longer than any the schema holds (an unknown key, a tag, a name) is refused as soon
+/// as it runs past the limit, naming the line it starts on, from text and from a file: it was
+/// read whole, copied into the error and read again to locate it (a 50 MB key took 447 MB).
+#[test]
+fn a_string_longer_than_the_schema_holds_is_refused_at_its_line() {
+    let long = "k".repeat(tumble_scene::MAX_JSON_STRING_BYTES + 1);
+    let texts = [
+        format!("{{\"name\": \"s\",\n\n\"{long}\": 1}}"),
+        format!(
+            "{{\"name\": \"s\",\n\"world\": {{\"dt\": 0.1, \"steps\": 3}},\n\"bodies\": [{{\"name\": \"{long}\"}}]}}"
+        ),
+    ];
+    let dir = tempfile::tempdir_in(env!("CARGO_TARGET_TMPDIR")).unwrap();
+    for (text, line) in texts.iter().zip([3, 3]) {
+        let path = write(dir.path(), "long.json", text);
+        for e in [json_error(text), load_scene(&path).unwrap_err()] {
+            assert_eq!((e.line, e.field.as_str()), (line, "json"), "{e}");
+            assert!(e.message.contains("longer than 65536 bytes"), "{e}");
+            assert!(e.message.len() < 200, "the string is not echoed");
+        }
+    }
+    // A name at the schema's limit, escaped, is far below it.
+    let name = "\\u00e9".repeat(tumble_scene::MAX_NAME_BYTES / 2);
+    let text = format!("{{\"name\": \"{name}\", \"world\": {{\"dt\": 0.1, \"steps\": 3}}}}");
+    assert!(Scene::parse_json("s.json", &text).is_ok());
+}
+
 #[test]
 fn a_json_file_is_read_as_a_stream_and_errors_are_located_in_it() {
     let dir = tempfile::tempdir_in(env!("CARGO_TARGET_TMPDIR")).unwrap();

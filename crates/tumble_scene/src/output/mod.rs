@@ -5,6 +5,9 @@
 //! directory with a unique, unpredictable name, exclusively (`O_EXCL`: never through a planted
 //! file or symlink). The caller writes into it; [`OutputFile::commit`] renames it over the output
 //! as the last step. Dropped without a commit (an error, Ctrl-C), the temporary file is removed.
+//! On Unix the output's directory is held open from the start, and the rename and the removal
+//! are made relative to it: a directory moved or replaced while tumble writes neither receives
+//! the output ([`OutputError::DirectoryMoved`]) nor keeps the temporary file.
 //! So the output is either the old file or the complete new one, never a mix; two writers to the
 //! same output each have their own temporary file, and the last rename wins.
 //!
@@ -33,7 +36,6 @@ use std::fs::{File, Metadata, OpenOptions};
 use std::io::{self, Write};
 use std::path::{Path, PathBuf};
 
-use tempfile::NamedTempFile;
 use thiserror::Error;
 
 use crate::text::path_for_terminal;
@@ -112,6 +114,17 @@ pub enum OutputError {
         /// The link's owner.
         owner: u32,
     },
+    /// The output's directory was moved or replaced (by another directory, or a link to
+    /// one) while tumble wrote: the output is not written into either, and the temporary file
+    /// is removed from where it was made.
+    #[error(
+        "{}: its directory was moved or replaced while tumble wrote; nothing was written",
+        path_for_terminal(.path)
+    )]
+    DirectoryMoved {
+        /// The path the caller gave.
+        path: PathBuf,
+    },
     /// The output path is empty.
     #[error("the output path is empty")]
     EmptyPath,
@@ -167,6 +180,7 @@ impl OutputError {
             | Self::IsInput { path, .. }
             | Self::SymlinkLoop { path }
             | Self::UntrustedLink { path, .. }
+            | Self::DirectoryMoved { path }
             | Self::MissingMarkers { path, .. }
             | Self::RepeatedMarkers { path, .. }
             | Self::Io { path, .. } => path,
@@ -179,11 +193,47 @@ impl OutputError {
 /// [`commit`](Self::commit) (see the [module](self) documentation for the rules).
 #[derive(Debug)]
 pub struct OutputFile {
-    temp: NamedTempFile,
+    file: File,
+    temp: Temporary,
     target: PathBuf,
     path: PathBuf,
     // Declared after `temp`, so dropped after it: the file is gone before it leaves the list.
     _live: live::LiveTemporary,
+}
+
+/// Where the temporary file is, to rename or remove it. On Unix its directory is held open,
+/// and both are done relative to it: a directory moved or replaced while tumble writes (by a
+/// link, say) can then neither receive the output nor keep the temporary file.
+#[cfg(unix)]
+#[derive(Debug)]
+struct Temporary {
+    /// The output's directory, as it was when the temporary file was made in it.
+    dir: std::os::fd::OwnedFd,
+    /// That directory's path, to check that it still names it.
+    dir_path: PathBuf,
+    /// The temporary file's name in it.
+    name: PathBuf,
+    /// Renamed over the output: nothing to remove.
+    committed: bool,
+}
+
+#[cfg(not(unix))]
+#[derive(Debug)]
+struct Temporary(tempfile::TempPath);
+
+#[cfg(unix)]
+impl Drop for Temporary {
+    fn drop(&mut self) {
+        if !self.committed {
+            let _ = rustix::fs::unlinkat(&self.dir, &self.name, rustix::fs::AtFlags::empty());
+        }
+    }
+}
+
+/// The same device and inode.
+#[cfg(unix)]
+fn same_inode(a: &rustix::fs::Stat, b: &rustix::fs::Stat) -> bool {
+    (a.st_dev, a.st_ino) == (b.st_dev, b.st_ino)
 }
 
 impl OutputFile {
@@ -222,6 +272,15 @@ impl OutputFile {
             // What a shell redirect would create; the umask applies.
             builder.permissions(std::fs::Permissions::from_mode(0o666));
         }
+        #[cfg(unix)]
+        let dir_fd = rustix::fs::open(
+            dir,
+            rustix::fs::OFlags::RDONLY
+                | rustix::fs::OFlags::DIRECTORY
+                | rustix::fs::OFlags::CLOEXEC,
+            rustix::fs::Mode::empty(),
+        )
+        .map_err(|e| OutputError::io(path, e.into()))?;
         let temp = builder
             .tempfile_in(dir)
             .map_err(|e| OutputError::io(path, without_temp_path(e)))?;
@@ -240,8 +299,42 @@ impl OutputFile {
                 .set_permissions(meta.permissions())
                 .map_err(|e| OutputError::io(path, e))?;
         }
-        let _live = live::LiveTemporary::register(temp.path());
+        let (file, temp_path) = temp.into_parts();
+        #[cfg(unix)]
+        let (temp, _live) = {
+            let name = PathBuf::from(temp_path.file_name().unwrap_or_default());
+            // The file must be in the directory held open: one moved or replaced between the
+            // open and the file's creation would hold neither the file nor, later, the output.
+            let made_here =
+                rustix::fs::statat(&dir_fd, &name, rustix::fs::AtFlags::SYMLINK_NOFOLLOW)
+                    .ok()
+                    .zip(rustix::fs::fstat(&file).ok())
+                    .is_some_and(|(there, made)| same_inode(&there, &made));
+            if !made_here {
+                // Removed where it was made, by its path.
+                drop(temp_path);
+                return Err(OutputError::DirectoryMoved {
+                    path: path.to_owned(),
+                });
+            }
+            // From here on it is removed relative to the directory, never by its path.
+            let _ = temp_path.keep();
+            let _live = live::LiveTemporary::register_in(std::os::fd::AsFd::as_fd(&dir_fd), &name);
+            let temp = Temporary {
+                dir: dir_fd,
+                dir_path: dir.to_owned(),
+                name,
+                committed: false,
+            };
+            (temp, _live)
+        };
+        #[cfg(not(unix))]
+        let (temp, _live) = {
+            let _live = live::LiveTemporary::register(&temp_path);
+            (Temporary(temp_path), _live)
+        };
         Ok(Self {
+            file,
             temp,
             target,
             path: path.to_owned(),
@@ -261,24 +354,40 @@ impl OutputFile {
 
     /// The temporary file (to write into, or to query its file system).
     pub fn file(&self) -> &File {
-        self.temp.as_file()
+        &self.file
     }
 
     /// Flushes the data to disk and renames the temporary file over the output. On error the
-    /// temporary file is removed and the output is left as it was.
+    /// temporary file is removed and the output is left as it was; so too if the output's
+    /// directory was moved or replaced while tumble wrote ([`OutputError::DirectoryMoved`]).
     pub fn commit(self) -> Result<(), OutputError> {
         let Self {
-            temp,
+            file,
+            mut temp,
             target,
             path,
             _live,
         } = self;
         // Durable before visible: after a crash the output is the old file or the whole new one.
-        temp.as_file()
-            .sync_all()
-            .map_err(|e| OutputError::io(&path, e))?;
+        file.sync_all().map_err(|e| OutputError::io(&path, e))?;
         check_destination(&path, &target)?;
-        temp.persist(&target)
+        #[cfg(unix)]
+        {
+            let still_there = rustix::fs::stat(&temp.dir_path)
+                .ok()
+                .zip(rustix::fs::fstat(&temp.dir).ok())
+                .is_some_and(|(named, held)| same_inode(&named, &held));
+            if !still_there {
+                return Err(OutputError::DirectoryMoved { path });
+            }
+            let name = target.file_name().unwrap_or_default();
+            rustix::fs::renameat(&temp.dir, &temp.name, &temp.dir, name)
+                .map_err(|e| OutputError::io(&path, e.into()))?;
+            temp.committed = true;
+        }
+        #[cfg(not(unix))]
+        temp.0
+            .persist(&target)
             .map_err(|e| OutputError::io(&path, without_temp_path(e.error)))?;
         Ok(())
     }
@@ -303,11 +412,11 @@ fn check_destination(path: &Path, target: &Path) -> Result<(), OutputError> {
 // which would hide the operating system's error code and name a file the user never saw.
 impl Write for OutputFile {
     fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
-        self.temp.as_file_mut().write(buf)
+        self.file.write(buf)
     }
 
     fn flush(&mut self) -> io::Result<()> {
-        self.temp.as_file_mut().flush()
+        self.file.flush()
     }
 }
 
@@ -554,6 +663,58 @@ mod tests {
         assert!(matches!(err, OutputError::NotDirectory { .. }), "{err}");
         let err = OutputFile::create(Path::new(""), &[]).unwrap_err();
         assert_eq!(err.to_string(), "the output path is empty");
+    }
+
+    /// The output's directory moved away while tumble wrote, or replaced by a link to another
+    /// one: the commit refuses to write into either, and neither a commit nor a drop leaves
+    /// the temporary file in the moved directory (it was removed by a path that no longer led
+    /// to it).
+    #[cfg(unix)]
+    #[test]
+    fn a_directory_moved_while_writing_gets_no_output_and_keeps_no_temporary_file() {
+        let root = tempfile::tempdir().unwrap();
+        let (dir, moved, other) = (
+            root.path().join("od"),
+            root.path().join("od2"),
+            root.path().join("other"),
+        );
+        for (commit, relink) in [(true, false), (false, false), (true, true)] {
+            std::fs::create_dir(&dir).unwrap();
+            std::fs::create_dir_all(&other).unwrap();
+            let mut file = OutputFile::create(&dir.join("out.csv"), &[]).unwrap();
+            file.write_all(b"rows").unwrap();
+            std::fs::rename(&dir, &moved).unwrap();
+            if relink {
+                std::os::unix::fs::symlink(&other, &dir).unwrap();
+            }
+            if commit {
+                let err = file.commit().unwrap_err();
+                assert!(matches!(err, OutputError::DirectoryMoved { .. }), "{err}");
+                assert!(
+                    err.to_string()
+                        .contains("od/out.csv: its directory was moved")
+                );
+            } else {
+                drop(file);
+            }
+            let left: Vec<_> = std::fs::read_dir(&moved).unwrap().collect();
+            assert!(left.is_empty(), "{left:?}");
+            assert_eq!(std::fs::read_dir(&other).unwrap().count(), 0);
+            std::fs::remove_dir(&moved).unwrap();
+            if relink {
+                std::fs::remove_file(&dir).unwrap();
+            }
+        }
+        // Untouched, the same directory by another path still commits.
+        std::fs::create_dir(&dir).unwrap();
+        let mut file = OutputFile::create(&dir.join("./out.csv"), &[]).unwrap();
+        file.write_all(b"rows").unwrap();
+        file.commit().unwrap();
+        assert_eq!(
+            std::fs::read_to_string(dir.join("out.csv")).unwrap(),
+            "rows"
+        );
+        assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1);
     }
 
     #[cfg(unix)]
