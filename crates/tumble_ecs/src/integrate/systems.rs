@@ -116,8 +116,8 @@ pub struct HalfDrifted(pub bool);
 /// in, never left half a stage on. Kept between steps so that a step does not allocate.
 #[derive(Resource, Debug, Default)]
 pub struct StageStarts {
-    /// Per table: its first entity and its bodies' states, in the table's order.
-    tables: Vec<(Entity, Vec<(Pose, Velocity)>)>,
+    /// Per table: its bodies' entities and states, in the table's order.
+    tables: Vec<(Vec<Entity>, Vec<(Pose, Velocity)>)>,
     /// The tables saved since the stage began (the rest are left over from earlier stages).
     saved: usize,
 }
@@ -125,30 +125,30 @@ pub struct StageStarts {
 impl StageStarts {
     /// Where the first half drift saves the bodies of the table `entities` lists.
     fn save(&mut self, entities: &[Entity]) -> TableStarts<'_> {
-        let Some(&first) = entities.first() else {
+        if entities.is_empty() {
             return TableStarts::Unused;
-        };
-        if self.saved == self.tables.len() {
-            self.tables.push((first, Vec::new()));
         }
-        let (key, states) = &mut self.tables[self.saved];
+        if self.saved == self.tables.len() {
+            self.tables.push(Default::default());
+        }
+        let (saved, states) = &mut self.tables[self.saved];
         self.saved += 1;
-        *key = first;
+        saved.clear();
+        saved.extend_from_slice(entities);
         states.resize(entities.len(), (Pose::default(), Velocity::default()));
         TableStarts::Save(states)
     }
 
-    /// The saved states of the table `entities` lists, if this stage saved it: a table is the
-    /// same between the two halves of a stage (structural changes wait for the end of the
-    /// schedule run), so its first entity and length find it.
+    /// The saved states of the table `entities` lists, if this stage saved it: found by its
+    /// first entity and length (structural changes wait for the end of the schedule run, so a
+    /// table is the same between the two halves of a stage unless game code changed the whole
+    /// world in between; each row's entity is checked again before it is put back).
     fn restore(&self, entities: &[Entity]) -> TableStarts<'_> {
         self.tables[..self.saved]
             .iter()
-            .find(|(first, states)| {
-                entities.first() == Some(first) && states.len() == entities.len()
-            })
-            .map_or(TableStarts::Unused, |(_, states)| {
-                TableStarts::Restore(states)
+            .find(|(saved, _)| saved.len() == entities.len() && saved.first() == entities.first())
+            .map_or(TableStarts::Unused, |(saved, states)| {
+                TableStarts::Restore(saved, states)
             })
     }
 }

@@ -142,8 +142,10 @@ pub(crate) enum TableStarts<'a> {
     /// Saves each body's state as it is read, before the first half drift changes it.
     Save(&'a mut [(Pose, Velocity)]),
     /// Puts a body refused in the second half back to its saved state, so that it keeps the
-    /// state the stage found, not one drifted half a stage.
-    Restore(&'a [(Pose, Velocity)]),
+    /// state the stage found, not one drifted half a stage: the bodies' entities when saved,
+    /// and their states. A row whose entity changed in between (game code with the whole
+    /// world despawned and spawned bodies of the table) is left as it is.
+    Restore(&'a [Entity], &'a [(Pose, Velocity)]),
 }
 
 impl TableStarts<'_> {
@@ -155,9 +157,9 @@ impl TableStarts<'_> {
                 let (a, b) = s.split_at_mut(mid);
                 (TableStarts::Save(a), TableStarts::Save(b))
             }
-            TableStarts::Restore(s) => {
-                let (a, b) = s.split_at(mid);
-                (TableStarts::Restore(a), TableStarts::Restore(b))
+            TableStarts::Restore(e, s) => {
+                let ((e0, e1), (s0, s1)) = (e.split_at(mid), s.split_at(mid));
+                (TableStarts::Restore(e0, s0), TableStarts::Restore(e1, s1))
             }
         }
     }
@@ -384,7 +386,9 @@ impl TableBatch<'_, '_> {
     #[cold]
     fn put_back(&mut self, i: usize) {
         let bodies = &mut self.bodies;
-        if let TableStarts::Restore(starts) = &bodies.starts {
+        if let TableStarts::Restore(entities, starts) = &bodies.starts
+            && entities[i] == bodies.entities[i]
+        {
             (bodies.transforms[i], bodies.velocities[i]) = starts[i];
         }
     }

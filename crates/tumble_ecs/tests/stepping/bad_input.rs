@@ -1261,3 +1261,65 @@ fn a_body_refused_after_its_first_half_drift_keeps_the_state_before_it() {
         }
     }
 }
+
+#[derive(Resource)]
+struct Reshuffle {
+    gone: Entity,
+    bad: Entity,
+}
+
+/// Game code with the whole world, in the force stage: despawns one body and spawns another
+/// of the same table (the bad body moves into the freed row), and makes the bad body's force
+/// non-finite.
+fn reshuffle(world: &mut World) {
+    let Some(Reshuffle { gone, bad }) = world.remove_resource::<Reshuffle>() else {
+        return;
+    };
+    world.despawn(gone);
+    world.spawn((
+        RigidBody,
+        mass_props(1.0, [1.0, 2.0, 3.0]),
+        Pose::from_translation(Vec3::new(9.0, 0.0, 0.0)),
+        Velocity::ZERO,
+        ForceAccumulator::default(),
+    ));
+    world
+        .get_mut::<ForceAccumulator>(bad)
+        .unwrap()
+        .add_force(Vec3::new(Real::NAN, 0.0, 0.0));
+}
+
+/// A body put back after a refused second half takes its own saved state or none: where game
+/// code rearranged its table between the halves, the row it now sits in was saved for another
+/// body, whose state it must not take.
+#[test]
+fn a_refused_body_never_takes_the_saved_state_of_another() {
+    let mut world = world_with(1.0 / 60.0, Integrator::Splitting);
+    let body = |world: &mut World, x: Real| {
+        world
+            .spawn((
+                RigidBody,
+                mass_props(1.0, [1.0, 2.0, 3.0]),
+                Pose::from_translation(Vec3::new(x, 0.0, 0.0)),
+                Velocity::linear(Vec3::new(0.0, x, 0.0)),
+                ForceAccumulator::default(),
+            ))
+            .id()
+    };
+    let _first = body(&mut world, 1.0);
+    let gone = body(&mut world, 2.0);
+    let bad = body(&mut world, 3.0);
+    let mut forces = ForceSystems::default();
+    forces.add(reshuffle);
+    world.insert_resource(forces);
+    let mut physics = PhysicsRunner::new(&mut world);
+    world.insert_resource(Reshuffle { gone, bad });
+    run_steps(&mut world, &mut physics, 1);
+    assert!(world.get::<Rejected>(bad).is_some(), "refused");
+    let pose = world.get::<Pose>(bad).unwrap();
+    assert!(pose.translation.is_finite());
+    assert!(
+        (pose.translation.x - 3.0).abs() < 1e-3,
+        "the bad body kept a state of its own, not the one saved for its new row: {pose:?}"
+    );
+}
