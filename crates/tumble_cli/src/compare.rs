@@ -63,6 +63,7 @@ pub(crate) fn run(scene: &Scene, settings: Settings) -> Result<(), Failure> {
         springs,
         rapier_springs,
         free_flow,
+        substeps: scene.settings().substeps(),
     };
     let result = compare(&comparison, &options, Some(&exact));
     let (tumble_springs, rapier_springs) = if comparison.springs.is_empty() {
@@ -79,11 +80,15 @@ pub(crate) fn run(scene: &Scene, settings: Settings) -> Result<(), Failure> {
     let mut out = String::new();
     let _ = writeln!(
         out,
-        "scene {} · tumble `{integrator}`{tumble_springs} vs rapier 0.36 (gyroscopic {}, 4 substeps{rapier_springs}) · {} steps of {} s",
+        "scene {} · tumble `{integrator}`{}{tumble_springs} vs rapier 0.36 (gyroscopic {}, 4 substeps{rapier_springs}) · {} steps of {} s",
         terminal_safe(scene.name()),
+        match options.substeps.get() {
+            1 => String::new(),
+            n => format!(", {n} substeps"),
+        },
         if gyroscopic { "on" } else { "off" },
         options.steps,
-        scene.dt()
+        tumble_core::error::compact(scene.dt())
     );
     let _ = writeln!(
         out,

@@ -353,6 +353,34 @@ fn compare_names_differences_past_the_largest_number() {
     assert_eq!(output.status.code(), Some(3), "{}", stderr(&output));
 }
 
+/// `compare` steps tumble with the scene's substeps and says so in its header: it stepped one
+/// substep whatever the file said, without a word.
+#[test]
+fn compare_steps_the_scene_s_substeps() {
+    let scene = |substeps: u32| {
+        format!(
+            "name = \"m\"\n[world]\ndt = 0.016666668\nsteps = 30\nsubsteps = {substeps}\n\
+             [[bodies]]\nname = \"a\"\nmass = 0.01\ninertia = [1.6e-6, 1.6e-6, 1.6e-6]\n\
+             [[forces]]\ntype = \"spring\"\na = \"a\"\nanchor_b = [0.0, 0.0, 0.0]\nstiffness = 0.1\n\
+             [[forces]]\ntype = \"constant\"\nbody = \"a\"\nforce = [0.0, -0.1, 0.0]\n"
+        )
+    };
+    let energy = |substeps: u32| {
+        let (_dir, path) = scratch_file("m.toml", &scene(substeps));
+        let output = tumble_run(&["compare", path.to_str().unwrap()]);
+        let text = String::from_utf8_lossy(&output.stdout).into_owned();
+        assert_eq!(output.status.code(), Some(0), "{text}{}", stderr(&output));
+        let header = text.lines().next().unwrap().to_owned();
+        assert_eq!(header.contains(", 2 substeps,"), substeps == 2, "{header}");
+        text.lines()
+            .find(|l| l.starts_with("total energy"))
+            .and_then(|l| l.split("; rapier").next())
+            .unwrap()
+            .to_owned()
+    };
+    assert_ne!(energy(1), energy(2), "the substeps change tumble's run");
+}
+
 /// Two finite states far apart: their difference is finite even where its square is past the
 /// precision's largest number (`f32`: beyond about 1.8e19), so the table prints it, never
 /// `overflow`. Gravity 1e30 m/s² for half a second: the engines' step biases differ by about

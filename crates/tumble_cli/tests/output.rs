@@ -781,3 +781,42 @@ fn exhausted_memory_is_an_error_line_and_leaves_nothing() {
     assert_eq!(std::fs::read_to_string(&out).unwrap(), "old");
     assert_eq!(listing(dir.path()), ["big.json", "out.csv"]);
 }
+
+/// A directory one may write in but not list (mode 0333) takes outputs: the directory is held
+/// by path only (`O_PATH`) while the file is written, which needs no read permission. Run as
+/// another user, which needs root: elsewhere the test says so and skips.
+#[cfg(target_os = "linux")]
+#[test]
+fn a_directory_that_can_be_written_but_not_listed_takes_the_output() {
+    use std::os::unix::fs::{PermissionsExt, chown};
+    use std::os::unix::process::CommandExt;
+
+    let dir = scratch_dir();
+    std::fs::set_permissions(dir.path(), std::fs::Permissions::from_mode(0o755)).unwrap();
+    let blind = dir.path().join("blind");
+    std::fs::create_dir(&blind).unwrap();
+    let nobody = 65534;
+    if chown(&blind, Some(nobody), Some(nobody)).is_err() {
+        eprintln!("skipped: giving the directory to another user needs root");
+        return;
+    }
+    std::fs::set_permissions(&blind, std::fs::Permissions::from_mode(0o333)).unwrap();
+    let output = match tumble()
+        .args(["run", "projectile", "--out", "blind/out.csv"])
+        .current_dir(dir.path())
+        .uid(nobody)
+        .gid(nobody)
+        .output()
+    {
+        Ok(output) => output,
+        Err(e) => {
+            eprintln!("skipped: cannot run as another user ({e})");
+            return;
+        }
+    };
+    assert!(output.status.success(), "{}", stderr(&output));
+    std::fs::set_permissions(&blind, std::fs::Permissions::from_mode(0o755)).unwrap();
+    assert_eq!(listing(&blind), ["out.csv"]);
+    let csv = std::fs::read_to_string(blind.join("out.csv")).unwrap();
+    assert!(csv.starts_with(CSV_HEADER), "{csv}");
+}

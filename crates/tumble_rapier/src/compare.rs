@@ -30,6 +30,9 @@ pub struct ComparisonOptions {
     /// Which free rotation tumble's split methods give each body
     /// (`PhysicsSettings::free_flow`; default `auto`).
     pub free_flow: FreeFlow,
+    /// tumble's substeps per step (`PhysicsSettings::substeps`; default 1). [`compare`] panics
+    /// if `scene.dt` divided by it is too short a step for the precision.
+    pub substeps: std::num::NonZeroU32,
 }
 
 impl Default for ComparisonOptions {
@@ -42,6 +45,7 @@ impl Default for ComparisonOptions {
             springs: SpringSolver::Auto,
             rapier_springs: RapierSprings::Joint,
             free_flow: FreeFlow::Auto,
+            substeps: std::num::NonZeroU32::MIN,
         }
     }
 }
@@ -139,6 +143,13 @@ pub fn compare(
         options.springs,
         options.free_flow,
     );
+    if options.substeps.get() > 1 {
+        tumble
+            .world_mut()
+            .resource_mut::<tumble_ecs::prelude::PhysicsSettings>()
+            .set_substeps(options.substeps)
+            .expect("substeps of a step the precision can take (see ComparisonOptions)");
+    }
     let mut rapier = RapierScene::with_springs(
         scene,
         options.gyroscopic,

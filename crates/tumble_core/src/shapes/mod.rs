@@ -122,19 +122,33 @@ pub enum HullError {
     /// More points than [`MAX_HULL_POINTS`].
     #[error("a convex hull takes at most {MAX_HULL_POINTS} points, got {0}")]
     TooManyPoints(usize),
-    /// The points are (nearly) coplanar, collinear or coincident: the hull has no volume.
+    /// The hull is so thin that its volume, below [`HULL_MIN_RELATIVE_VOLUME`] of its bounding
+    /// box's, is round-off: it has no usable inertia.
     #[error(
-        "convex hull is degenerate: its volume {} m³ is below {} of its bounding box's {} m³ \
-         (needs 4 points spanning a volume)",
-        crate::error::compact(*.volume),
-        crate::error::compact(HULL_MIN_RELATIVE_VOLUME),
-        crate::error::compact(*.bounding_box_volume)
+        "convex hull is degenerate: its volume {volume:.3e} m³ is below {} of its bounding \
+         box's {bounding_box_volume:.3e} m³ (needs 4 points spanning a volume)",
+        crate::error::compact(HULL_MIN_RELATIVE_VOLUME)
     )]
     Degenerate {
         /// The hull's volume (m³).
         volume: f64,
         /// The volume of its axis-aligned bounding box (m³).
         bounding_box_volume: f64,
+    },
+    /// The points lie (nearly) at one point, on a line or in a plane: within the hull
+    /// algorithm's tolerance, `1e-11` of the largest coordinate, so no hull is built.
+    #[error(
+        "convex hull is degenerate: its points lie within {thickness:.3e} m of a {shape}, \
+         within the tolerance {tolerance:.3e} m (1e-11 of the largest coordinate); needs 4 \
+         points spanning a volume"
+    )]
+    Flat {
+        /// What the points lie on: `"point"`, `"line"` or `"plane"`.
+        shape: &'static str,
+        /// Their largest distance from it (m).
+        thickness: f64,
+        /// The tolerance (m).
+        tolerance: f64,
     },
     /// The hull algorithm failed on these points (numerical trouble).
     #[error("the convex hull of these points could not be computed ({0})")]
@@ -516,21 +530,28 @@ mod tests {
             convex_hull_mass_properties(&bad, rho),
             Err(HullError::NonFinitePoint(4))
         );
-        // A needle 1e12 m long and about 1 m thick: refused before a hull is built, with the
-        // sizes it has, not zeros. Its bounding box is (1e12 m)³ (the unit points add less
-        // than the precision holds), and the largest tetrahedron of its points,
-        // |p₁ − p₀| d₂ d₃ / 6, is about 1.7e12 × 0.82 × 0.71 / 6 ≈ 1.7e11 m³.
+        // A needle 1e12 m long and about 1 m thick, and a plate 1e-11 thick: refused before a
+        // hull is built, each with the distance it has from a line or a plane and the
+        // tolerance (1e-11 of the largest coordinate), not zeros or a volume ratio it does
+        // not fail.
         let needle = [Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z, Vec3::splat(1e12)];
-        match convex_hull_mass_properties(&needle, rho) {
-            Err(HullError::Degenerate {
-                volume,
-                bounding_box_volume,
-            }) => {
-                let bounding_box = (1e12_f64 + 1.0).powi(3);
-                assert!((bounding_box_volume / bounding_box - 1.0).abs() < 1e-6);
-                assert!((1e11..3e11).contains(&volume), "{volume}");
+        let plate = [Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::new(0.0, 0.0, 1e-11)];
+        for (points, shape, thickness, tolerance) in [
+            (&needle[..], "line", 0.82, 10.0),
+            (&plate[..], "plane", 1e-11, 1e-11),
+        ] {
+            match convex_hull_mass_properties(points, rho) {
+                Err(HullError::Flat {
+                    shape: s,
+                    thickness: t,
+                    tolerance: e,
+                }) => {
+                    assert_eq!(s, shape);
+                    assert!((t / thickness - 1.0).abs() < 1e-2, "{t}");
+                    assert!((e / tolerance - 1.0).abs() < 1e-6, "{e}");
+                }
+                other => panic!("{shape}: {other:?}"),
             }
-            other => panic!("{other:?}"),
         }
     }
 }

@@ -122,14 +122,10 @@ fn initial_tetrahedron(points: &[DVec3], eps: f64) -> Result<[u32; 4], HullError
             }
         }
     }
-    let bounding_box_volume = (0..3)
-        .map(|axis| points[extremes[2 * axis + 1]][axis] - points[extremes[2 * axis]][axis])
-        .product::<f64>();
-    // The volume of the largest tetrahedron found, `|p₁ − p₀| d₂ d₃ / 6`, from the
-    // distances measured before the points were found to span less than a volume.
-    let degenerate = |spans: [f64; 3]| HullError::Degenerate {
-        volume: spans.iter().product::<f64>() / 6.0,
-        bounding_box_volume,
+    let flat = |shape, thickness| HullError::Flat {
+        shape,
+        thickness,
+        tolerance: eps,
     };
     let mut best = (0.0, 0, 0);
     for &i in &extremes {
@@ -143,7 +139,7 @@ fn initial_tetrahedron(points: &[DVec3], eps: f64) -> Result<[u32; 4], HullError
     let (i0, i1) = (best.1, best.2);
     let span = best.0.sqrt();
     if span <= eps {
-        return Err(degenerate([span, 0.0, 0.0]));
+        return Err(flat("point", span));
     }
     let (p0, p1) = (points[i0], points[i1]);
     let line = (p1 - p0).normalize();
@@ -156,10 +152,13 @@ fn initial_tetrahedron(points: &[DVec3], eps: f64) -> Result<[u32; 4], HullError
             .fold((0.0, 0), |a, b| if b.0 > a.0 { b } else { a })
     };
     let (d2, i2) = farthest(&|d| d.reject_from_normalized(line).length());
-    let plane = (p1 - p0).cross(points[i2] - p0).normalize_or_zero();
+    if d2 <= eps {
+        return Err(flat("line", d2));
+    }
+    let plane = (p1 - p0).cross(points[i2] - p0).normalize();
     let (d3, i3) = farthest(&|d| d.dot(plane).abs());
-    if d2 <= eps || d3 <= eps {
-        return Err(degenerate([span, d2, d3]));
+    if d3 <= eps {
+        return Err(flat("plane", d3));
     }
     let [i0, i1, i2, i3] = [i0, i1, i2, i3].map(|i| i as u32);
     // Orient the base (i0, i1, i2) so that i3 is below it.

@@ -32,8 +32,14 @@
 //! it) and rejects the group when
 //!
 //! ```text
-//! D > (A − 1) · E + ε,      E = (T + V)_start − D    (the energy the group should have)
+//! D > (A − 1) · E + ε,      E = max((T + V)_start − D, (T + V)_start − D + W_ext)
 //! ```
+//!
+//! `E` is the most energy the group should hold during the step: at its start, or at its end
+//! had the step been exact. The second matters for a group at rest and relaxed that a load
+//! sets moving (a body hanging from its anchor, the corners of a cloth): it holds nothing at
+//! the start, and the first step's error in the energy the load gives it — for a stable spring
+//! at most `(ωΔt)²/4 ≤ 1` times the load's work — must not be taken for created energy.
 //!
 //! `A` is twice the largest ratio of energies on one orbit of a *stable* linear spring under the
 //! method's position update, with `x = min(ω_max Δt, 1.99)/2`:

@@ -555,7 +555,11 @@ impl EnergyLedger {
             }
             account.seen = true;
             let before = account.created;
-            let should = (g.start - before).max(0.0);
+            // The energy the group should hold, at the most over the step: from its start to
+            // its start plus the loads' work. A group at rest and relaxed holds nothing at the
+            // start, yet a load's first step gives it energy, and the step's own error in that
+            // energy (`≤ W` for a stable spring) must fit the bound.
+            let should = (g.start - before).max(g.start - before + g.work).max(0.0);
             account.created += g.end - g.start - g.work;
             let x = OMEGA_DT_CAP.min(g.omega_dt) / 2.0;
             let factor = if self.midpoint {

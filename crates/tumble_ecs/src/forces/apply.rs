@@ -2,7 +2,7 @@
 
 use crate::components::{IndexOrder, IndexedQuery};
 use bevy_ecs::prelude::*;
-use tumble_core::math::{Vec3, quat_rotate};
+use tumble_core::math::{Real, Vec3, quat_rotate};
 
 use super::push_blocks::{Push, PushBuffer, push_in_blocks};
 use super::targets::{ForceTargets, PushTarget, TargetRows, Targets};
@@ -322,12 +322,32 @@ fn anchor_point(transform: &Pose, mass: &MassProps, local: Vec3) -> (Vec3, Vec3)
 /// [`crate::springs`].
 #[inline]
 pub fn spring_force(spring: &Spring, d: Vec3) -> Vec3 {
-    let length = d.length();
+    let length_squared = d.length_squared();
+    if length_squared == Real::INFINITY
+        && let Some((length, n)) = long_span(d)
+    {
+        return -(spring.stiffness * (length - spring.rest_length)) * n;
+    }
+    let length = length_squared.sqrt();
     if length <= 0.0 {
         return Vec3::ZERO;
     }
     let n = d / length;
     -(spring.stiffness * (length - spring.rest_length)) * n
+}
+
+/// The length and direction of a finite `d` whose squared length overflows (`|d|` past
+/// `√MAX`, 1.8e19 m in `f32`): scaled by its largest component first. `None` for any other
+/// `d` (a non-finite one stays non-finite where it is used, and is refused there).
+#[cold]
+pub(crate) fn long_span(d: Vec3) -> Option<(Real, Vec3)> {
+    let scale = d.abs().max_element();
+    if !(d.is_finite() && d.length_squared() == Real::INFINITY) {
+        return None;
+    }
+    let unit = d / scale;
+    let length = unit.length();
+    Some((scale * length, unit / length))
 }
 
 /// What one spring pushes: its force and the anchor points it acts at, with each end's centre

@@ -37,6 +37,7 @@ mod body_forces;
 mod push_blocks;
 mod targets;
 
+pub(crate) use apply::long_span;
 pub use apply::{apply_constant_forces, apply_constant_torques, apply_gravity, apply_springs};
 pub use apply::{kinetic_and_elastic_energy, spring_force};
 pub use body_forces::{

@@ -8,6 +8,7 @@ use crate::components::Rejected;
 use crate::components::{IndexOrder, IndexedQuery};
 use crate::components::{Kinematic, MassProps, PhysicsSettings, Pose, RigidBody, Static, Velocity};
 use crate::components::{Spring, SpringEnd};
+use crate::forces::long_span;
 use crate::integrate::StageCursor;
 
 /// The spring ends a damper reads and pushes: valid rigid bodies of any kind (a [`Static`] or
@@ -139,7 +140,10 @@ fn damp_spring(spring: &Spring, tau: Real, bodies: &mut DamperEnds) {
                 return;
             }
             let (pa, a) = Anchor::of(t, &v, m, spring.anchor_a);
-            let Some(n) = (pa - anchor_b).try_normalize() else {
+            let Some(n) = (pa - anchor_b)
+                .try_normalize()
+                .or_else(|| long_span(pa - anchor_b).map(|(_, n)| n))
+            else {
                 return;
             };
             let p = impulse(
@@ -159,7 +163,10 @@ fn damp_spring(spring: &Spring, tau: Real, bodies: &mut DamperEnds) {
             let (dynamic_a, dynamic_b) = (!(sa || ka), !(sb || kb));
             let (pa, a) = Anchor::held(Anchor::of(ta, &va, ma, spring.anchor_a), sa);
             let (pb, b) = Anchor::held(Anchor::of(tb, &vb, mb, anchor), sb);
-            let Some(n) = (pa - pb).try_normalize() else {
+            let Some(n) = (pa - pb)
+                .try_normalize()
+                .or_else(|| long_span(pa - pb).map(|(_, n)| n))
+            else {
                 return;
             };
             let share = |dynamic: bool, end: &Anchor, t, m| {

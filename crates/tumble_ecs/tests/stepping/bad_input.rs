@@ -1323,3 +1323,54 @@ fn a_refused_body_never_takes_the_saved_state_of_another() {
         "the bad body kept a state of its own, not the one saved for its new row: {pose:?}"
     );
 }
+
+/// A spring longer than the square root of the precision's largest number (1.8e19 m in `f32`)
+/// has a finite length and force although its squared length overflows: the explicit step
+/// pushes its bodies with it (it refused both, its force `NaN`), and the damper acts along it.
+#[test]
+fn a_spring_whose_squared_length_overflows_still_pulls() {
+    let far = 2.0 * Real::MAX.sqrt();
+    let spring = Spring::new(
+        Entity::from_raw_u32(1).unwrap(),
+        Vec3::ZERO,
+        SpringEnd::World(Vec3::ZERO),
+        1.0,
+        0.0,
+    );
+    let d = Vec3::new(far, far, 0.0);
+    assert_eq!(d.length_squared(), Real::INFINITY);
+    let force = tumble_ecs::forces::spring_force(&spring, d);
+    let expected = -d; // k = 1, L₀ = 0: −k |d| n = −d.
+    assert!(force.is_finite(), "{force}");
+    assert!(
+        (force - expected).abs().max_element() <= 4.0 * Real::EPSILON * far,
+        "{force} vs {expected}"
+    );
+
+    let mut world = world_with(1.0 / 60.0, Integrator::Splitting);
+    world.resource_mut::<PhysicsSettings>().springs = SpringSolver::Explicit;
+    let body = |world: &mut World, x: Real| {
+        world
+            .spawn((
+                RigidBody,
+                mass_props(1.0, [1.0, 1.0, 1.0]),
+                Pose::from_translation(Vec3::new(x, 0.0, 0.0)),
+                Velocity::ZERO,
+                ForceAccumulator::default(),
+            ))
+            .id()
+    };
+    let (a, b) = (body(&mut world, 0.0), body(&mut world, far));
+    world.spawn(
+        Spring::new(a, Vec3::ZERO, SpringEnd::on_body(b, Vec3::ZERO), 1.0, 0.0).with_damping(0.1),
+    );
+    let mut physics = PhysicsRunner::new(&mut world);
+    run_steps(&mut world, &mut physics, 2);
+    for (end, sign) in [(a, 1.0), (b, -1.0)] {
+        if let Some(r) = world.get::<Rejected>(end) {
+            panic!("refused: {}", r.0);
+        }
+        let v = world.get::<Velocity>(end).unwrap().linear;
+        assert!(v.is_finite() && sign * v.x > 0.0, "pulled together: {v}");
+    }
+}

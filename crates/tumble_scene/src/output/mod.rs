@@ -230,6 +230,14 @@ impl Drop for Temporary {
     }
 }
 
+/// How the output's directory is held: on Linux as a path only (`O_PATH`), which needs no
+/// read permission on it (a directory one may write in but not list still takes outputs) and
+/// serves the `*at` calls; elsewhere opened for reading.
+#[cfg(target_os = "linux")]
+const HOLD_DIRECTORY: rustix::fs::OFlags = rustix::fs::OFlags::PATH;
+#[cfg(all(unix, not(target_os = "linux")))]
+const HOLD_DIRECTORY: rustix::fs::OFlags = rustix::fs::OFlags::RDONLY;
+
 /// The same device and inode.
 #[cfg(unix)]
 fn same_inode(a: &rustix::fs::Stat, b: &rustix::fs::Stat) -> bool {
@@ -275,9 +283,7 @@ impl OutputFile {
         #[cfg(unix)]
         let dir_fd = rustix::fs::open(
             dir,
-            rustix::fs::OFlags::RDONLY
-                | rustix::fs::OFlags::DIRECTORY
-                | rustix::fs::OFlags::CLOEXEC,
+            HOLD_DIRECTORY | rustix::fs::OFlags::DIRECTORY | rustix::fs::OFlags::CLOEXEC,
             rustix::fs::Mode::empty(),
         )
         .map_err(|e| OutputError::io(path, e.into()))?;
