@@ -117,6 +117,19 @@ fn spawn_bad(world: &mut World, t: Pose, v: Velocity, acc: Option<ForceAccumulat
 
 fn no_corruption(_: &mut World, _: Entity) {}
 
+/// A unit body at rest at `x` on the x axis, with an accumulator.
+fn loaded_body_at(world: &mut World, x: Real) -> Entity {
+    world
+        .spawn((
+            RigidBody,
+            mass_props(1.0, [1.0, 1.0, 1.0]),
+            Pose::from_translation(Vec3::new(x, 0.0, 0.0)),
+            Velocity::ZERO,
+            ForceAccumulator::default(),
+        ))
+        .id()
+}
+
 #[test]
 fn nan_translation_on_insert() {
     check_case(
@@ -744,17 +757,7 @@ fn a_spring_force_past_the_precision_refuses_its_bodies() {
         };
         let mut world = world_with(1.0 / 60.0, Integrator::Splitting);
         world.resource_mut::<PhysicsSettings>().springs = SpringSolver::Explicit;
-        let body = |world: &mut World, x: Real| {
-            world
-                .spawn((
-                    RigidBody,
-                    mass_props(1.0, [1.0, 1.0, 1.0]),
-                    Pose::from_translation(Vec3::new(x, 0.0, 0.0)),
-                    Velocity::ZERO,
-                    ForceAccumulator::default(),
-                ))
-                .id()
-        };
+        let body = loaded_body_at;
         let a = body(&mut world, 0.0);
         let healthy = body(&mut world, 5.0);
         // `k ℓ` is ten times the precision's largest number, `ℓ` itself is finite.
@@ -1349,17 +1352,7 @@ fn a_spring_whose_squared_length_overflows_still_pulls() {
 
     let mut world = world_with(1.0 / 60.0, Integrator::Splitting);
     world.resource_mut::<PhysicsSettings>().springs = SpringSolver::Explicit;
-    let body = |world: &mut World, x: Real| {
-        world
-            .spawn((
-                RigidBody,
-                mass_props(1.0, [1.0, 1.0, 1.0]),
-                Pose::from_translation(Vec3::new(x, 0.0, 0.0)),
-                Velocity::ZERO,
-                ForceAccumulator::default(),
-            ))
-            .id()
-    };
+    let body = loaded_body_at;
     let (a, b) = (body(&mut world, 0.0), body(&mut world, far));
     world.spawn(
         Spring::new(a, Vec3::ZERO, SpringEnd::on_body(b, Vec3::ZERO), 1.0, 0.0).with_damping(0.1),
